@@ -1,0 +1,31 @@
+// fiberlab: Monte Carlo ground truth for light scattering by hair and fur fibers.
+#include <fmt/core.h>
+
+#include <CLI/CLI.hpp>
+#include <exception>
+
+#include "cli/commands.h"
+#include "common/error.h"
+
+int main(int argc, char** argv) {
+  CLI::App app{"fiberlab " FIBERLAB_VERSION
+               ": Monte Carlo ground truth for light scattering by single fibers"};
+  app.set_version_flag("--version", std::string(FIBERLAB_VERSION));
+  app.require_subcommand(1);
+  fiberlab::cli::add_run_command(app);
+  fiberlab::cli::add_info_command(app);
+  fiberlab::cli::add_merge_command(app);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int status = app.exit(e);
+    return status == 0 ? 0 : 2;
+  } catch (const fiberlab::Error& e) {
+    fmt::print(stderr, "fiberlab: error: {}\n", e.what());
+    return 2;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "fiberlab: internal error: {}\n", e.what());
+    return 3;
+  }
+  return fiberlab::cli::exit_code;
+}

@@ -1,0 +1,239 @@
+#include "common/h5_file.h"
+
+#include <fmt/core.h>
+
+#include "common/error.h"
+
+namespace fiberlab::h5 {
+
+namespace {
+
+void check(herr_t status, const std::string& what, const std::string& path) {
+  if (status < 0) throw Error(fmt::format("{}: HDF5 error: {}", path, what));
+}
+
+Handle checked(hid_t id, Handle::Closer closer, const std::string& what, const std::string& path) {
+  if (id < 0) throw Error(fmt::format("{}: HDF5 error: {}", path, what));
+  return Handle(id, closer);
+}
+
+Handle open_object(hid_t file, const std::string& obj, const std::string& path) {
+  return checked(H5Oopen(file, obj.c_str(), H5P_DEFAULT), H5Oclose, "cannot open " + obj, path);
+}
+
+Handle open_attr(hid_t file, const std::string& obj, const std::string& name,
+                 const std::string& path) {
+  return checked(H5Aopen_by_name(file, obj.c_str(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT),
+                 H5Aclose, "missing attribute " + obj + "@" + name, path);
+}
+
+template <typename T>
+void write_dataset(hid_t file, const std::string& path, const std::string& name,
+                   const Dims& dims, const std::vector<T>& data, hid_t mem_type, hid_t file_type) {
+  hsize_t n = 1;
+  for (hsize_t d : dims) n *= d;
+  if (n != data.size())
+    throw Error(fmt::format("{}: internal error: {} has {} values for {} cells", path, name,
+                            data.size(), n));
+  Handle space = checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
+                         H5Sclose, "dataspace for " + name, path);
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list", path);
+  // Large arrays are chunked and compressed: most histogram bins are empty.
+  if (n >= 4096 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
+    Dims chunk = dims;
+    hsize_t cells = n;
+    for (std::size_t i = 0; i < chunk.size() && cells > 65536; ++i) {
+      cells /= chunk[i];
+      chunk[i] = 1;
+      if (cells < 65536) {
+        chunk[i] = std::max<hsize_t>(1, 65536 / cells);
+        chunk[i] = std::min(chunk[i], dims[i]);
+        break;
+      }
+    }
+    H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
+    H5Pset_deflate(dcpl.id(), 4);
+  }
+  Handle set = checked(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
+                                  dcpl.id(), H5P_DEFAULT),
+                       H5Dclose, "cannot create " + name, path);
+  check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
+        "cannot write " + name, path);
+}
+
+template <typename T>
+std::vector<T> read_dataset(hid_t file, const std::string& path, const std::string& name,
+                            Dims* dims_out, hid_t mem_type) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  Dims dims(rank);
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  hsize_t n = 1;
+  for (hsize_t d : dims) n *= d;
+  std::vector<T> data(n);
+  check(H5Dread(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
+        "cannot read " + name, path);
+  if (dims_out) *dims_out = dims;
+  return data;
+}
+
+void write_attr(hid_t file, const std::string& path, const std::string& obj,
+                const std::string& name, hid_t type, hid_t space, const void* buf) {
+  Handle o = open_object(file, obj, path);
+  if (H5Aexists(o.id(), name.c_str()) > 0) H5Adelete(o.id(), name.c_str());
+  Handle a = checked(H5Acreate2(o.id(), name.c_str(), type, space, H5P_DEFAULT, H5P_DEFAULT),
+                     H5Aclose, "cannot create attribute " + obj + "@" + name, path);
+  check(H5Awrite(a.id(), type, buf), "cannot write attribute " + obj + "@" + name, path);
+}
+
+}  // namespace
+
+Handle& Handle::operator=(Handle&& o) noexcept {
+  if (this != &o) {
+    if (id_ >= 0 && closer_) closer_(id_);
+    id_ = o.id_;
+    closer_ = o.closer_;
+    o.id_ = -1;
+  }
+  return *this;
+}
+
+Handle::~Handle() {
+  if (id_ >= 0 && closer_) closer_(id_);
+}
+
+void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+File File::create(const std::string& path) {
+  quiet_hdf5_errors();
+  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  if (id < 0) throw Error(fmt::format("{}: cannot create file (is the folder writable?)", path));
+  return File(Handle(id, H5Fclose), path);
+}
+
+File File::open_read(const std::string& path) {
+  quiet_hdf5_errors();
+  hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (id < 0) throw Error(fmt::format("{}: cannot open as an HDF5 file", path));
+  return File(Handle(id, H5Fclose), path);
+}
+
+void File::close() {
+  if (handle_.id() >= 0) check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "flush", path_);
+  handle_ = Handle();
+}
+
+void File::create_group(const std::string& name) {
+  checked(H5Gcreate2(handle_.id(), name.c_str(), H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT),
+          H5Gclose, "cannot create group " + name, path_);
+}
+
+bool File::exists(const std::string& name) const {
+  // Check each path component, as H5Lexists requires.
+  std::size_t pos = 1;
+  while (true) {
+    std::size_t next = name.find('/', pos);
+    std::string prefix = name.substr(0, next);
+    if (H5Lexists(handle_.id(), prefix.c_str(), H5P_DEFAULT) <= 0) return false;
+    if (next == std::string::npos) return true;
+    pos = next + 1;
+  }
+}
+
+void File::write(const std::string& name, const Dims& dims, const std::vector<double>& data) {
+  write_dataset(handle_.id(), path_, name, dims, data, H5T_NATIVE_DOUBLE, H5T_IEEE_F64LE);
+}
+
+void File::write(const std::string& name, const Dims& dims,
+                 const std::vector<std::uint64_t>& data) {
+  write_dataset(handle_.id(), path_, name, dims, data, H5T_NATIVE_UINT64, H5T_STD_U64LE);
+}
+
+std::vector<double> File::read_doubles(const std::string& name, Dims* dims) const {
+  return read_dataset<double>(handle_.id(), path_, name, dims, H5T_NATIVE_DOUBLE);
+}
+
+std::vector<std::uint64_t> File::read_uint64s(const std::string& name, Dims* dims) const {
+  return read_dataset<std::uint64_t>(handle_.id(), path_, name, dims, H5T_NATIVE_UINT64);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name, const std::string& value) {
+  // Variable-length UTF-8 string: h5py reads it as a Python str.
+  Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "string type", path_);
+  H5Tset_size(type.id(), H5T_VARIABLE);
+  H5Tset_cset(type.id(), H5T_CSET_UTF8);
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "scalar space", path_);
+  const char* p = value.c_str();
+  write_attr(handle_.id(), path_, obj, name, type.id(), space.id(), &p);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name, double value) {
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "scalar space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_NATIVE_DOUBLE, space.id(), &value);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name, std::int64_t value) {
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "scalar space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_NATIVE_INT64, space.id(), &value);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name,
+                    const std::vector<double>& value) {
+  hsize_t n = value.size();
+  Handle space = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "array space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_NATIVE_DOUBLE, space.id(), value.data());
+}
+
+bool File::has_attr(const std::string& obj, const std::string& name) const {
+  return H5Aexists_by_name(handle_.id(), obj.c_str(), name.c_str(), H5P_DEFAULT) > 0;
+}
+
+std::string File::attr_string(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle ftype = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
+  if (H5Tget_class(ftype.id()) != H5T_STRING)
+    throw Error(fmt::format("{}: attribute {}@{} is not a string", path_, obj, name));
+  if (H5Tis_variable_str(ftype.id()) > 0) {
+    Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "string type", path_);
+    H5Tset_size(mtype.id(), H5T_VARIABLE);
+    H5Tset_cset(mtype.id(), H5Tget_cset(ftype.id()));
+    char* p = nullptr;
+    check(H5Aread(a.id(), mtype.id(), &p), "cannot read " + name, path_);
+    std::string s = p ? p : "";
+    Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
+    H5Dvlen_reclaim(mtype.id(), space.id(), H5P_DEFAULT, &p);
+    return s;
+  }
+  const std::size_t n = H5Tget_size(ftype.id());
+  std::string s(n, '\0');
+  check(H5Aread(a.id(), ftype.id(), s.data()), "cannot read " + name, path_);
+  s.resize(s.find('\0') == std::string::npos ? n : s.find('\0'));
+  return s;
+}
+
+double File::attr_double(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  double v = 0;
+  check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, &v), "cannot read " + name, path_);
+  return v;
+}
+
+std::int64_t File::attr_int(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  std::int64_t v = 0;
+  check(H5Aread(a.id(), H5T_NATIVE_INT64, &v), "cannot read " + name, path_);
+  return v;
+}
+
+std::vector<double> File::attr_doubles(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  std::vector<double> v(static_cast<std::size_t>(n));
+  check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, v.data()), "cannot read " + name, path_);
+  return v;
+}
+
+}  // namespace fiberlab::h5

@@ -1,0 +1,68 @@
+#pragma once
+// A thin RAII layer over the HDF5 C API: just what fiberlab's result files need
+// (groups, n-dimensional float64 / uint64 datasets, scalar and array attributes).
+// Errors are thrown as fiberlab::Error naming the file and the object.
+#include <hdf5.h>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace fiberlab::h5 {
+
+// Owns one hid_t and closes it with the matching H5*close.
+class Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  Handle() = default;
+  Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  Handle(const Handle&) = delete;
+  Handle& operator=(const Handle&) = delete;
+  Handle(Handle&& o) noexcept : id_(o.id_), closer_(o.closer_) { o.id_ = -1; }
+  Handle& operator=(Handle&& o) noexcept;
+  ~Handle();
+  hid_t id() const { return id_; }
+
+ private:
+  hid_t id_ = -1;
+  Closer closer_ = nullptr;
+};
+
+using Dims = std::vector<hsize_t>;
+
+class File {
+ public:
+  static File create(const std::string& path);  // truncates
+  static File open_read(const std::string& path);
+  const std::string& path() const { return path_; }
+  void close();
+
+  void create_group(const std::string& name);
+  bool exists(const std::string& name) const;  // a link at this path
+
+  void write(const std::string& name, const Dims& dims, const std::vector<double>& data);
+  void write(const std::string& name, const Dims& dims, const std::vector<std::uint64_t>& data);
+  std::vector<double> read_doubles(const std::string& name, Dims* dims = nullptr) const;
+  std::vector<std::uint64_t> read_uint64s(const std::string& name, Dims* dims = nullptr) const;
+
+  // Attributes on an object ("/" for the root).
+  void set_attr(const std::string& obj, const std::string& name, const std::string& value);
+  void set_attr(const std::string& obj, const std::string& name, double value);
+  void set_attr(const std::string& obj, const std::string& name, std::int64_t value);
+  void set_attr(const std::string& obj, const std::string& name, const std::vector<double>& value);
+  bool has_attr(const std::string& obj, const std::string& name) const;
+  std::string attr_string(const std::string& obj, const std::string& name) const;
+  double attr_double(const std::string& obj, const std::string& name) const;
+  std::int64_t attr_int(const std::string& obj, const std::string& name) const;
+  std::vector<double> attr_doubles(const std::string& obj, const std::string& name) const;
+
+ private:
+  File(Handle h, std::string path) : handle_(std::move(h)), path_(std::move(path)) {}
+  Handle handle_;
+  std::string path_;
+};
+
+// Silences HDF5's automatic error stack printing; fiberlab reports its own.
+void quiet_hdf5_errors();
+
+}  // namespace fiberlab::h5
