@@ -3,6 +3,7 @@
 // components (u, v, w): u is the tangent (root -> tip), v the major axis of the
 // cross-section, w the minor axis.
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 

@@ -1,0 +1,49 @@
+#include "cli/summary_table.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+
+#include "common/units.h"
+
+namespace fiberlab::cli {
+
+namespace {
+
+std::string lobe_name(int lobe, int lobes) {
+  static const char* names[] = {"R", "TT", "TRT", "TRRT", "TR3T", "TR4T"};
+  if (lobe == lobes - 1 && lobes > 1) return fmt::format("p>={}", lobe);
+  return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
+}
+
+}  // namespace
+
+void print_summary(std::FILE* out, const sim::ResultFile& r) {
+  for (std::size_t k = 0; k < r.configs(); ++k) {
+    const double N = static_cast<double>(r.photons[k]);
+    const std::string phi = std::isnan(r.phi_i[k]) ? std::string("uniform")
+                                                   : fmt::format("{:.2f}", rad_to_deg(r.phi_i[k]));
+    fmt::print(out, "theta_i = {:.2f} deg, phi_i = {}, {} photons\n", rad_to_deg(r.theta_i[k]),
+               phi, r.photons[k]);
+    fmt::print(out, "  {:<10}", "lobe");
+    for (int c = 0; c < r.channels; ++c) fmt::print(out, " {:>24}", fmt::format("channel {}", c));
+    fmt::print(out, "\n");
+    for (int l = 0; l < r.lobes; ++l) {
+      fmt::print(out, "  {:<10}", lobe_name(l, r.lobes));
+      for (int c = 0; c < r.channels; ++c) {
+        const sim::Estimate e = sim::lobe_energy(r, k, l, c);
+        fmt::print(out, " {:>24}", fmt::format("{:.6f} +- {:.6f}", e.mean, e.std_error));
+      }
+      fmt::print(out, "\n");
+    }
+    fmt::print(out, "  {:<10}", "absorbed");
+    for (int c = 0; c < r.channels; ++c)
+      fmt::print(out, " {:>24}", fmt::format("{:.6f}", r.absorbed[k * r.channels + c] / N));
+    fmt::print(out, "\n  {:<10}", "truncated");
+    for (int c = 0; c < r.channels; ++c)
+      fmt::print(out, " {:>24}", fmt::format("{:.3e}", r.truncated[k * r.channels + c] / N));
+    fmt::print(out, "\n");
+  }
+}
+
+}  // namespace fiberlab::cli

@@ -1,0 +1,64 @@
+#pragma once
+// Random numbers for one photon. Each photon's stream is derived only from
+// (seed, incident configuration, photon index), so a photon's path does not
+// depend on which thread traces it or in which order (OpenMC's scheme; SPEC
+// section 6, reproducibility). Generator: xoshiro256** (Blackman & Vigna
+// 2018) seeded through SplitMix64.
+#include <cmath>
+#include <cstdint>
+
+namespace fiberlab::sim {
+
+class PhotonRandom {
+ public:
+  PhotonRandom(std::uint64_t seed, std::uint64_t config, std::uint64_t photon) {
+    std::uint64_t x = splitmix(seed ^ 0x6a09e667f3bcc909ULL);
+    x = splitmix(x ^ config);
+    x = splitmix(x ^ photon);
+    for (auto& s : s_) s = x = splitmix(x);
+  }
+
+  // Uniform in [0, 1).
+  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  // Uniform in (0, 1]: safe under log().
+  double uniform_open0() { return static_cast<double>((next() >> 11) + 1) * 0x1.0p-53; }
+
+  // Standard normal deviate (Box-Muller, both values used).
+  double normal() {
+    if (has_spare_) {
+      has_spare_ = false;
+      return spare_;
+    }
+    const double r = std::sqrt(-2.0 * std::log(uniform_open0()));
+    const double a = 6.283185307179586 * uniform();
+    spare_ = r * std::sin(a);
+    has_spare_ = true;
+    return r * std::cos(a);
+  }
+
+ private:
+  static std::uint64_t splitmix(std::uint64_t z) {
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+  }
+  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
+  std::uint64_t next() {
+    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
+    const std::uint64_t t = s_[1] << 17;
+    s_[2] ^= s_[0];
+    s_[3] ^= s_[1];
+    s_[1] ^= s_[2];
+    s_[0] ^= s_[3];
+    s_[2] ^= t;
+    s_[3] = rotl(s_[3], 45);
+    return result;
+  }
+
+  std::uint64_t s_[4];
+  double spare_ = 0.0;
+  bool has_spare_ = false;
+};
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,204 @@
+#include "sim/result_file.h"
+
+#include <fmt/core.h>
+
+#include <chrono>
+#include <cmath>
+#include <ctime>
+#include <limits>
+
+#include "common/atomic_output.h"
+#include "common/error.h"
+#include "common/h5_file.h"
+#include "common/result_layout.h"
+
+namespace fiberlab::sim {
+
+namespace {
+
+std::string utc_now() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+template <typename T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
+}
+
+void write_parameters(h5::File& f, const Settings& s) {
+  f.create_group("/fiber");
+  f.set_attr("/fiber", "eta", s.fiber.eta);
+  f.set_attr("/fiber", "eccentricity", s.fiber.eccentricity);
+  f.set_attr("/fiber", "scale_tilt", s.fiber.scale_tilt);
+  f.set_attr("/fiber", "sigma_a", s.fiber.sigma_a);
+  f.create_group("/roughness");
+  f.set_attr("/roughness", "model", to_string(s.roughness.model));
+  f.set_attr("/roughness", "beta_long", s.roughness.beta_long);
+  f.set_attr("/roughness", "beta_azim", s.roughness.beta_azim);
+  f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
+  f.set_attr("/source", "polarization", to_string(s.polarization));
+  f.set_attr("/source", "phi_i_uniform", static_cast<std::int64_t>(s.source.phi_i_uniform));
+}
+
+}  // namespace
+
+ResultFile make_result(const Settings& settings, const BinGrid& grid,
+                       const std::vector<Tally>& tallies) {
+  ResultFile r;
+  r.settings = settings;
+  r.config_yaml = to_yaml(settings);
+  r.seeds = {settings.seed};
+  r.software_version = FIBERLAB_VERSION;
+  r.created_utc = utc_now();
+  r.grid = grid;
+  for (const Settings::Incidence& inc : settings.incidences()) {
+    r.theta_i.push_back(inc.theta_i);
+    r.phi_i.push_back(inc.phi_i);
+  }
+  r.lobes = settings.tally.lobes;
+  r.channels = static_cast<int>(settings.fiber.sigma_a.size());
+  for (const Tally& t : tallies) {
+    r.photons.push_back(t.photons());
+    append(r.weight_sum, t.weight_sum());
+    append(r.weight_sq_sum, t.weight_sq_sum());
+    append(r.count, t.count());
+    append(r.exited, t.exited());
+    append(r.absorbed, t.absorbed());
+    append(r.truncated, t.truncated());
+  }
+  return r;
+}
+
+void write_result(const ResultFile& r, const std::string& path) {
+  AtomicOutput out(path);
+  {
+    h5::File f = h5::File::create(out.temp_path());
+    f.set_attr("/", "format", std::string("fiber-histogram"));
+    f.set_attr("/", "format_version", static_cast<std::int64_t>(kFormatVersion));
+    f.set_attr("/", "software_version", r.software_version);
+    f.set_attr("/", "created_utc", r.created_utc);
+    f.set_attr("/", "seed", static_cast<std::int64_t>(r.seeds.front()));
+    std::vector<double> seeds(r.seeds.begin(), r.seeds.end());
+    f.set_attr("/", "merged_seeds", seeds);
+    f.set_attr("/", "config_yaml", r.config_yaml);
+    write_bins(f, r.grid);
+    write_incidences(f, r.theta_i, r.phi_i);
+    write_parameters(f, r.settings);
+
+    const hsize_t K = r.configs(), L = r.lobes, C = r.channels;
+    const hsize_t T = r.grid.n_theta(), P = r.grid.n_phi();
+    f.create_group("/tally");
+    f.write("/tally/photons", {K}, r.photons);
+    f.write("/tally/weight_sum", {K, L, T, P, C}, r.weight_sum);
+    f.write("/tally/weight_sq_sum", {K, L, T, P, C}, r.weight_sq_sum);
+    f.write("/tally/count", {K, L, T, P}, r.count);
+    f.create_group("/ledger");
+    f.write("/ledger/exited", {K, L, C}, r.exited);
+    f.write("/ledger/absorbed", {K, C}, r.absorbed);
+    f.write("/ledger/truncated", {K, C}, r.truncated);
+    f.close();
+  }
+  out.commit();
+}
+
+ResultFile read_result(const std::string& path) {
+  h5::File f = h5::File::open_read(path);
+  if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-histogram")
+    throw Error(fmt::format("{}: not a fiberlab result file (root attribute format is not "
+                            "\"fiber-histogram\")", path));
+  ResultFile r;
+  r.config_yaml = f.attr_string("/", "config_yaml");
+  r.settings = parse_settings_yaml(r.config_yaml, path + ":/config_yaml");
+  r.software_version = f.attr_string("/", "software_version");
+  r.created_utc = f.attr_string("/", "created_utc");
+  if (f.has_attr("/", "merged_seeds")) {
+    for (double s : f.attr_doubles("/", "merged_seeds")) r.seeds.push_back(static_cast<std::uint64_t>(s));
+  } else {
+    r.seeds = {static_cast<std::uint64_t>(f.attr_int("/", "seed"))};
+  }
+  r.grid = read_bins(f);
+  r.theta_i = f.read_doubles("/source/theta_i");
+  r.phi_i = f.read_doubles("/source/phi_i");
+  r.photons = f.read_uint64s("/tally/photons");
+  h5::Dims dims;
+  r.weight_sum = f.read_doubles("/tally/weight_sum", &dims);
+  if (dims.size() != 5) throw Error(path + ": /tally/weight_sum is not 5-dimensional");
+  r.lobes = static_cast<int>(dims[1]);
+  r.channels = static_cast<int>(dims[4]);
+  r.weight_sq_sum = f.read_doubles("/tally/weight_sq_sum");
+  r.count = f.read_uint64s("/tally/count");
+  r.exited = f.read_doubles("/ledger/exited");
+  r.absorbed = f.read_doubles("/ledger/absorbed");
+  r.truncated = f.read_doubles("/ledger/truncated");
+  if (r.weight_sum.size() != r.configs() * r.bin_cells() ||
+      r.weight_sq_sum.size() != r.weight_sum.size() || r.theta_i.size() != r.configs())
+    throw Error(path + ": dataset shapes do not agree with /bins and /source");
+  return r;
+}
+
+ResultFile merge_results(const std::vector<ResultFile>& parts,
+                         const std::vector<std::string>& names) {
+  if (parts.empty()) throw Error("merge: no input files");
+  ResultFile sum = parts.front();
+  // Everything but the seed and the photon count must agree.
+  auto comparable = [](Settings s) {
+    s.seed = 0;
+    s.photons = 1;
+    s.output.clear();
+    return to_yaml(s);
+  };
+  const std::string reference = comparable(sum.settings);
+  for (std::size_t i = 1; i < parts.size(); ++i) {
+    const ResultFile& p = parts[i];
+    if (comparable(p.settings) != reference || p.grid.theta_edges != sum.grid.theta_edges ||
+        p.grid.phi_edges != sum.grid.phi_edges || p.theta_i != sum.theta_i ||
+        p.lobes != sum.lobes || p.channels != sum.channels)
+      throw Error(fmt::format("merge: {} does not match {}: fiber, roughness, source, tally "
+                              "and segment settings must be identical (only seed and photons "
+                              "may differ)", names[i], names[0]));
+    for (std::uint64_t s : p.seeds)
+      for (std::uint64_t t : sum.seeds)
+        if (s == t)
+          throw Error(fmt::format("merge: {} repeats seed {}: merging runs with the same seed "
+                                  "double-counts identical photons", names[i], s));
+    append(sum.seeds, p.seeds);
+    for (std::size_t k = 0; k < sum.photons.size(); ++k) sum.photons[k] += p.photons[k];
+    auto add = [](std::vector<double>& a, const std::vector<double>& b) {
+      for (std::size_t j = 0; j < a.size(); ++j) a[j] += b[j];
+    };
+    add(sum.weight_sum, p.weight_sum);
+    add(sum.weight_sq_sum, p.weight_sq_sum);
+    add(sum.exited, p.exited);
+    add(sum.absorbed, p.absorbed);
+    add(sum.truncated, p.truncated);
+    for (std::size_t j = 0; j < sum.count.size(); ++j) sum.count[j] += p.count[j];
+  }
+  sum.settings.photons = sum.photons.front();  // every configuration has the same count
+  sum.config_yaml = to_yaml(sum.settings);
+  sum.created_utc = utc_now();
+  sum.software_version = FIBERLAB_VERSION;
+  return sum;
+}
+
+Estimate bin_estimate(double s1, double s2, std::uint64_t n) {
+  const double N = static_cast<double>(n);
+  const double p = s1 / N;
+  const double var = n > 1 ? std::max(0.0, (s2 / N - p * p) / (N - 1.0)) : 0.0;
+  return {p, std::sqrt(var)};
+}
+
+Estimate lobe_energy(const ResultFile& r, std::size_t k, int lobe, int c) {
+  // Each photon lands in one bin, so the lobe's S2 is the sum of its bins' S2.
+  double s2 = 0.0;
+  for (int i = 0; i < r.grid.n_theta(); ++i)
+    for (int j = 0; j < r.grid.n_phi(); ++j) s2 += r.weight_sq_sum[r.cell(k, lobe, i, j, c)];
+  const double s1 = r.exited[(k * r.lobes + lobe) * r.channels + c];
+  return bin_estimate(s1, s2, r.photons[k]);
+}
+
+}  // namespace fiberlab::sim

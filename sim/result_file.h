@@ -1,0 +1,60 @@
+#pragma once
+// The simulation's result file (SPEC section 9; OpenMC's "statepoint"): what
+// was counted, with the parameters it was counted for. Written atomically,
+// readable by h5py with no project code.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "common/bin_grid.h"
+#include "sim/settings.h"
+#include "sim/tally.h"
+
+namespace fiberlab::sim {
+
+struct ResultFile {
+  Settings settings;                 // parsed back from config_yaml on read
+  std::string config_yaml;
+  std::vector<std::uint64_t> seeds;  // one per run merged into this file
+  std::string software_version, created_utc;
+  BinGrid grid;
+  std::vector<double> theta_i, phi_i;  // K; phi_i NaN where uniform
+  int lobes = 0, channels = 0;
+  std::vector<std::uint64_t> photons;   // K
+  std::vector<double> weight_sum, weight_sq_sum;  // K x L x n_theta x n_phi x C
+  std::vector<std::uint64_t> count;     // K x L x n_theta x n_phi
+  std::vector<double> exited;           // K x L x C
+  std::vector<double> absorbed, truncated;  // K x C
+
+  std::size_t configs() const { return photons.size(); }
+  std::size_t bin_cells() const {
+    return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
+  }
+  // Index into weight_sum / weight_sq_sum.
+  std::size_t cell(std::size_t k, int lobe, int i_theta, int i_phi, int c) const {
+    return (((k * lobes + lobe) * grid.n_theta() + i_theta) * grid.n_phi() + i_phi) *
+               channels + c;
+  }
+};
+
+// Assembles the file contents from a finished run.
+ResultFile make_result(const Settings& settings, const BinGrid& grid,
+                       const std::vector<Tally>& tallies);
+
+void write_result(const ResultFile& result, const std::string& path);  // atomic
+ResultFile read_result(const std::string& path);
+
+// Adds runs of the same fiber, bins and incident directions; throws
+// fiberlab::Error naming the first difference otherwise.
+ResultFile merge_results(const std::vector<ResultFile>& parts,
+                         const std::vector<std::string>& names);
+
+// Estimators of SPEC section 6 for one lobe's total energy (all bins).
+struct Estimate {
+  double mean, std_error;
+};
+Estimate lobe_energy(const ResultFile& r, std::size_t k, int lobe, int c);
+// Probability P = S1 / N and its standard error sqrt((S2/N - P^2)/(N - 1)).
+Estimate bin_estimate(double s1, double s2, std::uint64_t n);
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,65 @@
+#include "sim/tally.h"
+
+namespace fiberlab::sim {
+
+Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
+    : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels) {
+  const std::size_t bins = static_cast<std::size_t>(lobes) * n_theta * n_phi;
+  s1_.assign(bins * channels, 0);
+  s2_.assign(bins * channels, 0);
+  count_.assign(bins, 0);
+  exited_.assign(static_cast<std::size_t>(lobes) * channels, 0);
+  absorbed_.assign(channels, 0);
+  truncated_.assign(channels, 0);
+}
+
+void Tally::score_exit(int lobe, int i_theta, int i_phi, const double* weight) {
+  const std::size_t b = bin_index(lobe, i_theta, i_phi);
+  ++count_[b];
+  Fixed* s1 = &s1_[b * channels_];
+  Fixed* s2 = &s2_[b * channels_];
+  for (int c = 0; c < channels_; ++c) {
+    const Fixed w = to_fixed(weight[c]);
+    s1[c] += w;
+    s2[c] += to_fixed(weight[c] * weight[c]);
+    exited_[static_cast<std::size_t>(lobe) * channels_ + c] += w;
+    absorbed_[c] += static_cast<Fixed>(1) << 60;
+    absorbed_[c] -= w;
+  }
+}
+
+void Tally::score_truncated(const double* weight) {
+  for (int c = 0; c < channels_; ++c) {
+    const Fixed w = to_fixed(weight[c]);
+    truncated_[c] += w;
+    absorbed_[c] += (static_cast<Fixed>(1) << 60) - w;
+  }
+}
+
+void Tally::add(const Tally& o) {
+  photons_ += o.photons_;
+  for (std::size_t i = 0; i < s1_.size(); ++i) {
+    s1_[i] += o.s1_[i];
+    s2_[i] += o.s2_[i];
+  }
+  for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
+  for (std::size_t i = 0; i < exited_.size(); ++i) exited_[i] += o.exited_[i];
+  for (int c = 0; c < channels_; ++c) {
+    absorbed_[c] += o.absorbed_[c];
+    truncated_[c] += o.truncated_[c];
+  }
+}
+
+std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(v[i]) / kScale;
+  return out;
+}
+
+std::vector<double> Tally::weight_sum() const { return to_double(s1_); }
+std::vector<double> Tally::weight_sq_sum() const { return to_double(s2_); }
+std::vector<double> Tally::exited() const { return to_double(exited_); }
+std::vector<double> Tally::absorbed() const { return to_double(absorbed_); }
+std::vector<double> Tally::truncated() const { return to_double(truncated_); }
+
+}  // namespace fiberlab::sim

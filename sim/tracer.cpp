@@ -1,0 +1,100 @@
+#include "sim/tracer.h"
+
+#include <cmath>
+
+#include "sim/exit_blur.h"
+#include "sim/interface_event.h"
+#include "sim/microfacet_normal.h"
+
+namespace fiberlab::sim {
+
+Tracer::Tracer(const Settings& s)
+    : ellipse_(s.fiber.eccentricity),
+      model_(s.roughness.model),
+      eta_(s.fiber.eta),
+      cos_tilt_(std::cos(s.fiber.scale_tilt)),
+      sin_tilt_(std::sin(s.fiber.scale_tilt)),
+      beta_long_(s.roughness.beta_long.front()),
+      beta_azim_(s.roughness.beta_azim.front()),
+      max_segments_(s.max_segments),
+      max_events_(s.max_events_per_point) {
+  for (double b : s.roughness.beta_long) blur_v_.push_back(b * b);
+  blur_beta_ = s.roughness.beta_azim;
+}
+
+// Returns false when the photon must be truncated (too many events at this
+// point, or no visible normal found). On return d is the new direction and
+// `inside` the photon's new side, consistent with the untilted normal.
+bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, PhotonRandom& rng,
+                                 TracerCounters& counters) const {
+  const Vec3 n0 = ellipse_.normal(p);
+  // Cuticle tilt towards the root, on both sides (SPEC section 2).
+  const Vec3 n_s = cos_tilt_ * n0 - sin_tilt_ * Vec3::UnitX();
+  ScalarLight light;
+  for (int k = 0; k < max_events_; ++k) {
+    ++counters.events;
+    const BoundaryNormals normals{inside ? Vec3(-n_s) : n_s, inside ? Vec3(-n0) : n0};
+    Vec3 m;
+    if (model_ == RoughnessModel::Gaussian) {
+      auto drawn = gaussian_normal(d, normals.facing, beta_long_, beta_azim_, rng,
+                                   kMaxNormalTries, counters.normal_draws);
+      if (!drawn) return false;
+      m = *drawn;
+    } else {
+      m = smooth_normal(d, normals);
+    }
+    const double eta_rel = inside ? 1.0 / eta_ : eta_;  // n_t / n_i
+    const EventResult r = light.interact(d, m, eta_rel, rng);
+    d = r.direction;
+    if (r.refracted) inside = !inside;
+    // Consistency rule (SPEC section 3): the new direction must leave the
+    // boundary on the photon's side, judged with the untilted normal.
+    const double dn = d.dot(n0);
+    if (inside ? dn < 0.0 : dn > 0.0) return true;
+  }
+  return false;
+}
+
+PhotonOutcome Tracer::trace(const Vec3& wi, double h, PhotonRandom& rng,
+                            TracerCounters* counters_out) const {
+  TracerCounters counters;
+  PhotonOutcome out;
+  Vec3 d = -wi;
+  Point2 p = ellipse_.entry_point(d, h);
+  bool inside = false;
+  while (true) {
+    if (!scatter_at_boundary(p, d, inside, rng, counters)) {
+      out.fate = PhotonFate::Truncated;
+      break;
+    }
+    if (!inside) {  // left the fiber
+      out.fate = PhotonFate::Exited;
+      if (model_ == RoughnessModel::ExitBlur) {
+        const int p_lobe = out.segments;
+        d = blur_exit_direction(d, RoughnessSettings::for_lobe(blur_v_, p_lobe),
+                                RoughnessSettings::for_lobe(blur_beta_, p_lobe), rng);
+      }
+      out.direction = d;
+      break;
+    }
+    if (out.segments == max_segments_) {  // the photon did not leave at the last boundary
+      out.fate = PhotonFate::Truncated;
+      break;
+    }
+    const double t = ellipse_.distance_to_boundary(p, d);
+    if (!std::isfinite(t)) {  // running exactly along the axis: guided for ever
+      out.fate = PhotonFate::Truncated;
+      break;
+    }
+    p = ellipse_.advance(p, d, t);
+    out.path_length += t;
+    ++out.segments;
+  }
+  if (counters_out) {
+    counters_out->events += counters.events;
+    counters_out->normal_draws += counters.normal_draws;
+  }
+  return out;
+}
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,55 @@
+#pragma once
+// A photon's life (SPEC sections 3-5): enter the fiber at an impact parameter,
+// meet the boundary, reflect or refract about a drawn normal, run straight
+// segments inside, until it leaves or is truncated. The path does not depend
+// on the colour channel, so the tracer returns the total internal path length
+// and the caller turns it into a Beer-Lambert weight per channel.
+#include "common/fiber_frame.h"
+#include "sim/ellipse_cross_section.h"
+#include "sim/random.h"
+#include "sim/settings.h"
+
+namespace fiberlab::sim {
+
+enum class PhotonFate { Exited, Truncated };
+
+struct PhotonOutcome {
+  PhotonFate fate = PhotonFate::Exited;
+  Vec3 direction = Vec3::Zero();  // exit direction wr (when Exited)
+  int segments = 0;               // internal straight segments: the lobe index p
+  double path_length = 0.0;       // total 3D length inside, in units of R
+};
+
+// Work counters, for benchmarks and notes.
+struct TracerCounters {
+  long events = 0;          // interface events
+  long normal_draws = 0;    // candidate microfacet normals drawn
+};
+
+class Tracer {
+ public:
+  explicit Tracer(const Settings& settings);
+
+  // Traces one photon arriving along -wi. h in (-1, 1) is its impact
+  // parameter across the projected width.
+  PhotonOutcome trace(const Vec3& wi, double h, PhotonRandom& rng,
+                      TracerCounters* counters = nullptr) const;
+
+  // Cap on candidate normals per event (SPEC section 3: at least 10,000).
+  static constexpr int kMaxNormalTries = 100000;
+
+ private:
+  // Interface events at one boundary point until the consistency rule holds.
+  bool scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, PhotonRandom& rng,
+                           TracerCounters& counters) const;
+
+  EllipseCrossSection ellipse_;
+  RoughnessModel model_;
+  double eta_;
+  double cos_tilt_, sin_tilt_;
+  double beta_long_, beta_azim_;          // gaussian
+  std::vector<double> blur_v_, blur_beta_; // exit_blur, indexed by p
+  int max_segments_, max_events_;
+};
+
+}  // namespace fiberlab::sim
