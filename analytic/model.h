@@ -35,12 +35,29 @@ struct ModelParams {
   double k_g = 0.5, w_c = 0.0, delta_eta = 0.0, delta_h_m = 0.0;  // caustics, see marschner2003.h
   // d'Eon 2011 only: Gauss-Legendre order of the N_p integral over h.
   int quadrature_order = 35;
+  // d'Eon 2011 only: the R lobe's Fresnel term. true = Eq. 12 as published,
+  // F(eta, arccos(wi.wr)/2) at the exit direction; false = Eq. 14 per h,
+  // F(eta, arccos(cos theta_d cos gamma_i)) (`r_fresnel=half_angle|per_h`).
+  bool r_half_angle_fresnel = true;
 };
+
+// Value of a per-lobe list for lobe p: the last entry applies to every larger p.
+inline double for_lobe(const std::vector<double>& list, int p) {
+  if (list.empty()) return 0.0;
+  return list[static_cast<std::size_t>(p) < list.size() ? static_cast<std::size_t>(p)
+                                                        : list.size() - 1];
+}
+// The tally's lobe index of path order p (SPEC section 6).
+inline int lobe_of(int p, int lobes) { return p < lobes - 1 ? p : lobes - 1; }
 
 class Model {
  public:
   virtual ~Model() = default;
   virtual std::string name() const = 0;
+  // Number of tally lobes L the model predicts (ModelParams::lobes). The
+  // default bin_probabilities() uses it; models built from ModelParams should
+  // return params.lobes (the factory makes sure they do).
+  virtual int lobes() const { return 4; }
 
   // Density of lobe `lobe` (the tally's lobe index: the last lobe sums every
   // p >= lobes-1) per d(theta_r) d(phi), one value per channel in `out`.
@@ -48,8 +65,9 @@ class Model {
                        std::vector<double>& out) const = 0;
 
   // Probability of each bin: out[((lobe * n_theta + i) * n_phi + j) * C + c].
-  // The default integrates density() by quadrature; models with singular
-  // densities (the smooth cylinder's delta in theta_r) override it.
+  // The default integrates density() by a 6 x 6-point Gauss-Legendre rule
+  // per bin (fine for densities smooth on the bin scale); models with
+  // singular or sharply peaked densities override it.
   virtual std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
                                                 double phi_i) const;
 };
