@@ -21,6 +21,8 @@ struct FiberSettings {
   std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
   // Set when the config gave melanin instead of sigma_a (sigma_a is then derived).
   std::optional<double> eumelanin, pheomelanin;
+
+  friend bool operator==(const FiberSettings&, const FiberSettings&) = default;
 };
 
 struct RoughnessSettings {
@@ -34,12 +36,16 @@ struct RoughnessSettings {
   static double for_lobe(const std::vector<double>& betas, int p) {
     return betas[std::min<std::size_t>(static_cast<std::size_t>(p), betas.size() - 1)];
   }
+
+  friend bool operator==(const RoughnessSettings&, const RoughnessSettings&) = default;
 };
 
 struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
   bool phi_i_uniform = false;        // a randomly rotated fiber
   std::vector<double> phi_i{0.0};    // radians (unused when uniform)
+
+  friend bool operator==(const SourceSettings&, const SourceSettings&) = default;
 };
 
 struct TallySettings {
@@ -47,6 +53,8 @@ struct TallySettings {
   int n_phi = 180;
   ThetaBinning theta_bins = ThetaBinning::Uniform;
   int lobes = 4;
+
+  friend bool operator==(const TallySettings&, const TallySettings&) = default;
 };
 
 struct Settings {
@@ -67,6 +75,10 @@ struct Settings {
     double theta_i, phi_i;
   };
   std::vector<Incidence> incidences() const;
+
+  // Field-by-field equality (exact doubles): to_yaml -> parse_settings_yaml
+  // gives back an equal Settings.
+  friend bool operator==(const Settings&, const Settings&) = default;
 };
 
 // Parses a YAML config. `origin` names the source in error messages (a file
