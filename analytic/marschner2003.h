@@ -1,0 +1,166 @@
+#pragma once
+// Marschner, Jensen, Cammarano, Worley, Hanrahan 2003, "Light Scattering from
+// Human Hair Fibers" (papers/marschner2003_light_scattering_from_hair.txt):
+// the complete practical model of section 5, Eq. 9,
+//
+//   S = sum_{p=0..2} M_p(theta_h) N_p(eta'(eta, theta_d); phi) / cos^2(theta_d),
+//
+// returned as the density per d(theta_r) d(phi) of SPEC section 7:
+//   density = S cos^2(theta_r).
+//
+// Frame (SPEC section 1): u the fiber tangent, v the major axis, w the minor
+// axis; phi is measured from v about u; phi = phi_r - phi_i; phi_i is the
+// incident azimuth (only the eccentricity approximation of section 5.2.3
+// depends on it, through phi_h = phi_i + phi/2, and there only through
+// cos(2 phi_h) = cos(2 phi_i + phi), which is single-valued under phi -> phi+2pi).
+//
+// Lobes: the model has R, TT, TRT (p = 0, 1, 2) only. Every p >= 3 is zero:
+// that is the energy the model misses (SPEC section 8: 0.8% at theta_i = 0,
+// 14% at theta_i = 85 deg for eta = 1.55).
+//
+// Parameters (ModelParams, angles in radians):
+// - beta_long[p]: standard deviation of the Gaussian M_p (section 5.1) in the
+//   variable the Gaussian is written in: theta_h (published) or 2 theta_h
+//   (two_theta_h). beta must be > 0. beta_azim is not used: the published
+//   model has no azimuthal roughness other than the caustic width w_c.
+// - alpha[p]: shift of theta_r for lobe p (SPEC section 7). Marschner's alpha_p
+//   is a shift of theta_h, i.e. alpha[p] / 2; with two_theta_h the Gaussian is
+//   g(beta; 2 theta_h - alpha[p]) = g(beta; theta_r + theta_i - alpha[p]).
+// - exact_roots: solve Phi(p, h) = phi (Eq. 3) numerically, all roots, instead
+//   of the cubic of Eq. 10.
+// - absorption: Published = exp(-2 sigma_a' (1 + cos 2 gamma_t)) (section 4.3),
+//   Chord = exp(-sigma_a' 2 cos gamma_t) (the chord of the unit circle).
+// - eccentricity a (minor/major, SPEC section 2): eta*(phi_h) of section 5.2.3
+//   replaces eta in N_TRT only.
+// - Caustic (section 5.2.2): k_g (glint scale), w_c (azimuthal width of the
+//   caustic, radians), delta_eta (Delta eta', fade range past the merge),
+//   delta_h_m (Delta h_M, caustic power limit). w_c == 0 (the default) means no
+//   caustic smoothing: N_TRT is the exact Eq. 8 sum over roots, with its
+//   integrable 1/sqrt singularities at the caustics.
+#include <memory>
+#include <vector>
+
+#include "analytic/model.h"
+
+namespace fiberlab::analytic {
+
+// The Marschner 2003 model. Throws fiberlab::Error for parameters it cannot
+// represent (beta_long <= 0, eta <= 1, a <= 0, w_c < 0, no channels).
+std::unique_ptr<Model> make_marschner2003(const ModelParams& params);
+
+namespace marschner2003 {
+
+// ---- Longitudinal scattering function M (section 5.1) ----------------------
+
+// g(beta; x): unit-integral zero-mean Gaussian with standard deviation beta.
+double g(double beta, double x);
+
+// M_p as published: g(beta; theta_h - alpha_theta_r / 2) (integrates to 2 over
+// theta_r for small beta), or with two_theta_h g(beta; 2 theta_h - alpha_theta_r)
+// (integrates to 1).
+double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bool two_theta_h);
+
+// ---- Bravais indices (Appendix B) ------------------------------------------
+
+// eta'(theta) = sqrt(eta^2 - sin^2 theta) / cos theta: Snell's law holds for
+// the projections into the normal plane with this index.
+double eta_prime(double eta, double theta);
+// eta''(theta) = eta^2 cos theta / sqrt(eta^2 - sin^2 theta).
+double eta_double_prime(double eta, double theta);
+// Generalized Fresnel F(eta', eta'', gamma) of Appendix B: s part with eta',
+// p part with eta''. gamma is the projected angle of incidence. The refraction
+// angle is the projected one, sin(gamma_t) = sin(gamma) / eta', for both
+// polarizations (Bravais's law holds for the ray, whatever its polarization).
+// The garbled text says only "eta' for the perpendicular component ... eta''
+// for the parallel component"; with this reading F(eta', eta'', gamma) equals
+// the 3D Fresnel reflectance at cos(i) = cos(theta) cos(gamma) exactly (tested),
+// which is the paper's claim. Leaving the fiber, pass (1/eta', 1/eta'', gamma_t).
+// Total internal reflection returns 1.
+double F(double eta_p, double eta_pp, double gamma);
+
+// ---- Paths through a circle (section 4.2, 5.2.1) ----------------------------
+
+// Eq. 3: Phi(p, h) = 2 p gamma_t - 2 gamma_i + p pi, with sin gamma_i = h,
+// sin gamma_t = h / eta'. Argument gamma_i (radians), not h.
+double Phi(int p, double gamma_i, double eta_p);
+// dPhi/dgamma_i of Eq. 3.
+double dPhi_dgamma(int p, double gamma_i, double eta_p);
+// Section 5.2.1: gamma_t ~ (3c/pi) gamma_i - (4c/pi^3) gamma_i^3, c = asin(1/eta').
+double gamma_t_cubic(double gamma_i, double eta_p);
+// Eq. 10: phi^(p, gamma_i) = (6pc/pi - 2) gamma_i - (8pc/pi^3) gamma_i^3 + p pi.
+double Phi_cubic(int p, double gamma_i, double eta_p);
+double dPhi_cubic_dgamma(int p, double gamma_i, double eta_p);
+
+// Every gamma_i in [-pi/2, pi/2] whose exit angle is phi modulo 2 pi, from
+// the cubic of Eq. 10 (closed form) or from Eq. 3 (bracketed bisection on
+// the monotonic pieces of Phi). Sorted ascending. h = sin(gamma_i).
+std::vector<double> gamma_roots_cubic(int p, double phi, double eta_p);
+std::vector<double> gamma_roots_exact(int p, double phi, double eta_p);
+
+// ---- Attenuation (section 4.3) ----------------------------------------------
+
+// T per internal segment; sigma_a_prime = sigma_a / cos(theta_t).
+double T(double sigma_a_prime, double gamma_t, Absorption absorption);
+// A(0, h) = F(eta', eta'', gamma_i);
+// A(p, h) = (1 - F(eta', eta'', gamma_i))^2 F(1/eta', 1/eta'', gamma_t)^(p-1) T^p.
+double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
+         Absorption absorption);
+
+// The 2D problem N is solved in: the Bravais indices at theta_d, cos(theta_t)
+// for sigma_a' and the solver choices.
+struct Projection {
+  double eta_p = 1.55;   // eta'(eta, theta_d)
+  double eta_pp = 1.55;  // eta''(eta, theta_d)
+  double cos_theta_t = 1.0;  // sin(theta_t) = sin(theta_d) / eta
+  bool exact_roots = false;
+  Absorption absorption = Absorption::Published;
+};
+// eta is the (possibly eta*-modified) index; theta is theta_d.
+Projection project(double eta, double theta, bool exact_roots, Absorption absorption);
+
+// ---- Azimuthal scattering function N (Eq. 8) ---------------------------------
+
+// N_p(p, phi) = sum_r A(p, h_r) / |2 dphi/dh (h_r)|, one value per sigma_a entry.
+// dphi/dh is the derivative of the same phi used to find the roots (Eq. 10 with
+// the cubic, Eq. 3 when exact), so that N integrates to (1/2) int A dh in both
+// cases. The fold (caustic) derivative zero is clamped to keep the result finite.
+void N_p(int p, double phi, const Projection& proj, const std::vector<double>& sigma_a,
+         std::vector<double>& out);
+
+// The TRT caustic (Eq. 4, section 5.2.2) of the phi function in use: for the
+// exact Eq. 3, h_c^2 = (4 - eta'^2)/3; for the cubic of Eq. 10, the fold of the
+// cubic (2 deg away in phi at eta' = 1.55), because only removing the
+// singularity where the cubic puts it removes it. exists = false when
+// eta' >= 2 (the caustics have merged).
+struct Caustic {
+  bool exists = false;
+  double gamma_c = 0.0;    // gamma_i at the fold (> 0); h_c = sin(gamma_c)
+  double h_c = 0.0;
+  double phi_c = 0.0;      // exit angle of the fold, wrapped to [-pi, pi)
+  double d2phi_dh2 = 0.0;  // at h_c
+};
+Caustic caustic(const Projection& proj);
+
+struct CausticParams {
+  double k_g = 0.5;        // glint scale factor
+  double w_c = 0.0;        // azimuthal width of the caustic (radians)
+  double delta_eta = 0.0;  // Delta eta': fade range past the merge
+  double delta_h_m = 0.0;  // Delta h_M: caustic power limit
+};
+// N_TRT by the procedure of section 5.2.2 (with w_c == 0: N_p(2, phi)).
+void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_a,
+           const CausticParams& caustic_params, std::vector<double>& out);
+
+// ---- Eccentricity (section 5.2.3) -------------------------------------------
+
+// eta*_1 = 2(eta-1)a^2 - eta + 2, eta*_2 = 2(eta-1)a^-2 - eta + 2,
+// eta*(phi_h) = ((eta*_1 + eta*_2) + cos(2 phi_h)(eta*_1 - eta*_2)) / 2.
+// phi_h = 0 is the v axis (the major axis, SPEC section 1): we read the paper's
+// "paths symmetric across the major axis" (phi_i = -phi_r, so phi_h = 0) as
+// phi_h measured from the major axis, so eta*(0) = eta*_1. The result is not
+// clamped here; the model clamps it to eta* >= 1 + 1e-6 (a < ~0.6 at eta = 1.55
+// gives eta* < 1, outside the "mild eccentricity" the approximation is for).
+double eta_star(double eta, double a, double phi_h);
+
+}  // namespace marschner2003
+}  // namespace fiberlab::analytic
