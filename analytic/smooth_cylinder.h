@@ -1,0 +1,122 @@
+#pragma once
+// The exact smooth circular cylinder (SPEC section 7): the oracle for the
+// simulator. Light leaves on the specular cone theta_r = -theta_i only, so
+//   p(theta_r, phi) = delta(theta_r + theta_i) N_p(phi),
+//   N_p(phi) = sum over roots h of Phi(p, h) = phi of A(p, h) / |2 dPhi/dh|,
+//   Phi(p, h) = 2 p gamma_t - 2 gamma_i + p pi,  sin gamma_i = h,
+//   sin gamma_t = h / eta',  eta' = sqrt(eta^2 - sin^2 theta) / cos theta,
+//   A(0, h) = f,  A(p, h) = (1 - f)^2 f^(p-1) T^p,
+//   f = F(eta, acos(cos theta cos gamma_i)) (exact 3D Fresnel),
+//   T = exp(-sigma_a' 2 cos gamma_t)            (Absorption::Chord), or
+//   T = exp(-2 sigma_a' (1 + cos 2 gamma_t))    (Absorption::Published,
+//                                                Marschner 2003 s4.3),
+//   sigma_a' = sigma_a / cos theta_t, sin theta_t = sin theta / eta.
+// Bin probabilities never evaluate N_p at a point (it is infinite at the
+// caustics): they integrate (1/2) A(p, h) dh over h = sin(gamma_i), split
+// wherever Phi(p, .) crosses a phi-bin edge, with Gauss-Legendre on each
+// piece, so every quadrature node lies inside one bin and the result is
+// exact to rounding through the caustics. Independent of any simulator code.
+//
+// The path machinery here (Bravais index, Phi, the fold, attenuation, node
+// sets over h) is shared with d'Eon 2011, whose N_p is the same integral
+// with a Gaussian detector instead of the delta.
+#include <memory>
+#include <vector>
+
+#include "analytic/model.h"
+
+namespace fiberlab::analytic {
+
+namespace cylinder {
+
+// eta' of Bravais's law (Marschner 2003 Appendix B).
+double eta_prime(double eta, double theta);
+// Phi(p, gamma_i) and its derivative for the projected index eta_p.
+double Phi(int p, double gamma_i, double eta_p);
+double dPhi_dgamma(int p, double gamma_i, double eta_p);
+// gamma_c > 0 where dPhi/dgamma = 0 (sin^2 gamma_c = (p^2 - eta'^2)/(p^2 - 1)),
+// for p >= 2 and eta' < p; otherwise -1 (Phi monotonic). For p = 2 this is
+// the TRT caustic, h^2 = (4 - eta'^2)/3 (SPEC s8).
+double fold_gamma(int p, double eta_p);
+
+// The attenuation of paths at inclination theta (theta_i for the smooth
+// fiber, theta_d for d'Eon 2011). Precomputes what does not depend on h.
+class Attenuation {
+ public:
+  Attenuation(double eta, double theta, const std::vector<double>& sigma_a, Absorption absorption);
+  double eta_p() const { return eta_p_; }
+  int channels() const { return static_cast<int>(sigma_a_prime_.size()); }
+  // f = F(eta, acos(cos theta cos gamma_i)).
+  double f(double gamma_i) const;
+  // T of one internal segment, per channel.
+  void T(double gamma_i, double* out) const;
+  // A(p, gamma_i) per channel (out[0..C)).
+  void A(int p, double gamma_i, double* out) const;
+  // Sum of A(p', gamma_i) over every p' > P (P >= 0), per channel, in closed
+  // form: (1 - f)^2 f^P T^(P+1) / (1 - f T).
+  void A_beyond(int P, double gamma_i, double* out) const;
+
+ private:
+  double eta_, cos_theta_, eta_p_;
+  std::vector<double> sigma_a_prime_;
+  Absorption absorption_;
+};
+
+// A quadrature node of (1/2) integral over h in (-1, 1) of g(h) dh, written
+// over gamma_i (h = sin gamma_i; weight includes cos(gamma_i) / 2), with the
+// exit azimuth Phi(p, gamma_i) wrapped to [-pi, pi).
+struct PathNode {
+  double gamma, weight, phi;
+};
+// Nodes split at every crossing of Phi(p, .) with an edge of n_phi uniform
+// bins on [-pi, pi) and at the fold: each node's phi is strictly inside one
+// bin and each piece carries a smooth integrand. `order` points per piece.
+void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNode>& out);
+// Composite Gauss-Legendre over gamma_i in (-pi/2, pi/2), split at the fold,
+// with panels over which Phi changes by at most max_dphi.
+void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out);
+// Bin of a wrapped phi in n uniform bins on [-pi, pi).
+int phi_bin(double phi, int n_phi);
+
+}  // namespace cylinder
+
+// Lobe energies and phi-bin probabilities of the smooth circular fiber at one
+// incidence; usable directly by simulator tests.
+struct SmoothCylinderPrediction {
+  int lobes = 0, n_phi = 0, channels = 0;
+  std::vector<double> energy;    // [lobe * C + c] = (1/2) int A dh, p >= L-1 summed
+  std::vector<double> phi_bins;  // [(lobe * n_phi + j) * C + c], sums to energy over j
+  int max_explicit_p = 0;        // orders traced bin by bin (see below)
+  double residual_energy = 0.0;  // max over c of the energy of p > max_explicit_p
+};
+// The last lobe sums p = L-1 .. P explicitly, P the first order (>= L-1,
+// <= max_p) after which the closed-form remaining energy is below
+// residual_tol; that remaining energy (exact) is then spread uniformly in
+// phi: lobe energies are exact to rounding in any case, and the phi
+// distribution's error is bounded by residual_energy.
+SmoothCylinderPrediction smooth_cylinder_prediction(double eta, double theta_i,
+                                                    const std::vector<double>& sigma_a,
+                                                    Absorption absorption, int lobes, int n_phi,
+                                                    double residual_tol = 1e-7, int max_p = 100);
+
+// The Model: ModelParams eta, sigma_a, absorption, lobes (roughness ignored;
+// eccentricity must be 1). density() is the delta's weight N_p(phi) per
+// unit phi, evaluated from the roots of Phi = phi (infinite at a caustic) and
+// valid on theta_r = -theta_i only (0 elsewhere).
+class SmoothCylinder : public Model {
+ public:
+  explicit SmoothCylinder(ModelParams params);
+  std::string name() const override { return "exact"; }
+  int lobes() const override { return params_.lobes; }
+  void density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
+               std::vector<double>& out) const override;
+  std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
+                                        double phi_i) const override;
+
+ private:
+  ModelParams params_;
+};
+
+std::unique_ptr<Model> make_smooth_cylinder(const ModelParams& params);
+
+}  // namespace fiberlab::analytic
