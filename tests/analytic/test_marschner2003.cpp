@@ -1,0 +1,514 @@
+// Tests of the Marschner et al. 2003 model (analytic/marschner2003.h). Oracles:
+// the 3D Fresnel of common/fresnel.h, the exact smooth-cylinder lobe energies
+// of SPEC section 8, a forward-mapped (h -> phi) histogram of the SPEC s7
+// closed form, brute-force root counting, the 1/sqrt law of a fold caustic,
+// and the total-reflectance behaviour of d'Eon et al. 2011 section 4, Fig. 3.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <vector>
+
+#include "analytic/marschner2003.h"
+#include "common/error.h"
+#include "common/fresnel.h"
+#include "common/units.h"
+
+namespace fiberlab::analytic {
+namespace {
+
+namespace m3 = marschner2003;
+
+constexpr double kEta = 1.55;
+
+ModelParams params_one_channel(double beta_deg) {
+  ModelParams p;
+  p.eta = kEta;
+  p.sigma_a = {0.0};
+  p.beta_long = {deg_to_rad(beta_deg)};
+  p.alpha = {0.0};
+  return p;
+}
+
+// Integral of f over [a, b] by the midpoint rule in u after the substitution
+// x = a + (b - a)(1 - cos(pi u))/2, which cancels 1/sqrt singularities at both
+// ends (the TRT caustics, which we place at piece ends).
+double integrate_ends(const std::function<double(double)>& f, double a, double b, int n) {
+  double sum = 0.0;
+  for (int k = 0; k < n; ++k) {
+    const double u = (k + 0.5) / n;
+    const double x = a + 0.5 * (b - a) * (1.0 - std::cos(kPi * u));
+    const double dx = 0.5 * (b - a) * kPi * std::sin(kPi * u) / n;
+    sum += f(x) * dx;
+  }
+  return sum;
+}
+
+// Integral over [a, b] split at the knots inside it.
+double integrate_split(const std::function<double(double)>& f, double a, double b,
+                       std::vector<double> knots, int n) {
+  knots.push_back(a);
+  knots.push_back(b);
+  std::sort(knots.begin(), knots.end());
+  double sum = 0.0;
+  for (std::size_t i = 0; i + 1 < knots.size(); ++i) {
+    const double lo = std::max(a, knots[i]), hi = std::min(b, knots[i + 1]);
+    if (hi > lo) sum += integrate_ends(f, lo, hi, n);
+  }
+  return sum;
+}
+
+// phi-marginal of one lobe: integral of density over theta_r in theta_c +- half_width.
+double phi_marginal(const Model& m, int lobe, double theta_i, double phi, double theta_c,
+                    double half_width, int n_theta) {
+  std::vector<double> out;
+  double sum = 0.0;
+  const double dt = 2.0 * half_width / n_theta;
+  for (int i = 0; i < n_theta; ++i) {
+    const double tr = theta_c - half_width + (i + 0.5) * dt;
+    if (std::abs(tr) > 0.5 * kPi) continue;
+    m.density(lobe, theta_i, 0.0, tr, phi, out);
+    sum += out[0] * dt;
+  }
+  return sum;
+}
+
+// Total reflectance (d'Eon 2011 eq. 5): integral of the density over the whole
+// sphere of exit directions, summed over lobes, midpoint rule.
+double total_reflectance(const Model& m, double theta_i, int n_theta, int n_phi) {
+  std::vector<double> out;
+  double sum = 0.0;
+  const double dt = kPi / n_theta, dp = kTwoPi / n_phi;
+  for (int lobe = 0; lobe < 4; ++lobe)
+    for (int i = 0; i < n_theta; ++i)
+      for (int j = 0; j < n_phi; ++j) {
+        m.density(lobe, theta_i, 0.0, -0.5 * kPi + (i + 0.5) * dt, -kPi + (j + 0.5) * dp, out);
+        sum += out[0] * dt * dp;
+      }
+  return sum;
+}
+
+// ---- Appendix B ----------------------------------------------------------------
+
+TEST(Marschner2003, BravaisFresnelEqualsThreeDimensionalFresnel) {
+  for (double theta_deg : {0.0, 20.0, 45.0, 70.0, 85.0}) {
+    const double th = deg_to_rad(theta_deg);
+    const double ep = m3::eta_prime(kEta, th), epp = m3::eta_double_prime(kEta, th);
+    for (double gamma_deg = 0.0; gamma_deg < 90.0; gamma_deg += 7.5) {
+      const double g = deg_to_rad(gamma_deg);
+      // Oracle: the 3D angle of incidence has cos = cos(theta) cos(gamma).
+      const double exact = fresnel_dielectric(std::cos(th) * std::cos(g), kEta);
+      EXPECT_NEAR(m3::F(ep, epp, g), exact, 1e-12) << theta_deg << " " << gamma_deg;
+      // Leaving the fiber along the reversed path (reciprocity).
+      const double gt = std::asin(std::sin(g) / ep);
+      EXPECT_NEAR(m3::F(1.0 / ep, 1.0 / epp, gt), exact, 1e-12);
+    }
+  }
+  EXPECT_DOUBLE_EQ(m3::eta_prime(kEta, 0.0), kEta);
+  EXPECT_DOUBLE_EQ(m3::eta_double_prime(kEta, 0.0), kEta);
+}
+
+// ---- Section 5.2.1: the cubic ---------------------------------------------------
+
+TEST(Marschner2003, CubicSnellWithinPaperBound) {
+  // The paper's 0.75 deg is the error of gamma_t(gamma_i) (its Snell
+  // approximation) for eta > 1.5. Measured at eta' = 1.55: 0.537 deg.
+  for (double ep = 1.5; ep <= 3.0 + 1e-9; ep += 0.05) {
+    double worst = 0.0;
+    for (int i = 0; i <= 4000; ++i) {
+      const double g = -0.5 * kPi + kPi * i / 4000.0;
+      worst = std::max(worst, std::abs(m3::gamma_t_cubic(g, ep) - std::asin(std::sin(g) / ep)));
+    }
+    EXPECT_LT(rad_to_deg(worst), 0.75) << "eta' = " << ep;
+    if (std::abs(ep - 1.55) < 1e-9) {
+      EXPECT_NEAR(rad_to_deg(worst), 0.537, 0.002);
+    }
+  }
+}
+
+TEST(Marschner2003, CubicRootsNearExactRoots) {
+  // Which error measure: for h on a grid of [-1, 1], phi = Phi(p, h) exactly
+  // (Eq. 3); the cubic (Eq. 10) is then solved for phi and the nearest cubic
+  // root compared with asin(h). Measured at eta' = 1.55: R exact (linear);
+  // phi error at fixed h <= 2 p * 0.537 deg (1.07 TT, 2.15 TRT); gamma_i root
+  // error 1.29 deg for TT; for TRT up to 11.4 deg, near the fold where a 2 deg
+  // shift of the caustic moves roots far (5.4 deg more than 0.2 from h_c).
+  double worst_phi[3] = {0, 0, 0}, worst_root[3] = {0, 0, 0};
+  for (int p = 0; p <= 2; ++p)
+    for (int i = 0; i <= 4000; ++i) {
+      const double h = -1.0 + 2.0 * i / 4000.0, g = std::asin(h);
+      worst_phi[p] = std::max(worst_phi[p], std::abs(m3::Phi_cubic(p, g, kEta) - m3::Phi(p, g, kEta)));
+      const double phi = wrap_angle(m3::Phi(p, g, kEta));
+      const std::vector<double> roots = m3::gamma_roots_cubic(p, phi, kEta);
+      ASSERT_FALSE(roots.empty()) << p << " " << h;
+      double best = 1e9;
+      for (double r : roots) best = std::min(best, std::abs(r - g));
+      worst_root[p] = std::max(worst_root[p], best);
+    }
+  EXPECT_LT(rad_to_deg(worst_phi[0]), 1e-9);
+  EXPECT_LT(rad_to_deg(worst_root[0]), 1e-9);
+  EXPECT_LT(rad_to_deg(worst_phi[1]), 2 * 0.75);
+  EXPECT_LT(rad_to_deg(worst_phi[2]), 4 * 0.75);
+  EXPECT_LT(rad_to_deg(worst_root[1]), 1.35);
+  EXPECT_LT(rad_to_deg(worst_root[2]), 12.0);
+}
+
+// ---- Eq. 3: all roots -------------------------------------------------------------
+
+TEST(Marschner2003, ExactRootsAreAllRoots) {
+  // Oracle: sign changes of wrap(Phi(p, gamma) - phi) on a fine gamma grid.
+  for (double ep : {1.2, 1.55, 1.9, 2.5}) {
+    for (int p = 0; p <= 2; ++p) {
+      for (double phi_deg = -179.0; phi_deg < 180.0; phi_deg += 7.3) {
+        const double phi = deg_to_rad(phi_deg);
+        int brute = 0;
+        const int n = 20000;
+        double prev = wrap_angle(m3::Phi(p, -0.5 * kPi, ep) - phi);
+        for (int i = 1; i <= n; ++i) {
+          const double cur = wrap_angle(m3::Phi(p, -0.5 * kPi + kPi * i / n, ep) - phi);
+          if ((prev < 0.0) != (cur < 0.0) && std::abs(cur - prev) < kPi) ++brute;
+          prev = cur;
+        }
+        const std::vector<double> roots = m3::gamma_roots_exact(p, phi, ep);
+        EXPECT_EQ(static_cast<int>(roots.size()), brute) << ep << " " << p << " " << phi_deg;
+        for (double r : roots) EXPECT_NEAR(wrap_angle(m3::Phi(p, r, ep) - phi), 0.0, 1e-9);
+        const std::vector<double> cubic = m3::gamma_roots_cubic(p, phi, ep);
+        EXPECT_LE(cubic.size(), 3u);
+      }
+    }
+  }
+}
+
+// ---- Eq. 4, section 5.2.2: the TRT caustic ------------------------------------------
+
+TEST(Marschner2003, TrtCausticAtDescartesFold) {
+  const m3::Projection proj = m3::project(kEta, 0.0, true, Absorption::Published);
+  const m3::Caustic c = m3::caustic(proj);
+  ASSERT_TRUE(c.exists);
+  // Oracle 1: the maximum of Phi(2, .) found by a dense scan sits at h_c.
+  double best_g = 0.0, best_phi = -1e9;
+  for (int i = 0; i <= 200000; ++i) {
+    const double g = 0.5 * kPi * i / 200000.0;
+    const double v = m3::Phi(2, g, kEta);
+    if (v > best_phi) best_phi = v, best_g = g;
+  }
+  EXPECT_NEAR(c.h_c, std::sin(best_g), 1e-4);
+  EXPECT_NEAR(c.h_c * c.h_c, (4.0 - kEta * kEta) / 3.0, 1e-12);
+  EXPECT_NEAR(c.phi_c, wrap_angle(best_phi), 1e-9);
+  EXPECT_NEAR(rad_to_deg(c.phi_c), 18.616, 0.01);
+  // Oracle 2: next to a fold the intensity grows as 1/sqrt(phi_c - phi) on the
+  // side with three roots: quartering the distance doubles N.
+  std::vector<double> sigma{0.0}, n1, n4;
+  for (double eps : {1e-4, 1e-5}) {
+    m3::N_p(2, c.phi_c - eps, proj, sigma, n1);
+    m3::N_p(2, c.phi_c - 4 * eps, proj, sigma, n4);
+    EXPECT_NEAR(n1[0] / n4[0], 2.0, 0.02) << eps;
+  }
+  // Beyond the fold only one root: N is finite and small.
+  m3::N_p(2, c.phi_c + 1e-4, proj, sigma, n1);
+  EXPECT_LT(n1[0], 0.1);
+  EXPECT_EQ(m3::gamma_roots_exact(2, c.phi_c + 1e-4, kEta).size(), 1u);
+  EXPECT_EQ(m3::gamma_roots_exact(2, c.phi_c - 1e-4, kEta).size(), 3u);
+  // The cubic's fold: 2 deg away from the exact one (reported, see header).
+  const m3::Caustic cc = m3::caustic(m3::project(kEta, 0.0, false, Absorption::Published));
+  ASSERT_TRUE(cc.exists);
+  EXPECT_NEAR(rad_to_deg(cc.phi_c), rad_to_deg(c.phi_c), 2.5);
+}
+
+TEST(Marschner2003, TrtCausticVanishesWhenEtaPrimeReachesTwo) {
+  // eta'(theta) = 2 at sin^2 theta = (4 - eta^2)/3, theta = 46.9 deg for 1.55.
+  const double theta_merge = std::asin(std::sqrt((4.0 - kEta * kEta) / 3.0));
+  EXPECT_NEAR(m3::eta_prime(kEta, theta_merge), 2.0, 1e-12);
+  for (double dtheta_deg : {-3.0, 3.0, 10.0}) {
+    const double th = theta_merge + deg_to_rad(dtheta_deg);
+    for (bool exact : {true, false}) {
+      const m3::Projection proj = m3::project(kEta, th, exact, Absorption::Published);
+      const bool expect = dtheta_deg < 0.0;
+      EXPECT_EQ(m3::caustic(proj).exists, expect);
+      std::size_t most = 0;
+      double peak = 0.0;
+      std::vector<double> sigma{0.0}, n;
+      for (int j = 0; j < 3600; ++j) {
+        const double phi = -kPi + kTwoPi * (j + 0.5) / 3600.0;
+        most = std::max(most, exact ? m3::gamma_roots_exact(2, phi, proj.eta_p).size()
+                                    : m3::gamma_roots_cubic(2, phi, proj.eta_p).size());
+        m3::N_p(2, phi, proj, sigma, n);
+        peak = std::max(peak, n[0]);
+      }
+      EXPECT_EQ(most, expect ? 3u : 1u) << dtheta_deg << " " << exact;
+      if (!expect) {
+        EXPECT_LT(peak, 1.0);
+      }
+    }
+  }
+}
+
+TEST(Marschner2003, SmoothedCausticIsFiniteAndPeaksAtPhiC) {
+  m3::CausticParams cp;
+  // k_g at the top of the paper's range (0.5 to 5): with k_g = 0.5 the glint is
+  // weaker than the shoulder of the partly removed fold just inside phi_c, and
+  // the maximum sits at 0.22 rad instead of phi_c = 0.31 rad (eta' ~ 1.56).
+  cp.k_g = 5.0;
+  // Narrower than phi_c (~18 deg), so that the two glints stay apart.
+  cp.w_c = deg_to_rad(4.0);
+  cp.delta_eta = 0.3;
+  cp.delta_h_m = 0.5;
+  std::vector<double> sigma{0.0, 1.0}, n, raw;
+  for (bool exact : {true, false}) {
+    const m3::Projection proj = m3::project(kEta, deg_to_rad(10.0), exact, Absorption::Published);
+    const m3::Caustic c = m3::caustic(proj);
+    double peak = -1.0, peak_phi = 0.0;
+    for (int j = 0; j < 7200; ++j) {
+      const double phi = -kPi + kTwoPi * (j + 0.5) / 7200.0;
+      m3::N_TRT(phi, proj, sigma, cp, n);
+      ASSERT_TRUE(std::isfinite(n[0]) && std::isfinite(n[1]));
+      ASSERT_GE(n[0], 0.0);
+      ASSERT_LT(n[0], 10.0);
+      if (phi > 0 && n[0] > peak) peak = n[0], peak_phi = phi;
+    }
+    // The glint (a Gaussian of width w_c at phi_c) pulls the maximum to phi_c.
+    EXPECT_NEAR(peak_phi, c.phi_c, deg_to_rad(1.0)) << exact;
+    // At phi_c itself the singular Eq. 8 part is removed: only the glint is left.
+    m3::N_TRT(c.phi_c, proj, sigma, cp, n);
+    const double dh = std::min(cp.delta_h_m, 2.0 * std::sqrt(2.0 * cp.w_c / std::abs(c.d2phi_dh2)));
+    const double glint = cp.k_g *
+                         m3::A(2, c.gamma_c, proj.eta_p, proj.eta_pp, 0.0, Absorption::Published) *
+                         dh * (m3::g(cp.w_c, 0.0) + m3::g(cp.w_c, 2.0 * c.phi_c));
+    EXPECT_NEAR(n[0], glint, 1e-6 * glint) << exact;
+  }
+  // Past the merge: faded over Delta eta'; beyond 2 + Delta eta' the plain Eq. 8.
+  const auto theta_for = [](double ep) {  // eta'(theta) = ep
+    return std::asin(std::sqrt((ep * ep - kEta * kEta) / (ep * ep - 1.0)));
+  };
+  const m3::Projection mid = m3::project(kEta, theta_for(2.15), true, Absorption::Published);
+  const m3::Projection far = m3::project(kEta, theta_for(2.4), true, Absorption::Published);
+  EXPECT_NEAR(mid.eta_p, 2.15, 1e-9);
+  m3::N_TRT(0.0, far, sigma, cp, n);
+  m3::N_p(2, 0.0, far, sigma, raw);
+  EXPECT_DOUBLE_EQ(n[0], raw[0]);
+  m3::N_TRT(0.0, mid, sigma, cp, n);
+  m3::N_p(2, 0.0, mid, sigma, raw);
+  // t = 1/2 at eta' = 2 + Delta eta'/2: removal (1 - t)^2 at phi = 0, plus the
+  // two Gaussians at phi_c = 0 with A(2, h = 0).
+  const double a2 = m3::A(2, 0.0, mid.eta_p, mid.eta_pp, 0.0, Absorption::Published);
+  const double expect = raw[0] * 0.25 + 0.5 * cp.k_g * a2 * cp.delta_h_m * 2.0 * m3::g(cp.w_c, 0.0);
+  EXPECT_NEAR(n[0], expect, 1e-12);
+}
+
+// ---- The exact smooth cylinder limit (SPEC s7, s8) ------------------------------------
+
+// Forward-mapped histogram of the exact smooth circle at theta = 0 (SPEC s7):
+// each h cell sends A(p, h) dh / 2 to phi = Phi(p, h). Independent of the model:
+// uses fresnel_dielectric and no root finding.
+std::vector<double> smooth_circle_histogram(int p, int n_bins, double sigma_a, bool chord) {
+  std::vector<double> bins(n_bins, 0.0);
+  const int n = 2000000;
+  for (int i = 0; i < n; ++i) {
+    const double h = -1.0 + 2.0 * (i + 0.5) / n;
+    const double gi = std::asin(h), gt = std::asin(h / kEta);
+    const double f = fresnel_dielectric(std::cos(gi), kEta);
+    const double len = chord ? 2.0 * std::cos(gt) : 2.0 * (1.0 + std::cos(2.0 * gt));
+    const double t = std::exp(-sigma_a * len);
+    const double a = p == 0 ? f : (1 - f) * (1 - f) * std::pow(f, p - 1) * std::pow(t, p);
+    const double phi = wrap_angle(2 * p * gt - 2 * gi + p * kPi);
+    const int b = std::min(n_bins - 1, static_cast<int>((phi + kPi) / kTwoPi * n_bins));
+    bins[b] += a * (2.0 / n) / 2.0;
+  }
+  return bins;
+}
+
+TEST(Marschner2003, ConvergesToExactSmoothCylinder) {
+  // Exact roots, Gaussian in 2 theta_h, no caustic smoothing, small beta,
+  // theta_i = 0 (where Marschner's Bravais Fresnel and the 3D one coincide in
+  // any case; they coincide everywhere with our reading of Appendix B).
+  ModelParams params = params_one_channel(0.1);
+  params.two_theta_h = true;
+  params.exact_roots = true;
+  const auto model = make_marschner2003(params);
+  const double half = deg_to_rad(0.6);  // 6 beta
+  const double phi_c = m3::caustic(m3::project(kEta, 0.0, true, Absorption::Published)).phi_c;
+  const std::vector<double> knots{-phi_c, 0.0, phi_c};
+  // SPEC s8, theta_i = 0: R, TT, TRT.
+  const double spec[3] = {0.07496, 0.86179, 0.05567};
+  const int n_bins = 36;
+  for (int lobe = 0; lobe < 3; ++lobe) {
+    const auto f = [&](double phi) { return phi_marginal(*model, lobe, 0.0, phi, 0.0, half, 24); };
+    const double energy = integrate_split(f, -kPi, kPi, knots, 400);
+    EXPECT_NEAR(energy, spec[lobe], 2e-4) << "lobe " << lobe;
+    // The phi distribution, bin by bin, against the forward-mapped histogram.
+    const std::vector<double> oracle = smooth_circle_histogram(lobe, n_bins, 0.0, false);
+    for (int b = 0; b < n_bins; ++b) {
+      const double lo = -kPi + kTwoPi * b / n_bins, hi = lo + kTwoPi / n_bins;
+      const double bin = integrate_split(f, lo, hi, knots, 60);
+      EXPECT_NEAR(bin, oracle[b], 2e-4) << "lobe " << lobe << " bin " << b;
+    }
+  }
+  // p >= 3 is zero in this model: that is the 0.758% it misses at theta_i = 0.
+  std::vector<double> out;
+  model->density(3, 0.0, 0.0, 0.0, 0.3, out);
+  EXPECT_EQ(out[0], 0.0);
+}
+
+TEST(Marschner2003, AbsorptionPublishedAndChord) {
+  // TT energy at theta_i = 0 against the forward-mapped closed form, with the
+  // published segment length 2 + 2 cos(2 gamma_t) and with the chord 2 cos gamma_t.
+  for (bool chord : {false, true}) {
+    ModelParams params = params_one_channel(0.1);
+    params.sigma_a = {0.4};
+    params.two_theta_h = true;
+    params.exact_roots = true;
+    params.absorption = chord ? Absorption::Chord : Absorption::Published;
+    const auto model = make_marschner2003(params);
+    const double half = deg_to_rad(0.6);
+    for (int lobe : {1, 2}) {
+      const auto f = [&](double phi) { return phi_marginal(*model, lobe, 0.0, phi, 0.0, half, 24); };
+      const double phi_c =
+          m3::caustic(m3::project(kEta, 0.0, true, Absorption::Published)).phi_c;
+      const double energy = integrate_split(f, -kPi, kPi, {-phi_c, 0.0, phi_c}, 400);
+      double oracle = 0.0;
+      for (double v : smooth_circle_histogram(lobe, 4, 0.4, chord)) oracle += v;
+      EXPECT_NEAR(energy, oracle, 2e-4) << chord << " " << lobe;
+    }
+  }
+}
+
+// ---- d'Eon et al. 2011 section 4, Fig. 3 --------------------------------------------
+
+TEST(Marschner2003, TotalReflectanceBehavesAsDeonFigure3) {
+  // sigma_a = 0, cubic roots, no caustic smoothing. The three lobes carry
+  // 1 - E_{p>=3}: 0.992 at theta_i = 0 (SPEC s8). Measured (720 x 360 grid):
+  // beta 2 deg, theta_h: 1.963 (0 deg), 1.974 (30 deg); two_theta_h 0.984,
+  // 0.989. Grazing, beta 20 deg, theta_i 85: theta_h 2.28, two_theta_h 1.07
+  // (> 1 although 14% is missing). beta 30 deg, theta_i 0: 1.11 and 0.815.
+  const auto total = [](double beta_deg, bool two, double theta_i_deg) {
+    ModelParams params = params_one_channel(beta_deg);
+    params.two_theta_h = two;
+    return total_reflectance(*make_marschner2003(params), deg_to_rad(theta_i_deg), 360, 360);
+  };
+  for (double theta_i : {0.0, 30.0}) {
+    for (double beta : {2.0, 5.0}) {
+      EXPECT_NEAR(total(beta, false, theta_i), 2.0, 0.08) << beta << " " << theta_i;
+      EXPECT_NEAR(total(beta, true, theta_i), 1.0, 0.04) << beta << " " << theta_i;
+    }
+  }
+  // Excess at grazing incidence (relative to the moderate-angle value, and
+  // above 1 with two_theta_h despite the missing p >= 3 energy).
+  EXPECT_GT(total(20.0, false, 85.0), 2.1);
+  EXPECT_GT(total(20.0, true, 85.0), 1.03);
+  // Loss at large roughness (the Gaussian spills out of [-90, 90] deg).
+  EXPECT_LT(total(30.0, false, 0.0), 1.3);
+  EXPECT_LT(total(30.0, true, 0.0), 0.87);
+}
+
+// ---- Section 5.2.3 ---------------------------------------------------------------------
+
+TEST(Marschner2003, EccentricityOneEqualsCircle) {
+  EXPECT_NEAR(m3::eta_star(kEta, 1.0, 0.7), kEta, 1e-15);
+  const double a = 0.85;
+  const double e1 = 2 * (kEta - 1) * a * a - kEta + 2, e2 = 2 * (kEta - 1) / (a * a) - kEta + 2;
+  EXPECT_NEAR(m3::eta_star(kEta, a, 0.0), e1, 1e-15);
+  EXPECT_NEAR(m3::eta_star(kEta, a, 0.5 * kPi), e2, 1e-15);
+  EXPECT_NEAR(m3::eta_star(kEta, a, 0.25 * kPi), 0.5 * (e1 + e2), 1e-15);
+
+  ModelParams circ = params_one_channel(8.0);
+  circ.w_c = deg_to_rad(15.0);
+  circ.delta_h_m = 0.5;
+  circ.delta_eta = 0.3;
+  ModelParams one = circ, ell = circ;
+  one.eccentricity = 1.0 - 1e-14;  // takes the eta* path
+  ell.eccentricity = 0.85;
+  const auto m_circ = make_marschner2003(circ), m_one = make_marschner2003(one),
+             m_ell = make_marschner2003(ell);
+  std::vector<double> a_out, b_out, c_out, d_out;
+  bool differs = false;
+  for (double phi_i : {0.0, 0.4, 1.3, -2.0})
+    for (double phi = -3.0; phi < 3.1; phi += 0.25) {
+      m_circ->density(2, 0.3, 0.0, -0.25, phi, a_out);
+      m_one->density(2, 0.3, phi_i, -0.25, phi, b_out);
+      EXPECT_NEAR(a_out[0], b_out[0], 1e-9 * (1 + a_out[0]));
+      // R and TT never see eta*.
+      m_circ->density(1, 0.3, 0.0, -0.25, phi, c_out);
+      m_ell->density(1, 0.3, phi_i, -0.25, phi, d_out);
+      EXPECT_EQ(c_out[0], d_out[0]);
+      // The elliptical TRT depends on phi_i, with period pi in phi_h.
+      m_ell->density(2, 0.3, phi_i, -0.25, phi, c_out);
+      m_ell->density(2, 0.3, phi_i + kPi, -0.25, phi, d_out);
+      EXPECT_NEAR(c_out[0], d_out[0], 1e-9 * (1 + c_out[0]));
+      if (std::abs(c_out[0] - a_out[0]) > 1e-3 * a_out[0]) differs = true;
+    }
+  EXPECT_TRUE(differs);
+}
+
+// ---- Robustness ------------------------------------------------------------------------
+
+TEST(Marschner2003, FiniteOnDenseGrid) {
+  std::vector<double> out;
+  for (int variant = 0; variant < 8; ++variant) {
+    ModelParams params = params_one_channel(variant % 2 ? 0.05 : 20.0);
+    params.sigma_a = {0.0, 5.0, 1e3};
+    params.two_theta_h = variant & 2;
+    params.exact_roots = variant & 4;
+    params.absorption = variant & 1 ? Absorption::Chord : Absorption::Published;
+    params.eccentricity = variant % 3 == 0 ? 0.5 : 0.9;  // 0.5 drives eta* below 1
+    if (variant >= 4) {
+      params.w_c = deg_to_rad(10.0);
+      params.delta_h_m = 0.5;
+      params.delta_eta = 0.3;
+      params.k_g = 2.0;
+    }
+    const auto model = make_marschner2003(params);
+    for (int i = 0; i <= 36; ++i) {
+      const double ti = -0.5 * kPi + kPi * i / 36;
+      for (int j = 0; j <= 36; ++j) {
+        const double tr = -0.5 * kPi + kPi * j / 36;
+        for (int k = 0; k <= 72; ++k) {
+          const double phi = -kPi + kTwoPi * k / 72;
+          for (int lobe = 0; lobe < 4; ++lobe) {
+            model->density(lobe, ti, 0.3 * k, tr, phi, out);
+            ASSERT_EQ(out.size(), 3u);
+            for (double v : out) ASSERT_TRUE(std::isfinite(v) && v >= 0.0)
+                << variant << " " << ti << " " << tr << " " << phi << " " << lobe << " " << v;
+          }
+        }
+      }
+    }
+  }
+  // h = +-1 (gamma_i = +-90 deg) in the pieces.
+  for (int p = 0; p <= 2; ++p)
+    for (double g : {-0.5 * kPi, 0.5 * kPi}) {
+      EXPECT_TRUE(std::isfinite(m3::A(p, g, kEta, kEta, 1.0, Absorption::Published)));
+      std::vector<double> n;
+      m3::N_p(p, wrap_angle(m3::Phi(p, g, kEta)), m3::project(kEta, 0.0, true, Absorption::Chord),
+              {0.0}, n);
+      EXPECT_TRUE(std::isfinite(n[0]));
+    }
+}
+
+TEST(Marschner2003, LobeGrouping) {
+  ModelParams params = params_one_channel(6.0);
+  params.lobes = 2;  // lobe 1 = TT + TRT
+  const auto two = make_marschner2003(params);
+  params.lobes = 4;
+  const auto four = make_marschner2003(params);
+  std::vector<double> a, b, c, d;
+  for (double phi : {-2.5, -0.2, 0.1, 1.7}) {
+    two->density(1, 0.2, 0.0, -0.15, phi, a);
+    four->density(1, 0.2, 0.0, -0.15, phi, b);
+    four->density(2, 0.2, 0.0, -0.15, phi, c);
+    four->density(3, 0.2, 0.0, -0.15, phi, d);
+    EXPECT_NEAR(a[0], b[0] + c[0], 1e-12 * (1 + a[0]));
+    EXPECT_EQ(d[0], 0.0);
+  }
+}
+
+TEST(Marschner2003, RejectsUnrepresentableParameters) {
+  ModelParams params = params_one_channel(0.0);
+  EXPECT_THROW(make_marschner2003(params), Error);
+  params = params_one_channel(5.0);
+  params.eta = 1.0;
+  EXPECT_THROW(make_marschner2003(params), Error);
+}
+
+}  // namespace
+}  // namespace fiberlab::analytic
