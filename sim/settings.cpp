@@ -128,7 +128,9 @@ std::string degrees_text(double rad) {
 std::string list_text(const std::vector<double>& xs, std::string (*text)(double)) {
   std::vector<std::string> parts;
   for (double x : xs) parts.push_back(text(x));
-  return "[" + join(parts) + "]";
+  std::string out = "[";  // (built step by step: GCC 12 -O3 warns on "[" + std::string&&)
+  out += join(parts);
+  return out += "]";
 }
 
 // A string in YAML double quotes (\" \\ and control characters escaped).
