@@ -502,6 +502,60 @@ TEST(Marschner2003, LobeGrouping) {
   }
 }
 
+// ---- bin_probabilities --------------------------------------------------------------------
+
+TEST(Marschner2003, BinProbabilitiesReachTheSmoothLimit) {
+  // beta = 0.1 deg inside 2 deg theta bins: the override resolves M and the
+  // 1/sqrt caustics. Oracle: the forward-mapped smooth-circle histogram.
+  ModelParams params = params_one_channel(0.1);
+  params.two_theta_h = true;
+  params.exact_roots = true;
+  const auto model = make_marschner2003(params);
+  EXPECT_EQ(model->lobes(), 4);
+  const BinGrid grid = BinGrid::make(91, 36, ThetaBinning::Uniform);  // theta = 0 mid-bin
+  const std::vector<double> prob = model->bin_probabilities(grid, 0.0, 0.0);
+  ASSERT_EQ(prob.size(), 4u * 91 * 36);
+  const int centre = grid.theta_bin(0.0);
+  for (int lobe = 0; lobe < 3; ++lobe) {
+    const std::vector<double> oracle = smooth_circle_histogram(lobe, 36, 0.0, false);
+    for (int j = 0; j < 36; ++j) {
+      double column = 0.0;
+      for (int i = 0; i < 91; ++i) column += prob[(lobe * 91 + i) * 36 + j];
+      EXPECT_NEAR(column, oracle[j], 2e-4) << lobe << " " << j;
+      EXPECT_NEAR(prob[(lobe * 91 + centre) * 36 + j], column, 1e-9);
+    }
+  }
+  for (int k = 3 * 91 * 36; k < 4 * 91 * 36; ++k) EXPECT_EQ(prob[k], 0.0);
+}
+
+TEST(Marschner2003, BinProbabilitiesAgreeWithDefaultWhenSmooth) {
+  // Broad lobes and a smoothed caustic: the base class's per-bin 6 x 6
+  // Gauss-Legendre rule is accurate there and must agree with the override.
+  ModelParams params = params_one_channel(12.0);
+  params.sigma_a = {0.3, 1.0};
+  params.w_c = deg_to_rad(20.0);
+  params.k_g = 1.0;
+  params.delta_h_m = 0.5;
+  params.delta_eta = 0.3;
+  params.eccentricity = 0.9;
+  params.alpha = {deg_to_rad(-6.0), deg_to_rad(3.0), deg_to_rad(12.0)};
+  const auto model = make_marschner2003(params);
+  const BinGrid grid = BinGrid::make(12, 24, ThetaBinning::EqualArea);
+  for (double theta_i : {deg_to_rad(-20.0), deg_to_rad(50.0)}) {
+    const std::vector<double> mine = model->bin_probabilities(grid, theta_i, 0.4);
+    const std::vector<double> base = model->Model::bin_probabilities(grid, theta_i, 0.4);
+    ASSERT_EQ(mine.size(), base.size());
+    double sum_mine = 0.0, sum_base = 0.0, worst = 0.0;
+    for (std::size_t k = 0; k < mine.size(); ++k) {
+      sum_mine += mine[k];
+      sum_base += base[k];
+      worst = std::max(worst, std::abs(mine[k] - base[k]));
+    }
+    EXPECT_NEAR(sum_mine, sum_base, 1e-4 * sum_base);
+    EXPECT_LT(worst, 1e-4);
+  }
+}
+
 TEST(Marschner2003, RejectsUnrepresentableParameters) {
   ModelParams params = params_one_channel(0.0);
   EXPECT_THROW(make_marschner2003(params), Error);
