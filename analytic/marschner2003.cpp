@@ -188,15 +188,24 @@ std::vector<double> gamma_roots_exact(int p, double phi, double eta_p) {
     const int k_hi = static_cast<int>(std::floor((f_max - phi) / kTwoPi));
     for (int k = k_lo; k <= k_hi; ++k) {
       const double target = phi + kTwoPi * k;
-      // Bisection on a monotonic piece: robust next to the fold where Newton is not.
+      // Newton safeguarded by bisection on a monotonic piece: the bracket keeps
+      // it robust next to the fold, where dPhi/dgamma -> 0 and Newton alone
+      // overshoots.
       double a = lo, b = hi;
       const bool increasing = f_hi > f_lo;
-      for (int it = 0; it < 60 && b - a > 1e-15; ++it) {
-        const double m = 0.5 * (a + b);
-        const bool below = Phi(p, m, eta_p) < target;
-        if (below == increasing) a = m; else b = m;
+      double x = (f_hi == f_lo) ? 0.5 * (lo + hi)
+                                : lo + (hi - lo) * std::clamp((target - f_lo) / (f_hi - f_lo), 0.0, 1.0);
+      for (int it = 0; it < 100 && b - a > 1e-15; ++it) {
+        const double r = Phi(p, x, eta_p) - target;
+        if (r == 0.0) { a = b = x; break; }
+        if ((r < 0.0) == increasing) a = x; else b = x;
+        const double d = dPhi_dgamma(p, x, eta_p);
+        double next = (d != 0.0) ? x - r / d : 0.5 * (a + b);
+        if (!(next > a && next < b)) next = 0.5 * (a + b);
+        if (std::abs(next - x) < 1e-15) { x = next; break; }
+        x = next;
       }
-      roots.push_back(0.5 * (a + b));
+      roots.push_back(std::clamp(x, lo, hi));
     }
   }
   std::sort(roots.begin(), roots.end());

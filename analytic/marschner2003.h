@@ -92,7 +92,7 @@ double Phi_cubic(int p, double gamma_i, double eta_p);
 double dPhi_cubic_dgamma(int p, double gamma_i, double eta_p);
 
 // Every gamma_i in [-pi/2, pi/2] whose exit angle is phi modulo 2 pi, from
-// the cubic of Eq. 10 (closed form) or from Eq. 3 (bracketed bisection on
+// the cubic of Eq. 10 (closed form) or from Eq. 3 (Newton safeguarded by bisection on
 // the monotonic pieces of Phi). Sorted ascending. h = sin(gamma_i).
 std::vector<double> gamma_roots_cubic(int p, double phi, double eta_p);
 std::vector<double> gamma_roots_exact(int p, double phi, double eta_p);
