@@ -9,6 +9,7 @@
 // are strings and are rejected where a number is expected.
 #include "sim/settings.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
