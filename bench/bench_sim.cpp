@@ -1,0 +1,64 @@
+// Photons per second per core for the three cases of issue 2:
+//  (a) smooth circle, sigma_a 0;
+//  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
+//  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg.
+// One thread, so the rate is per core. Counters: photons/s, interface events
+// and candidate normals per photon.
+#include <benchmark/benchmark.h>
+
+#include "common/units.h"
+#include "sim/simulation.h"
+
+namespace {
+
+using namespace fiberlab;
+using namespace fiberlab::sim;
+
+Settings bench_case(char which) {
+  Settings s;
+  s.seed = 1;
+  s.fiber.eta = 1.55;
+  s.tally.n_theta = 90;
+  s.tally.n_phi = 180;
+  s.tally.lobes = 4;
+  if (which == 'a') {
+    s.fiber.sigma_a = {0.0};
+    s.roughness.model = RoughnessModel::Smooth;
+    s.source.theta_i = {deg_to_rad(30.0)};
+    return s;
+  }
+  s.fiber.sigma_a = {0.2, 0.4, 0.8};
+  s.fiber.scale_tilt = deg_to_rad(3.0);
+  s.roughness.model = RoughnessModel::Gaussian;
+  const double beta = deg_to_rad(which == 'b' ? 5.0 : 7.5);
+  s.roughness.beta_long = {beta};
+  s.roughness.beta_azim = {beta};
+  s.source.theta_i = {deg_to_rad(which == 'b' ? 30.0 : 17.0)};
+  s.source.phi_i = {deg_to_rad(which == 'b' ? 0.0 : 11.0)};
+  if (which == 'c') s.fiber.eccentricity = 0.8;
+  return s;
+}
+
+void trace(benchmark::State& state, char which) {
+  const Simulation sim(bench_case(which));
+  const std::uint64_t batch = 65536;
+  Tally tally(4, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
+  TracerCounters counters;
+  std::uint64_t first = 0;
+  for (auto _ : state) {
+    sim.trace_photons(0, first, batch, tally, counters);
+    first += batch;
+  }
+  const double photons = static_cast<double>(first);
+  state.counters["photons_per_s"] = benchmark::Counter(photons, benchmark::Counter::kIsRate);
+  state.counters["events_per_photon"] = counters.events / photons;
+  state.counters["normals_per_photon"] = counters.normal_draws / photons;
+}
+
+BENCHMARK_CAPTURE(trace, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+}  // namespace
+
+BENCHMARK_MAIN();
