@@ -396,8 +396,10 @@ class Marschner2003 final : public Model {
       if (M == 0.0) continue;
       double eta = params_.eta;
       if (p == 2 && params_.eccentricity != 1.0) {
-        // Section 5.2.3: phi_h = (phi_i + phi_r)/2 = phi_i + phi/2 (SPEC s1).
-        const double phi_h = phi_i + 0.5 * phi;
+        // Section 5.2.3: phi_h = (phi_i + phi_r)/2 = phi_i + phi/2 (SPEC s1, from
+        // the major axis v); the paper's phi_h is measured from the minor axis
+        // (see eta_star in the header: fixed by a ray trace of the ellipse).
+        const double phi_h = phi_i + 0.5 * phi - 0.5 * kPi;
         eta = std::max(m3::eta_star(params_.eta, params_.eccentricity, phi_h), 1.0 + 1e-6);
       }
       // Eq. 9: N evaluated with eta'(eta, theta_d).

@@ -31,8 +31,8 @@
 // - absorption: Published = exp(-2 sigma_a' (1 + cos 2 gamma_t)) (section 4.3),
 //   Chord = exp(-sigma_a' 2 cos gamma_t) (the chord of the unit circle).
 // - eccentricity a (minor/major, SPEC section 2): eta*(phi_h) of section 5.2.3
-//   replaces eta in N_TRT only, and there everywhere (eta', eta'', cos theta_t):
-//   the paper "simply pass[es] the refractive index eta* to the code that
+//   replaces eta in N_TRT only (phi_h from the minor axis, see eta_star), and
+//   there everywhere (eta', eta'', cos theta_t): the paper "simply pass[es] the refractive index eta* to the code that
 //   computes N_TRT".
 // - Caustic (section 5.2.2): k_g (glint scale), w_c (azimuthal width of the
 //   caustic, radians), delta_eta (Delta eta', fade range past the merge),
@@ -162,12 +162,20 @@ void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_
 // ---- Eccentricity (section 5.2.3) -------------------------------------------
 
 // eta*_1 = 2(eta-1)a^2 - eta + 2, eta*_2 = 2(eta-1)a^-2 - eta + 2,
-// eta*(phi_h) = ((eta*_1 + eta*_2) + cos(2 phi_h)(eta*_1 - eta*_2)) / 2.
-// phi_h = 0 is the v axis (the major axis, SPEC section 1): we read the paper's
-// "paths symmetric across the major axis" (phi_i = -phi_r, so phi_h = 0) as
-// phi_h measured from the major axis, so eta*(0) = eta*_1. The result is not
-// clamped here; the model clamps it to eta* >= 1 + 1e-6 (a < ~0.6 at eta = 1.55
-// gives eta* < 1, outside the "mild eccentricity" the approximation is for).
+// eta*(phi_h) = ((eta*_1 + eta*_2) + cos(2 phi_h)(eta*_1 - eta*_2)) / 2,
+// exactly as printed, in the paper's phi_h. The printed text does not say from
+// which axis its phi_h is measured, nor (Table 1: a "0.85 to 1") whether it
+// matters. We settled it with a 2D ray trace of the ellipse (SPEC s2 shape,
+// a = e = 0.85, eta 1.55, the test EccentricityMatchesEllipseRayTrace): light
+// along the major axis v gives TRT caustics at +-0.23 deg (almost merged, an
+// effective index near 2 = eta*_2 = 1.97), light along the minor axis w gives
+// +-39.2 deg (a smaller index, towards eta*_1 = 1.25); the circle gives 18.6.
+// So with a = minor/major the paper's phi_h = 0 is the minor axis: the model
+// calls eta_star(eta, e, phi_h_spec - pi/2), phi_h_spec measured from v
+// (SPEC s1). (Equivalently: a = major/minor with phi_h from the major axis.)
+// The result is not clamped here; the model clamps it to eta* >= 1 + 1e-6
+// (a < ~0.6 at eta = 1.55 gives eta* < 1, far outside the "mild
+// eccentricity" the approximation is meant for).
 double eta_star(double eta, double a, double phi_h);
 
 }  // namespace marschner2003
