@@ -12,7 +12,7 @@
 // axis; phi is measured from v about u; phi = phi_r - phi_i; phi_i is the
 // incident azimuth (only the eccentricity approximation of section 5.2.3
 // depends on it, through phi_h = phi_i + phi/2, and there only through
-// cos(2 phi_h) = cos(2 phi_i + phi), which is single-valued under phi -> phi+2pi).
+// cos(2 phi_h), which is single-valued under phi -> phi + 2 pi).
 //
 // Lobes: the model has R, TT, TRT (p = 0, 1, 2) only. Every p >= 3 is zero:
 // that is the energy the model misses (SPEC section 8: 0.8% at theta_i = 0,
@@ -32,8 +32,8 @@
 //   Chord = exp(-sigma_a' 2 cos gamma_t) (the chord of the unit circle).
 // - eccentricity a (minor/major, SPEC section 2): eta*(phi_h) of section 5.2.3
 //   replaces eta in N_TRT only (phi_h from the minor axis, see eta_star), and
-//   there everywhere (eta', eta'', cos theta_t): the paper "simply pass[es] the refractive index eta* to the code that
-//   computes N_TRT".
+//   there everywhere (eta', eta'', cos theta_t): the paper "simply pass[es]
+//   the refractive index eta* to the code that computes N_TRT".
 // - Caustic (section 5.2.2): k_g (glint scale), w_c (azimuthal width of the
 //   caustic, radians), delta_eta (Delta eta', fade range past the merge),
 //   delta_h_m (Delta h_M, caustic power limit). w_c == 0 (the default) means no
@@ -131,7 +131,9 @@ Projection project(double eta, double theta, bool exact_roots, Absorption absorp
 // N_p(p, phi) = sum_r A(p, h_r) / |2 dphi/dh (h_r)|, one value per sigma_a entry.
 // dphi/dh is the derivative of the same phi used to find the roots (Eq. 10 with
 // the cubic, Eq. 3 when exact), so that N integrates to (1/2) int A dh in both
-// cases. The fold (caustic) derivative zero is clamped to keep the result finite.
+// cases. A(p, h) always uses the exact gamma_t = asin(h / eta') (A is a
+// function of h; the cubic only finds h). The fold (caustic) derivative zero
+// is clamped (|dphi/dgamma| >= 1e-10) to keep the result finite.
 void N_p(int p, double phi, const Projection& proj, const std::vector<double>& sigma_a,
          std::vector<double>& out);
 
