@@ -34,3 +34,31 @@ struct ScalarLight {
 };
 
 }  // namespace fiberlab::sim
+
+namespace fiberlab::sim {
+
+// `polarization: stokes` (SPEC section 3): the photon carries one Stokes
+// vector (I, Q, U, V), kept at I = 1, referred to an axis e1 perpendicular to
+// its direction. At each event the reference axis is first turned to the
+// event's s-axis, then the photon reflects with probability (first row of the
+// reflection Mueller matrix) . (I, Q, U, V) and the Stokes vector becomes the
+// chosen Mueller matrix times itself, renormalised to I = 1.
+class StokesLight {
+ public:
+  static constexpr bool kPolarized = true;
+  // Unpolarised light travelling along d.
+  explicit StokesLight(const Vec3& d);
+  EventResult interact(const Vec3& d, const Vec3& m, double eta_rel, PhotonRandom& rng);
+
+  const Eigen::Vector4d& stokes() const { return stokes_; }
+  const Vec3& reference_axis() const { return e1_; }
+
+ private:
+  // Turn the reference axis about d to s; (Q, U) rotate by 2 psi.
+  void rotate_reference(const Vec3& d, const Vec3& s);
+
+  Eigen::Vector4d stokes_{1.0, 0.0, 0.0, 0.0};
+  Vec3 e1_;
+};
+
+}  // namespace fiberlab::sim

@@ -7,7 +7,6 @@
 #include <chrono>
 #include <cmath>
 
-#include "common/error.h"
 #include "common/units.h"
 
 namespace fiberlab::sim {
@@ -21,10 +20,7 @@ Simulation::Simulation(Settings settings)
       grid_(BinGrid::make(settings_.tally.n_theta, settings_.tally.n_phi,
                           settings_.tally.theta_bins)),
       tracer_(settings_),
-      incidences_(settings_.incidences()) {
-  if (settings_.polarization != Polarization::Scalar)
-    throw Error("polarization = stokes is not implemented yet in the tracer (allowed: scalar)");
-}
+      incidences_(settings_.incidences()) {}
 
 void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n,
                                Tally& tally, TracerCounters& counters) const {

@@ -8,9 +8,18 @@
 
 namespace fiberlab::sim {
 
+namespace {
+template <typename Light>
+Light make_light(const Vec3& d) {
+  if constexpr (Light::kPolarized) return Light(d);  // unpolarised, axis perpendicular to d
+  else return Light{};
+}
+}  // namespace
+
 Tracer::Tracer(const Settings& s)
     : ellipse_(s.fiber.eccentricity),
       model_(s.roughness.model),
+      polarization_(s.polarization),
       eta_(s.fiber.eta),
       cos_tilt_(std::cos(s.fiber.scale_tilt)),
       sin_tilt_(std::sin(s.fiber.scale_tilt)),
@@ -25,12 +34,12 @@ Tracer::Tracer(const Settings& s)
 // Returns false when the photon must be truncated (too many events at this
 // point, or no visible normal found). On return d is the new direction and
 // `inside` the photon's new side, consistent with the untilted normal.
-bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, PhotonRandom& rng,
-                                 TracerCounters& counters) const {
+template <typename Light>
+bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& light,
+                                 PhotonRandom& rng, TracerCounters& counters) const {
   const Vec3 n0 = ellipse_.normal(p);
   // Cuticle tilt towards the root, on both sides (SPEC section 2).
   const Vec3 n_s = cos_tilt_ * n0 - sin_tilt_ * Vec3::UnitX();
-  ScalarLight light;
   for (int k = 0; k < max_events_; ++k) {
     ++counters.events;
     const BoundaryNormals normals{inside ? Vec3(-n_s) : n_s, inside ? Vec3(-n0) : n0};
@@ -58,12 +67,26 @@ bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, PhotonR
 PhotonOutcome Tracer::trace(const Vec3& wi, double h, PhotonRandom& rng,
                             TracerCounters* counters_out) const {
   TracerCounters counters;
+  const PhotonOutcome out = polarization_ == Polarization::Stokes
+                                ? trace_with<StokesLight>(wi, h, rng, counters)
+                                : trace_with<ScalarLight>(wi, h, rng, counters);
+  if (counters_out) {
+    counters_out->events += counters.events;
+    counters_out->normal_draws += counters.normal_draws;
+  }
+  return out;
+}
+
+template <typename Light>
+PhotonOutcome Tracer::trace_with(const Vec3& wi, double h, PhotonRandom& rng,
+                                 TracerCounters& counters) const {
   PhotonOutcome out;
   Vec3 d = -wi;
+  Light light = make_light<Light>(d);
   Point2 p = ellipse_.entry_point(d, h);
   bool inside = false;
   while (true) {
-    if (!scatter_at_boundary(p, d, inside, rng, counters)) {
+    if (!scatter_at_boundary(p, d, inside, light, rng, counters)) {
       out.fate = PhotonFate::Truncated;
       break;
     }
@@ -89,10 +112,6 @@ PhotonOutcome Tracer::trace(const Vec3& wi, double h, PhotonRandom& rng,
     p = ellipse_.advance(p, d, t);
     out.path_length += t;
     ++out.segments;
-  }
-  if (counters_out) {
-    counters_out->events += counters.events;
-    counters_out->normal_draws += counters.normal_draws;
   }
   return out;
 }

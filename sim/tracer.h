@@ -39,12 +39,18 @@ class Tracer {
   static constexpr int kMaxNormalTries = 100000;
 
  private:
-  // Interface events at one boundary point until the consistency rule holds.
-  bool scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, PhotonRandom& rng,
+  // The photon's life for one kind of light (ScalarLight or StokesLight).
+  template <typename Light>
+  PhotonOutcome trace_with(const Vec3& wi, double h, PhotonRandom& rng,
                            TracerCounters& counters) const;
+  // Interface events at one boundary point until the consistency rule holds.
+  template <typename Light>
+  bool scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& light,
+                           PhotonRandom& rng, TracerCounters& counters) const;
 
   EllipseCrossSection ellipse_;
   RoughnessModel model_;
+  Polarization polarization_;
   double eta_;
   double cos_tilt_, sin_tilt_;
   double beta_long_, beta_azim_;          // gaussian
