@@ -1,0 +1,97 @@
+#pragma once
+// d'Eon, Francois, Hill, Letteri, Aubry 2011, "An Energy-Conserving Hair
+// Reflectance Model" (papers/deon2011_energy_conserving_hair.txt), complete:
+//
+//   S(theta_i, theta_r, phi) = sum_p M_p(v_p, theta_i, theta_r - alpha_p) N_p(phi)
+//   density per d(theta_r) d(phi) = S cos(theta_r)            (SPEC s7)
+//
+// - M_p: Eq. 7, evaluated in log space (csch and I0 overflow for small v).
+// - N_p: Eq. 10, N_p(phi) = 1/2 int_{-1}^{1} A(p, h) D_p(phi - Phi(p, h)) dh,
+//   with the Gaussian detector of Eq. 11, D_p = sum_k g(beta_p; phi - 2 pi k).
+// - A(p, h): Eq. 13, (1 - f)^2 f^(p-1) T^p, f of Eq. 14,
+//   f = F(eta, arccos(cos theta_d cos(arcsin h))), T as published
+//   (exp(-2 mu_a' (1 + cos 2 gamma_t)), mu_a' = mu_a / cos theta_t) or with the
+//   chord correction; gamma_t from the Bravais index eta'(theta_d), theta_t
+//   from sin theta_t = sin theta_d / eta (the text names neither; theta_d is
+//   what Eq. 14 uses, and it reduces to SPEC s7 on the specular cone).
+// - A(0, h): Eq. 12 as published, F(eta, arccos(wi . wr) / 2), a function of
+//   the exit direction, not of h (r_fresnel=half_angle, the default), or
+//   Eq. 14 like the other orders (r_fresnel=per_h). They agree for v, beta -> 0;
+//   only per_h conserves energy exactly for rough fibers.
+// - Lobes: 0..L-2 one order each; lobe L-1 sums p >= L-1: orders up to the
+//   first P (<= max order 20) after which the remaining energy, computed in
+//   closed form per h (sum_{p>P} A = (1-f)^2 f^P T^(P+1) / (1 - f T)), is
+//   below 1e-6, then that remainder spread uniformly in phi (d'Eon's and
+//   pbrt's residual term), with the last lobe's M. Energy is exact; only the
+//   remainder's phi shape is approximate.
+// - Per-lobe parameters: v_p = beta_long_p^2, beta_p = beta_azim_p, alpha_p
+//   (lists indexed by p, the last entry for every larger p).
+// - Limits: beta_long = 0 gives M_p = delta(theta_r - alpha_p + theta_i) /
+//   cos(theta_i) (SPEC s7), beta_azim = 0 the smooth N_p (exact bins through
+//   caustics); bin_probabilities() handles both exactly. density() floors
+//   beta at 1e-3 rad instead, since deltas cannot be evaluated pointwise.
+#include <memory>
+#include <vector>
+
+#include "analytic/model.h"
+
+namespace fiberlab::analytic {
+
+namespace deon2011 {
+
+// log I0(x), x >= 0: power series below 30, the asymptotic expansion
+// e^x / sqrt(2 pi x) (1 + 1/(8x) + 9/(2 (8x)^2) + ...) above (relative error
+// < 1e-15 of I0 everywhere; the asymptotic terms shrink until k ~ 2x).
+double log_I0(double x);
+// log csch(x) for x > 0: log 2 - x - log1p(-exp(-2x)).
+double log_csch(double x);
+// Eq. 7: log M_p(v, theta_i, theta_r) =
+//   log csch(1/v) - log(2v) - sin(theta_i) sin(theta_r)/v + log I0(cos(theta_i) cos(theta_r)/v).
+double log_M_p(double v, double theta_i, double theta_r);
+double M_p(double v, double theta_i, double theta_r);
+// Eq. 11: the Gaussian detector, unit-integral over one period.
+double D_p(double beta, double phi);
+// Eq. 10 by Gauss-Legendre of `order` points over h (paper: 35), per channel.
+// r_half_angle: the R order uses Eq. 12 with the exit direction given by
+// (theta_i, theta_r, phi) (theta_d = (theta_r - theta_i) / 2).
+struct Fiber {
+  double eta = 1.55;
+  std::vector<double> sigma_a{0.0};
+  Absorption absorption = Absorption::Published;
+  bool r_half_angle = true;
+};
+void N_p(int p, double beta, const Fiber& fiber, double theta_i, double theta_r, double phi,
+         int order, std::vector<double>& out);
+// Eq. 12's Fresnel term: F(eta, arccos(wi . wr) / 2).
+double F_half_angle(double eta, double theta_i, double theta_r, double phi);
+
+}  // namespace deon2011
+
+class Deon2011 : public Model {
+ public:
+  explicit Deon2011(ModelParams params);
+  std::string name() const override { return "deon2011"; }
+  int lobes() const override { return params_.lobes; }
+  void density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
+               std::vector<double>& out) const override;
+  // Bin integrals: M_p exactly by composite Gauss-Legendre (panels below
+  // sqrt(v)/3) against a Chebyshev interpolant in theta_r of the phi-bin
+  // integrals of N_p, which are exact in phi (the Gaussian detector's bin
+  // mass in closed form, erfc) and use composite Gauss-Legendre over gamma_i
+  // with panels on which Phi moves by at most min(beta_p, 0.25).
+  std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
+                                        double phi_i) const override;
+  // Multiplies every node density of bin_probabilities() (Chebyshev nodes,
+  // h panels, M panels) by `factor`, to measure convergence (tests).
+  void set_refinement(double factor) { refine_ = factor; }
+  int max_order() const { return max_order_; }
+
+ private:
+  ModelParams params_;
+  double refine_ = 1.0;
+  int max_order_ = 20;
+};
+
+std::unique_ptr<Model> make_deon2011(const ModelParams& params);
+
+}  // namespace fiberlab::analytic
