@@ -15,6 +15,9 @@ int main(int argc, char** argv) {
   fiberlab::cli::add_run_command(app);
   fiberlab::cli::add_info_command(app);
   fiberlab::cli::add_merge_command(app);
+  fiberlab::cli::add_predict_command(app);
+  fiberlab::cli::add_compare_command(app);
+  fiberlab::cli::add_energy_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

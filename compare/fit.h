@@ -1,0 +1,55 @@
+#pragma once
+// Weighted least-squares fit of model parameters to a simulated histogram
+// (Levenberg-Marquardt with central-difference derivatives, Eigen).
+//
+// Residuals: the normalised residuals (P_b - M_b(theta)) / sigma_b of
+// comparison.h over a selection of bins fixed before the fit (every
+// incident configuration, lobe and channel of the result; bins with
+// S1^2/S2 >= 30 one by one, the rest pooled per lobe). chi2 = |r|^2,
+// dof = residuals - fitted parameters.
+//
+// Uncertainties: covariance (J^T W J)^-1 at the minimum (J the derivatives of
+// the model's bin probabilities, W = diag(1/sigma^2)), scaled by
+// max(1, chi2/dof): when the model does not describe the data within the
+// noise (chi2/dof > 1), the errors grow as for any under-fitted least-squares
+// problem (the PDG's scale factor); when it does they are the bare ones.
+// Both are reported.
+//
+// Keys (angles in degrees):
+//   eta, sigma_a (one common value for every channel), sigma_a[c];
+//   beta_long, beta_azim, alpha (one common value for every lobe: the list
+//     is replaced by one entry); beta_long[p], beta_azim[p], alpha[p] (entry
+//     p only; the list is extended by its last entry as needed);
+//   scale_tilt: the physical cuticle tilt a, mapped to alpha by SPEC s7
+//     (R -2a, TT +a, TRT +4a, p >= 3: 0).
+#include <string>
+#include <vector>
+
+#include "analytic/model.h"
+#include "compare/comparison.h"
+#include "sim/result_file.h"
+
+namespace fiberlab::compare {
+
+// Reads / writes one fit key of ModelParams, in the key's units (degrees for
+// angles). Throws fiberlab::Error for an unknown key.
+double get_parameter(const analytic::ModelParams& p, const std::string& key);
+void set_parameter(analytic::ModelParams& p, const std::string& key, double value);
+
+struct FitResult {
+  std::vector<std::string> keys;
+  std::vector<double> start, value;
+  std::vector<double> error;           // scaled by sqrt(max(1, chi2/dof))
+  std::vector<double> error_unscaled;  // sqrt(diag((J^T W J)^-1))
+  double chi2_start = 0.0, chi2 = 0.0;
+  int residuals = 0, dof = 0, iterations = 0, evaluations = 0;
+  bool converged = false;
+  analytic::ModelParams params;  // at the minimum
+  double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
+};
+
+FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
+                    const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                    const Options& options = {}, int max_iterations = 40);
+
+}  // namespace fiberlab::compare
