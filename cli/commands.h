@@ -12,7 +12,6 @@ void add_run_command(CLI::App& app);
 void add_info_command(CLI::App& app);
 void add_merge_command(CLI::App& app);
 void add_predict_command(CLI::App& app);
-void add_predict_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_energy_command(CLI::App& app);
 

@@ -16,7 +16,6 @@ int main(int argc, char** argv) {
   fiberlab::cli::add_info_command(app);
   fiberlab::cli::add_merge_command(app);
   fiberlab::cli::add_predict_command(app);
-  fiberlab::cli::add_predict_command(app);
   fiberlab::cli::add_compare_command(app);
   fiberlab::cli::add_energy_command(app);
   try {
