@@ -1,0 +1,59 @@
+#pragma once
+// Helpers for the comparison tests: simulations built in code, run in
+// process, and the model bins of a result.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/units.h"
+#include "compare/comparison.h"
+#include "compare/models.h"
+#include "sim/result_file.h"
+#include "sim/settings.h"
+#include "sim/simulation.h"
+
+namespace fiberlab::compare::testing {
+
+// A white or absorbing circular fiber without tilt; `model` picks roughness.
+inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::RoughnessModel model) {
+  sim::Settings s;
+  s.photons = photons;
+  s.seed = 4242;
+  s.fiber.eta = 1.55;
+  s.fiber.sigma_a = {0.0};
+  s.roughness.model = model;
+  s.roughness.beta_long = {0.0};
+  s.roughness.beta_azim = {0.0};
+  s.source.theta_i = {deg_to_rad(theta_i_deg)};
+  s.source.phi_i = {0.0};
+  s.tally.n_theta = 90;
+  s.tally.n_phi = 180;
+  s.tally.lobes = 4;
+  return s;
+}
+
+inline sim::ResultFile run(const sim::Settings& s, int threads = 2) {
+  sim::Simulation simulation(s);
+  return sim::make_result(s, simulation.grid(), simulation.run(threads));
+}
+
+// Model params for a result (compare/model_defaults.h) plus --set overrides.
+inline analytic::ModelParams params(const sim::ResultFile& r, const std::string& model,
+                                    const std::vector<std::string>& settings = {}) {
+  return params_for(r.settings, parse_model_spec(model), settings);
+}
+
+inline std::vector<LobeComparison> compare_with(const sim::ResultFile& r, const std::string& model,
+                                                const std::vector<std::string>& settings = {}) {
+  const analytic::ModelParams p = params(r, model, settings);
+  const auto m = make_model(parse_model_spec(model).name, p);
+  return compare(r, predict_result(*m, r), p.alpha);
+}
+
+// The acceptance rule of `fiberlab compare` without --max-chi2: chi2/dof
+// within five standard deviations of its mean 1 (sd sqrt(2/dof), SPEC s10).
+// With fixed seeds the outcome is deterministic; a correct model fails it
+// with probability below 1e-5 per lobe for the dof used here.
+inline double max_chi2_per_dof(int dof) { return 1.0 + 5.0 * std::sqrt(2.0 / dof); }
+
+}  // namespace fiberlab::compare::testing
