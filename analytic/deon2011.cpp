@@ -447,6 +447,9 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       }
     }
   }
+  // The interpolation in theta_r can leave rounding-level negatives (1e-28)
+  // where the probability is zero.
+  for (double& x : out) x = std::max(x, 0.0);
   return out;
 }
 

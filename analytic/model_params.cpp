@@ -75,7 +75,7 @@ int integer(const std::string& key, const std::string& value, const std::string&
 void apply_setting(ModelParams& p, const std::string& key_value) {
   const auto eq = key_value.find('=');
   if (eq == std::string::npos)
-    throw Error(fmt::format("--set {}: expected KEY=VALUE; keys: {}", key_value, kKeys));
+    throw Error(fmt::format("--set {}: expected KEY=VALUE; allowed keys: {}", key_value, kKeys));
   const std::string key = trim(key_value.substr(0, eq)), value = trim(key_value.substr(eq + 1));
   const double deg = deg_to_rad(1.0);
   auto nonneg = [](double x) { return x >= 0.0; };
