@@ -35,8 +35,15 @@ class EllipseCrossSection {
   // parallel and ratios across the beam, so uniform h on the ellipse is
   // uniform impact parameter on the circle, where the entry point is exact.
   Point2 entry_point(const Vec3& d, double h) const {
-    Eigen::Vector2d g(d.y() / rv_, d.z() / rw_);  // direction in circle space
-    g.normalize();
+    return entry_point_in_beam(beam_direction(d), h);
+  }
+  // The two halves of entry_point, for a source that launches many photons
+  // along one direction: the unit beam direction in circle space, then the
+  // entry point of impact parameter h.
+  Eigen::Vector2d beam_direction(const Vec3& d) const {
+    return Eigen::Vector2d(d.y() / rv_, d.z() / rw_).normalized();
+  }
+  Point2 entry_point_in_beam(const Eigen::Vector2d& g, double h) const {
     const Eigen::Vector2d g_perp(-g.y(), g.x());
     const Eigen::Vector2d q = h * g_perp - std::sqrt(std::max(0.0, 1.0 - h * h)) * g;
     return Point2(rv_ * q.x(), rw_ * q.y());

@@ -68,11 +68,13 @@ std::optional<Vec3> gaussian_normal(const Vec3& d, const Vec3& n_facing, double 
         dl = beta_long * rng.normal();
         da = beta_azim * rng.normal();
       } else if (pick < c + w_long) {
-        dl = rayleigh(beta_long, rng) * (rng.uniform() < 0.5 ? -1.0 : 1.0);
+        dl = rayleigh(beta_long, rng);  // magnitude first, then its sign
+        if (rng.uniform() < 0.5) dl = -dl;
         da = beta_azim * rng.normal();
       } else {
         dl = beta_long * rng.normal();
-        da = rayleigh(beta_azim, rng) * (rng.uniform() < 0.5 ? -1.0 : 1.0);
+        da = rayleigh(beta_azim, rng);
+        if (rng.uniform() < 0.5) da = -da;
       }
       bound = c + std::abs(dl) + std::abs(da);
     }

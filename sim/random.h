@@ -9,8 +9,21 @@
 
 namespace fiberlab::sim {
 
+// The whole state of a photon's stream, so that a batched tracer can keep it
+// in structure-of-arrays form and hand it back.
+struct RandomState {
+  std::uint64_t s[4];
+  double spare;
+  bool has_spare;
+};
+
 class PhotonRandom {
  public:
+  explicit PhotonRandom(const RandomState& st) : spare_(st.spare), has_spare_(st.has_spare) {
+    for (int i = 0; i < 4; ++i) s_[i] = st.s[i];
+  }
+  RandomState state() const { return {{s_[0], s_[1], s_[2], s_[3]}, spare_, has_spare_}; }
+
   PhotonRandom(std::uint64_t seed, std::uint64_t config, std::uint64_t photon) {
     std::uint64_t x = splitmix(seed ^ 0x6a09e667f3bcc909ULL);
     x = splitmix(x ^ config);

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "common/units.h"
+#include "sim/source.h"
 
 namespace fiberlab::sim {
 
@@ -20,6 +21,8 @@ Simulation::Simulation(Settings settings)
       grid_(BinGrid::make(settings_.tally.n_theta, settings_.tally.n_phi,
                           settings_.tally.theta_bins)),
       tracer_(settings_),
+      batch_tracer_(settings_),
+      use_batch_tracer_(settings_.polarization == Polarization::Scalar),
       incidences_(settings_.incidences()) {}
 
 void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n,
@@ -29,24 +32,26 @@ void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t
   const int channels = static_cast<int>(sigma_a.size());
   const int last_lobe = tally.lobes() - 1;
   std::vector<double> weight(channels);
-  for (std::uint64_t i = first; i < first + n; ++i) {
-    PhotonRandom rng(settings_.seed, k, i);
-    // A randomly rotated fiber (phi_i uniform) draws its azimuth per photon.
-    const double phi_i = settings_.source.phi_i_uniform ? kTwoPi * rng.uniform() - kPi
-                                                        : inc.phi_i;
-    const Vec3 wi = direction_from_angles(inc.theta_i, phi_i);
-    const double h = 2.0 * rng.uniform() - 1.0;
-    const PhotonOutcome out = tracer_.trace(wi, h, rng, &counters);
+  auto score = [&](std::uint64_t, double phi_i, const PhotonOutcome& out) {
     // Beer-Lambert per channel along the whole internal path (SPEC section 4).
     for (int c = 0; c < channels; ++c) weight[c] = std::exp(-sigma_a[c] * out.path_length);
     if (out.fate == PhotonFate::Truncated) {
       tally.score_truncated(weight.data());
-      continue;
+      return;
     }
     const int lobe = std::min(out.segments, last_lobe);
-    const int it = grid_.theta_bin(inclination(out.direction));
-    const int ip = grid_.phi_bin(wrap_angle(azimuth(out.direction) - phi_i));
+    const int it = grid_.theta_bin(out.theta);
+    const int ip = grid_.phi_bin(wrap_angle(out.phi - phi_i));
     tally.score_exit(lobe, it, ip, weight.data());
+  };
+  if (use_batch_tracer_) {
+    batch_tracer_.trace(k, inc.theta_i, inc.phi_i, first, n, score, counters);
+  } else {
+    const Source source(settings_.seed, k, inc.theta_i, inc.phi_i, settings_.source.phi_i_uniform);
+    for (std::uint64_t i = first; i < first + n; ++i) {
+      LaunchedPhoton p = source.launch(i);
+      score(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));
+    }
   }
   tally.add_launched(n);
 }

@@ -7,6 +7,7 @@
 
 #include "sim/settings.h"
 #include "sim/tally.h"
+#include "sim/batch_tracer.h"
 #include "sim/tracer.h"
 
 namespace fiberlab::sim {
@@ -32,14 +33,17 @@ class Simulation {
   std::vector<Tally> run(int threads, const ProgressCallback& progress = {},
                          RunStatistics* stats = nullptr) const;
 
-  // Traces photons [first, first + n) of incident configuration k into `tally`.
+  // Traces photons [first, first + n) of incident configuration k into `tally`
+  // (with the batched tracer for scalar light, the reference tracer otherwise).
   void trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n, Tally& tally,
                      TracerCounters& counters) const;
 
  private:
   Settings settings_;
   BinGrid grid_;
-  Tracer tracer_;
+  Tracer tracer_;            // the reference tracer; serves polarization: stokes
+  BatchTracer batch_tracer_; // the vectorised tracer for unpolarised light
+  bool use_batch_tracer_;
   std::vector<Settings::Incidence> incidences_;
 };
 

@@ -98,6 +98,8 @@ PhotonOutcome Tracer::trace_with(const Vec3& wi, double h, PhotonRandom& rng,
                                 RoughnessSettings::for_lobe(blur_beta_, p_lobe), rng);
       }
       out.direction = d;
+      out.theta = inclination(d);
+      out.phi = azimuth(d);
       break;
     }
     if (out.segments == max_segments_) {  // the photon did not leave at the last boundary

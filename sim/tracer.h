@@ -18,6 +18,7 @@ struct PhotonOutcome {
   Vec3 direction = Vec3::Zero();  // exit direction wr (when Exited)
   int segments = 0;               // internal straight segments: the lobe index p
   double path_length = 0.0;       // total 3D length inside, in units of R
+  double theta = 0.0, phi = 0.0;  // inclination and azimuth of `direction` (when Exited)
 };
 
 // Work counters, for benchmarks and notes.

@@ -1,0 +1,417 @@
+#include "sim/batch_tracer.h"
+
+#include <xsimd/xsimd.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+
+#include "sim/exit_blur.h"
+#include "sim/source.h"
+
+namespace fiberlab::sim {
+
+namespace {
+
+using Batch = xsimd::batch<double>;
+using UBatch = xsimd::batch<std::uint64_t>;
+using Mask = Batch::batch_bool_type;
+using UMask = UBatch::batch_bool_type;
+constexpr int W = static_cast<int>(Batch::size);
+constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
+
+// What a lane's photon does next (kept as a double per lane).
+enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kDone = 4 };
+
+UMask to_umask(const Mask& m) {
+  return xsimd::bitwise_cast<UBatch>(xsimd::select(m, Batch(1.0), Batch(0.0))) != UBatch(0);
+}
+
+Batch lane_index() {
+  alignas(64) double idx[W];
+  for (int i = 0; i < W; ++i) idx[i] = i;
+  return Batch::load_aligned(idx);
+}
+
+int popcount(const Mask& m) {
+  alignas(64) double v[W];
+  xsimd::select(m, Batch(1.0), Batch(0.0)).store_aligned(v);
+  int n = 0;
+  for (int i = 0; i < W; ++i) n += v[i] != 0.0;
+  return n;
+}
+
+}  // namespace
+
+// The pool of photons in flight, structure of arrays.
+struct BatchTracer::Lanes {
+  alignas(64) double px[kPoolLanes], py[kPoolLanes];             // boundary point (v, w)
+  alignas(64) double dx[kPoolLanes], dy[kPoolLanes], dz[kPoolLanes];  // direction
+  alignas(64) double inside[kPoolLanes];       // 1 inside the fiber, 0 outside
+  alignas(64) double path[kPoolLanes];         // internal 3D path length
+  alignas(64) double segments[kPoolLanes];
+  alignas(64) double events_here[kPoolLanes];  // events at the current point
+  alignas(64) double code[kPoolLanes];         // LaneCode
+  alignas(64) double phi_i[kPoolLanes];
+  alignas(64) std::uint64_t photon[kPoolLanes];
+  alignas(64) std::uint64_t s0[kPoolLanes], s1[kPoolLanes], s2[kPoolLanes], s3[kPoolLanes];
+  alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
+  alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
+  alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
+
+  void move(int to, int from) {
+    px[to] = px[from]; py[to] = py[from];
+    dx[to] = dx[from]; dy[to] = dy[from]; dz[to] = dz[from];
+    inside[to] = inside[from]; path[to] = path[from]; segments[to] = segments[from];
+    events_here[to] = events_here[from]; code[to] = code[from]; phi_i[to] = phi_i[from];
+    photon[to] = photon[from];
+    s0[to] = s0[from]; s1[to] = s1[from]; s2[to] = s2[from]; s3[to] = s3[from];
+    spare[to] = spare[from]; has_spare[to] = has_spare[from];
+    tries[to] = tries[from]; theta_out[to] = theta_out[from]; phi_out[to] = phi_out[from];
+  }
+  RandomState rng_state(int i) const {
+    return {{s0[i], s1[i], s2[i], s3[i]}, spare[i], has_spare[i] != 0.0};
+  }
+  void set_rng_state(int i, const RandomState& st) {
+    s0[i] = st.s[0]; s1[i] = st.s[1]; s2[i] = st.s[2]; s3[i] = st.s[3];
+    spare[i] = st.spare; has_spare[i] = st.has_spare ? 1.0 : 0.0;
+  }
+};
+
+namespace {
+
+// W photons' random streams side by side: the same xoshiro256** and
+// Box-Muller as PhotonRandom, advancing only the lanes in a mask, so each
+// photon consumes its own stream in the same order as in Tracer.
+class LaneRandom {
+ public:
+  LaneRandom(const BatchTracer::Lanes& l, int o)
+      : s0_(UBatch::load_aligned(l.s0 + o)), s1_(UBatch::load_aligned(l.s1 + o)),
+        s2_(UBatch::load_aligned(l.s2 + o)), s3_(UBatch::load_aligned(l.s3 + o)),
+        spare_(Batch::load_aligned(l.spare + o)),
+        has_spare_(Batch::load_aligned(l.has_spare + o) != Batch(0.0)) {}
+
+  void store(BatchTracer::Lanes& l, int o) const {
+    s0_.store_aligned(l.s0 + o);
+    s1_.store_aligned(l.s1 + o);
+    s2_.store_aligned(l.s2 + o);
+    s3_.store_aligned(l.s3 + o);
+    spare_.store_aligned(l.spare + o);
+    xsimd::select(has_spare_, Batch(1.0), Batch(0.0)).store_aligned(l.has_spare + o);
+  }
+
+  Batch uniform(const Mask& m) { return to_unit(next(m)); }
+  Batch uniform_open0(const Mask& m) { return to_unit(next(m)) + Batch(0x1.0p-53); }
+
+  Batch normal(const Mask& m) {
+    const Mask use_spare = m & has_spare_;
+    const Mask generate = m & !has_spare_;
+    const Batch r = xsimd::sqrt(Batch(-2.0) * xsimd::log(uniform_open0(generate)));
+    const Batch a = Batch(6.283185307179586) * uniform(generate);
+    const auto [sn, cs] = xsimd::sincos(a);
+    const Batch out = xsimd::select(use_spare, spare_, r * cs);
+    spare_ = xsimd::select(generate, r * sn, spare_);
+    has_spare_ = (has_spare_ & !m) | generate;
+    return out;
+  }
+
+  // sigma * |x| of a Normal weighted by |x| (Rayleigh), then a random sign.
+  Batch signed_rayleigh(double sigma, const Mask& m) {
+    const Batch r = Batch(sigma) * xsimd::sqrt(Batch(-2.0) * xsimd::log(uniform_open0(m)));
+    return xsimd::select(uniform(m) < Batch(0.5), -r, r);
+  }
+
+ private:
+  static UBatch rotl(const UBatch& x, int k) { return (x << k) | (x >> (64 - k)); }
+  static Batch to_unit(const UBatch& x) {
+    return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x >> 11)) *
+           Batch(0x1.0p-53);
+  }
+  UBatch next(const Mask& m) {
+    const UMask um = to_umask(m);
+    const UBatch x5 = (s1_ << 2) + s1_;
+    const UBatch r7 = rotl(x5, 7);
+    const UBatch result = (r7 << 3) + r7;
+    const UBatch t = s1_ << 17;
+    UBatch n2 = s2_ ^ s0_;
+    UBatch n3 = s3_ ^ s1_;
+    const UBatch n1 = s1_ ^ n2;
+    const UBatch n0 = s0_ ^ n3;
+    n2 = n2 ^ t;
+    n3 = rotl(n3, 45);
+    s0_ = xsimd::select(um, n0, s0_);
+    s1_ = xsimd::select(um, n1, s1_);
+    s2_ = xsimd::select(um, n2, s2_);
+    s3_ = xsimd::select(um, n3, s3_);
+    return result;
+  }
+
+  UBatch s0_, s1_, s2_, s3_;
+  Batch spare_;
+  Mask has_spare_;
+};
+
+struct Vec3B {
+  Batch x, y, z;
+  Batch dot(const Vec3B& o) const { return x * o.x + y * o.y + z * o.z; }
+  Vec3B normalized() const {
+    const Batch inv = Batch(1.0) / xsimd::sqrt(dot(*this));
+    return {x * inv, y * inv, z * inv};
+  }
+};
+Vec3B operator*(const Batch& s, const Vec3B& v) { return {s * v.x, s * v.y, s * v.z}; }
+Vec3B operator+(const Vec3B& a, const Vec3B& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+Vec3B select(const Mask& m, const Vec3B& a, const Vec3B& b) {
+  return {xsimd::select(m, a.x, b.x), xsimd::select(m, a.y, b.y), xsimd::select(m, a.z, b.z)};
+}
+
+// The gaussian microfacet normal, both samplers of microfacet_normal.cpp
+// (which explains them), for the lanes in `live`. A group of lanes is only
+// as fast as its slowest, so each call draws at most kRoundsPerCall
+// candidates per lane: lanes still without a normal are left out of this
+// event (not `ready`) and continue drawing from their own stream at the next
+// call, with their count of candidates so far in `tries`. Lanes that reach
+// the cap are returned in `failed` (truncated, as in Tracer).
+constexpr int kRoundsPerCall = 2;
+
+Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double beta_azim,
+                       const Mask& live, LaneRandom& rng, Batch& tries, Mask& ready,
+                       Mask& failed, long& draws) {
+  constexpr double kSqrt2OverPi = 0.7978845608028654;
+  const Batch theta_n = xsimd::asin(f.x);
+  const Batch inv = Batch(1.0) / xsimd::sqrt(f.y * f.y + f.z * f.z);
+  const Batch pv = f.y * inv, pw = f.z * inv;
+  const Batch c = xsimd::max(Batch(0.0), -d.dot(f));
+  const Batch w_long(beta_long * kSqrt2OverPi), w_azim(beta_azim * kSqrt2OverPi);
+  const Mask envelope = c < Batch(0.5);
+  const Batch w_total = c + w_long + w_azim;
+  failed = live & envelope & (w_total <= Batch(0.0));
+  ready = live & Mask(false);
+  Mask pending = live & !failed;
+  Vec3B m{Batch(0.0), Batch(0.0), Batch(0.0)};
+  for (int k = 0; k < kRoundsPerCall && xsimd::any(pending); ++k) {
+    draws += popcount(pending);
+    tries = tries + xsimd::select(pending, Batch(1.0), Batch(0.0));
+    const Batch pick = w_total * rng.uniform(pending & envelope);
+    const Mask first = envelope & (pick < c);
+    const Mask second = envelope & !first & (pick < c + w_long);
+    const Mask third = envelope & !first & !second;
+    const Batch dl_normal = Batch(beta_long) * rng.normal(pending & !second);
+    const Batch dl = xsimd::select(second, rng.signed_rayleigh(beta_long, pending & second), dl_normal);
+    const Batch da_normal = Batch(beta_azim) * rng.normal(pending & !third);
+    const Batch da = xsimd::select(third, rng.signed_rayleigh(beta_azim, pending & third), da_normal);
+    const Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
+    const auto [st, ct] = xsimd::sincos(theta_n + dl);
+    const auto [sa, ca] = xsimd::sincos(da);
+    const Vec3B candidate{st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
+    const Batch visible = -d.dot(candidate);
+    const Mask facing = pending & (visible > Batch(0.0));
+    const Mask accepted = facing & (rng.uniform(facing) * bound < visible);
+    m = select(accepted, candidate, m);
+    ready = ready | accepted;
+    pending = pending & !accepted;
+    failed = failed | (pending & (tries >= Batch(Tracer::kMaxNormalTries)));
+    pending = pending & !failed;
+  }
+  tries = xsimd::select(ready | failed, Batch(0.0), tries);
+  return m;
+}
+
+}  // namespace
+
+BatchTracer::BatchTracer(const Settings& s)
+    : settings_(s),
+      ellipse_(s.fiber.eccentricity),
+      cos_tilt_(std::cos(s.fiber.scale_tilt)),
+      sin_tilt_(std::sin(s.fiber.scale_tilt)) {}
+
+// `beam` is the entry geometry of the source's fixed direction (unused when
+// each photon has its own).
+void BatchTracer::launch(Lanes& l, int i, const Source& source, const Eigen::Vector2d& beam,
+                         std::uint64_t photon) const {
+  const LaunchedPhoton p = source.launch(photon);
+  const Vec3 d = -p.wi;
+  const Point2 entry = ellipse_.entry_point_in_beam(
+      source.fixed_direction() ? beam : ellipse_.beam_direction(d), p.h);
+  l.px[i] = entry.x();
+  l.py[i] = entry.y();
+  l.dx[i] = d.x();
+  l.dy[i] = d.y();
+  l.dz[i] = d.z();
+  l.inside[i] = 0.0;
+  l.path[i] = 0.0;
+  l.segments[i] = 0.0;
+  l.events_here[i] = 0.0;
+  l.tries[i] = 0.0;
+  l.code[i] = kAtBoundary;
+  l.phi_i[i] = p.phi_i;
+  l.photon[i] = photon;
+  l.set_rng_state(i, p.rng.state());
+}
+
+// One interface event for every photon in flight (SPEC section 3): the
+// vectorised ScalarLight::interact with the normal models of Tracer.
+void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& counters) const {
+  const double eta = settings_.fiber.eta;
+  const RoughnessModel model = settings_.roughness.model;
+  const double beta_long = settings_.roughness.beta_long.front();
+  const double beta_azim = settings_.roughness.beta_azim.front();
+  const Batch iota = lane_index();
+  for (int o = 0; o < n_active; o += W) {
+    const Mask live = (iota + Batch(o)) < Batch(n_active);
+    LaneRandom rng(l, o);
+    const Batch px = Batch::load_aligned(l.px + o), py = Batch::load_aligned(l.py + o);
+    Vec3B d{Batch::load_aligned(l.dx + o), Batch::load_aligned(l.dy + o),
+            Batch::load_aligned(l.dz + o)};
+    const Mask inside = Batch::load_aligned(l.inside + o) != Batch(0.0);
+    // Untilted outward normal n0 and the tilted normal n_s (SPEC section 2).
+    const Batch nv = px * Batch(1.0 / (ellipse_.r_v() * ellipse_.r_v()));
+    const Batch nw = py * Batch(1.0 / (ellipse_.r_w() * ellipse_.r_w()));
+    const Batch inv = Batch(1.0) / xsimd::sqrt(nv * nv + nw * nw);
+    const Vec3B n0{Batch(0.0), nv * inv, nw * inv};
+    const Batch side = xsimd::select(inside, Batch(-1.0), Batch(1.0));
+    const Vec3B facing{side * Batch(-sin_tilt_), side * Batch(cos_tilt_) * n0.y,
+                       side * Batch(cos_tilt_) * n0.z};
+    Mask failed = live & Mask(false), ready = live;
+    Vec3B m;
+    if (model == RoughnessModel::Gaussian) {
+      Batch tries = Batch::load_aligned(l.tries + o);
+      m = gaussian_normals(d, facing, beta_long, beta_azim, live, rng, tries, ready, failed,
+                           counters.normal_draws);
+      tries.store_aligned(l.tries + o);
+    } else {
+      m = select(d.dot(facing) < Batch(0.0), facing, side * n0);
+    }
+    // Fresnel and the choice between reflection and refraction, for the
+    // lanes that have their normal.
+    const Mask act = ready & !failed;
+    const Batch cos_i = xsimd::min(Batch(1.0), xsimd::max(Batch(0.0), -d.dot(m)));
+    const Batch eta_rel = xsimd::select(inside, Batch(1.0 / eta), Batch(eta));
+    const Batch ratio = xsimd::select(inside, Batch(eta), Batch(1.0 / eta));
+    const Batch sin2_t = ratio * ratio * (Batch(1.0) - cos_i * cos_i);
+    const Mask tir = sin2_t >= Batch(1.0);
+    const Batch cos_t = xsimd::sqrt(xsimd::max(Batch(0.0), Batch(1.0) - sin2_t));
+    const Batch r_s = (cos_i - eta_rel * cos_t) / (cos_i + eta_rel * cos_t);
+    const Batch r_p = (eta_rel * cos_i - cos_t) / (eta_rel * cos_i + cos_t);
+    const Batch F = Batch(0.5) * (r_s * r_s + r_p * r_p);
+    const Mask reflect = tir | (rng.uniform(act & !tir) < F);
+    const Vec3B reflected = (d + (Batch(2.0) * cos_i) * m).normalized();
+    const Vec3B refracted = (ratio * d + (ratio * cos_i - cos_t) * m).normalized();
+    d = select(act, select(reflect, reflected, refracted), d);
+    const Mask flip = act & !reflect;
+    const Mask now_inside = (flip & !inside) | (!flip & inside);
+    // Consistency rule, judged with the untilted normal.
+    const Batch dn = d.dot(n0);
+    const Mask consistent = (now_inside & (dn < Batch(0.0))) | (!now_inside & (dn > Batch(0.0)));
+    Batch code = xsimd::select(consistent, xsimd::select(now_inside, Batch(kTravel), Batch(kExited)),
+                               Batch(kAtBoundary));
+    code = xsimd::select(failed, Batch(kTruncated), code);
+    code = xsimd::select(act | failed, code, Batch::load_aligned(l.code + o));
+    const Mask exited = act & (code == Batch(kExited));
+    if (xsimd::any(exited)) {  // the exit angles, for the tally
+      xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), d.x))).store_aligned(l.theta_out + o);
+      xsimd::atan2(d.z, d.y).store_aligned(l.phi_out + o);
+    }
+    code.store_aligned(l.code + o);
+    d.x.store_aligned(l.dx + o);
+    d.y.store_aligned(l.dy + o);
+    d.z.store_aligned(l.dz + o);
+    xsimd::select(now_inside, Batch(1.0), Batch(0.0)).store_aligned(l.inside + o);
+    (Batch::load_aligned(l.events_here + o) + xsimd::select(act, Batch(1.0), Batch(0.0)))
+        .store_aligned(l.events_here + o);
+    rng.store(l, o);
+    counters.events += popcount(act);
+  }
+}
+
+// One internal segment for the photons about to cross the fiber (SPEC
+// sections 2 and 4): the far root t = -B/A of the ellipse from a boundary point.
+void BatchTracer::travel(Lanes& l, int n_active) const {
+  const Batch inv_rv2(1.0 / (ellipse_.r_v() * ellipse_.r_v()));
+  const Batch inv_rw2(1.0 / (ellipse_.r_w() * ellipse_.r_w()));
+  for (int o = 0; o < n_active; o += W) {
+    const Batch code = Batch::load_aligned(l.code + o);
+    const Mask go = code == Batch(kTravel);
+    if (!xsimd::any(go)) continue;
+    const Batch px = Batch::load_aligned(l.px + o), py = Batch::load_aligned(l.py + o);
+    const Batch dy = Batch::load_aligned(l.dy + o), dz = Batch::load_aligned(l.dz + o);
+    const Batch a = dy * dy * inv_rv2 + dz * dz * inv_rw2;
+    const Batch b = Batch(2.0) * (px * dy * inv_rv2 + py * dz * inv_rw2);
+    const Mask along_axis = go & (a <= Batch(0.0));  // guided for ever
+    const Batch t = xsimd::select(go & !along_axis, xsimd::max(Batch(0.0), -b / a), Batch(0.0));
+    const Batch qx = px + t * dy, qy = py + t * dz;
+    const Batch s = Batch(1.0) / xsimd::sqrt(qx * qx * inv_rv2 + qy * qy * inv_rw2);
+    const Mask moved = go & !along_axis;
+    xsimd::select(moved, qx * s, px).store_aligned(l.px + o);
+    xsimd::select(moved, qy * s, py).store_aligned(l.py + o);
+    (Batch::load_aligned(l.path + o) + t).store_aligned(l.path + o);
+    (Batch::load_aligned(l.segments + o) + xsimd::select(moved, Batch(1.0), Batch(0.0)))
+        .store_aligned(l.segments + o);
+    xsimd::select(moved, Batch(0.0), Batch::load_aligned(l.events_here + o))
+        .store_aligned(l.events_here + o);
+    xsimd::select(moved, Batch(kAtBoundary), xsimd::select(along_axis, Batch(kTruncated), code))
+        .store_aligned(l.code + o);
+  }
+}
+
+void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std::uint64_t first,
+                        std::uint64_t n, const Sink& sink, TracerCounters& counters) const {
+  auto lanes = std::make_unique<Lanes>();
+  Lanes& l = *lanes;
+  const std::uint64_t end = first + n;
+  std::uint64_t next = first;
+  int n_active = 0;
+  const double max_segments = settings_.max_segments;
+  const double max_events = settings_.max_events_per_point;
+  const bool blur = settings_.roughness.model == RoughnessModel::ExitBlur;
+  std::vector<double> blur_v;
+  for (double b : settings_.roughness.beta_long) blur_v.push_back(b * b);
+
+  auto finish = [&](int i, PhotonFate fate) {
+    PhotonOutcome out;
+    out.fate = fate;
+    out.segments = static_cast<int>(l.segments[i]);
+    out.path_length = l.path[i];
+    if (fate == PhotonFate::Exited) {
+      out.direction = Vec3(l.dx[i], l.dy[i], l.dz[i]);
+      out.theta = l.theta_out[i];
+      out.phi = l.phi_out[i];
+      if (blur) {
+        PhotonRandom rng(l.rng_state(i));
+        out.direction = blur_exit_direction(
+            out.direction, RoughnessSettings::for_lobe(blur_v, out.segments),
+            RoughnessSettings::for_lobe(settings_.roughness.beta_azim, out.segments), rng);
+        out.theta = inclination(out.direction);
+        out.phi = azimuth(out.direction);
+      }
+    }
+    sink(l.photon[i], l.phi_i[i], out);
+    l.code[i] = kDone;
+  };
+
+  const Source source(settings_.seed, config, theta_i, phi_i, settings_.source.phi_i_uniform);
+  const Eigen::Vector2d beam = ellipse_.beam_direction(-direction_from_angles(theta_i, phi_i));
+  while (true) {
+    while (n_active < kPoolLanes && next < end) launch(l, n_active++, source, beam, next++);
+    if (n_active == 0) break;
+    interface_events(l, n_active, counters);
+    for (int i = 0; i < n_active; ++i) {
+      const int code = static_cast<int>(l.code[i]);
+      if (code == kExited) finish(i, PhotonFate::Exited);
+      else if (code == kTruncated) finish(i, PhotonFate::Truncated);
+      else if (code == kAtBoundary && l.events_here[i] >= max_events) finish(i, PhotonFate::Truncated);
+      else if (code == kTravel && l.segments[i] >= max_segments) finish(i, PhotonFate::Truncated);
+    }
+    travel(l, n_active);
+    for (int i = 0; i < n_active;) {  // drop finished lanes: the last lane takes the slot
+      if (static_cast<int>(l.code[i]) == kTruncated) finish(i, PhotonFate::Truncated);
+      if (static_cast<int>(l.code[i]) == kDone) {
+        l.move(i, --n_active);
+      } else {
+        ++i;
+      }
+    }
+  }
+}
+
+}  // namespace fiberlab::sim
