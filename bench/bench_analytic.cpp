@@ -1,0 +1,61 @@
+// Speed of the analytic models: S (density) evaluations per second and one
+// full 90 x 180 x 4-lobe bin prediction (what `fiberlab predict` does per
+// incident configuration).
+#include <benchmark/benchmark.h>
+
+#include <memory>
+
+#include "analytic/model_factory.h"
+#include "common/bin_grid.h"
+#include "common/units.h"
+
+using namespace fiberlab;
+using namespace fiberlab::analytic;
+
+namespace {
+
+ModelParams typical() {
+  ModelParams p;
+  p.sigma_a = {0.2, 0.4, 0.8};
+  p.beta_long = {deg_to_rad(5.0), deg_to_rad(2.5), deg_to_rad(10.0)};
+  p.beta_azim = {deg_to_rad(5.0)};
+  p.alpha = {deg_to_rad(-6.0), deg_to_rad(3.0), deg_to_rad(12.0), 0.0};
+  return p;
+}
+
+const char* kNames[] = {"exact", "deon2011", "marschner2003"};
+
+void BM_Density(benchmark::State& state) {
+  const std::string name = kNames[state.range(0)];
+  const auto model = make_model(name, typical());
+  std::vector<double> out;
+  double tr = -0.5, phi = -3.0;
+  const double ti = name == "exact" ? 0.5 : 0.4;
+  for (auto _ : state) {
+    for (int lobe = 0; lobe < 4; ++lobe) {
+      model->density(lobe, ti, 0.0, name == "exact" ? -ti : tr, phi, out);
+      benchmark::DoNotOptimize(out.data());
+    }
+    tr = tr > 0.5 ? -0.5 : tr + 0.013;
+    phi = phi > 3.0 ? -3.0 : phi + 0.031;
+  }
+  state.SetItemsProcessed(state.iterations());  // one S = sum over the 4 lobes
+  state.SetLabel(name);
+}
+BENCHMARK(BM_Density)->DenseRange(0, 2)->Unit(benchmark::kMicrosecond);
+
+void BM_FullPredict(benchmark::State& state) {
+  const std::string name = kNames[state.range(0)];
+  const auto model = make_model(name, typical());
+  const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
+  for (auto _ : state) {
+    auto p = model->bin_probabilities(grid, deg_to_rad(30.5), 0.0);
+    benchmark::DoNotOptimize(p.data());
+  }
+  state.SetLabel(name + " 90x180x4x3");
+}
+BENCHMARK(BM_FullPredict)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Iterations(2);
+
+}  // namespace
+
+BENCHMARK_MAIN();
