@@ -106,6 +106,10 @@ class LaneRandom {
   Batch normal(const Mask& m) {
     const Mask use_spare = m & has_spare_;
     const Mask generate = m & !has_spare_;
+    if (!xsimd::any(generate)) {
+      has_spare_ = has_spare_ & !m;
+      return spare_;
+    }
     const Batch r = xsimd::sqrt(Batch(-2.0) * xsimd::log(uniform_open0(generate)));
     const Batch a = Batch(6.283185307179586) * uniform(generate);
     const auto [sn, cs] = xsimd::sincos(a);
@@ -117,6 +121,7 @@ class LaneRandom {
 
   // sigma * |x| of a Normal weighted by |x| (Rayleigh), then a random sign.
   Batch signed_rayleigh(double sigma, const Mask& m) {
+    if (!xsimd::any(m)) return Batch(0.0);
     const Batch r = Batch(sigma) * xsimd::sqrt(Batch(-2.0) * xsimd::log(uniform_open0(m)));
     return xsimd::select(uniform(m) < Batch(0.5), -r, r);
   }
