@@ -178,7 +178,7 @@ struct Term {
 
 }  // namespace
 
-Deon2011::Deon2011(ModelParams params) : params_(std::move(params)) {
+Deon2011::Deon2011(ModelParams params) : params_(std::move(params)), max_order_(params_.max_order) {
   auto bad = [](const std::string& what) { throw Error("deon2011: " + what); };
   if (!(params_.eta > 1.0)) bad(fmt::format("eta = {} must be > 1", params_.eta));
   if (params_.eccentricity != 1.0)
@@ -195,6 +195,7 @@ Deon2011::Deon2011(ModelParams params) : params_(std::move(params)) {
   for (double s : params_.sigma_a)
     if (!(s >= 0.0) || !std::isfinite(s)) bad(fmt::format("sigma_a = {} must be >= 0", s));
   if (params_.quadrature_order < 1) bad("quadrature_order must be >= 1");
+  if (params_.max_order < 0) bad("max_order must be >= 0");
 }
 
 void Deon2011::density(int lobe, double theta_i, double, double theta_r, double phi,

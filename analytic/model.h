@@ -39,6 +39,9 @@ struct ModelParams {
   // F(eta, arccos(wi.wr)/2) at the exit direction; false = Eq. 14 per h,
   // F(eta, arccos(cos theta_d cos gamma_i)) (`r_fresnel=half_angle|per_h`).
   bool r_half_angle_fresnel = true;
+  // d'Eon 2011 only: highest order p traced explicitly in the last lobe; the
+  // energy of the orders above goes to the uniform residual (`max_order=N`).
+  int max_order = 20;
 };
 
 // Value of a per-lobe list for lobe p: the last entry applies to every larger p.

@@ -18,7 +18,7 @@ namespace {
 
 const char* kKeys =
     "eta, sigma_a, beta_long, beta_azim, alpha, absorption, longitudinal, roots, eccentricity, "
-    "k_g, w_c, delta_eta, delta_h_m, lobes, quadrature_order, r_fresnel";
+    "k_g, w_c, delta_eta, delta_h_m, lobes, quadrature_order, r_fresnel, max_order";
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
@@ -116,6 +116,8 @@ void apply_setting(ModelParams& p, const std::string& key_value) {
     p.lobes = integer(key, value, "an integer >= 1");
   } else if (key == "quadrature_order") {
     p.quadrature_order = integer(key, value, "an integer >= 1");
+  } else if (key == "max_order") {
+    p.max_order = integer(key, value, "an integer >= 1");
   } else if (key == "r_fresnel") {
     if (value == "half_angle") p.r_half_angle_fresnel = true;
     else if (value == "per_h") p.r_half_angle_fresnel = false;
@@ -149,6 +151,7 @@ std::vector<ParamAttribute> to_attributes(const ModelParams& p) {
       num("lobes", {static_cast<double>(p.lobes)}),
       num("quadrature_order", {static_cast<double>(p.quadrature_order)}),
       txt("r_fresnel", p.r_half_angle_fresnel ? "half_angle" : "per_h"),
+      num("max_order", {static_cast<double>(p.max_order)}),
   };
 }
 
