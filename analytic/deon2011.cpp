@@ -206,10 +206,12 @@ void Deon2011::density(int lobe, double theta_i, double, double theta_r, double 
   const deon2011::Fiber fiber{params_.eta, params_.sigma_a, params_.absorption,
                               params_.r_half_angle_fresnel};
   const double cos_r = std::cos(theta_r);
+  // theta_r at which N_p is evaluated (its theta_d = (theta_rn - theta_i) / 2).
+  const double theta_rn = params_.specular_theta_d ? -theta_i : theta_r;
   int p_end = lobe;
   std::vector<double> res;
   if (lobe >= L - 1) {
-    const cylinder::Attenuation att(params_.eta, 0.5 * (theta_r - theta_i), params_.sigma_a,
+    const cylinder::Attenuation att(params_.eta, 0.5 * (theta_rn - theta_i), params_.sigma_a,
                                     params_.absorption);
     for (p_end = lobe;; ++p_end) {
       residual_energy(att, p_end, res);
@@ -226,7 +228,7 @@ void Deon2011::density(int lobe, double theta_i, double, double theta_r, double 
     const int order = std::min(
         4000, std::max(params_.quadrature_order,
                        static_cast<int>(std::ceil(params_.quadrature_order * deg_to_rad(2.0) / ba))));
-    deon2011::N_p(p, ba, fiber, theta_i, theta_r, phi, order, n);
+    deon2011::N_p(p, ba, fiber, theta_i, theta_rn, phi, order, n);
     for (int c = 0; c < C; ++c) out[c] += m * n[c] * cos_r;
   }
   if (lobe >= L - 1) {
@@ -340,8 +342,9 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       const double tr = t.alpha - theta_i;
       if (std::abs(tr) > kPi / 2) continue;  // shifted off the sphere (documented loss)
       const double w = std::cos(tr) / std::cos(theta_i);
-      if (t.open) p_last = last_order(t, tr);
-      azimuthal(t, tr, nb);
+      const double trn = params_.specular_theta_d ? -theta_i : tr;
+      if (t.open) p_last = last_order(t, trn);
+      azimuthal(t, trn, nb);
       const int i = grid.theta_bin(tr);
       for (std::size_t k = 0; k < nb.size(); ++k) lobe_out[static_cast<std::size_t>(i) * np * C + k] += w * nb[k];
       continue;
@@ -389,7 +392,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
         }
       }
     }
-    if (t.p0 == 0 && r_special && !t.open) {
+    if (t.p0 == 0 && r_special && !t.open && !params_.specular_theta_d) {
       // R with Eq. 12: F depends on (theta_r, phi) itself: direct 2D quadrature.
       std::vector<double> row(np);
       for (const ThetaPoint& pt : tp) {
@@ -403,6 +406,19 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
           double* o = &lobe_out[(static_cast<std::size_t>(pt.i) * np + j) * C];
           for (int c = 0; c < C; ++c) o[c] += pt.w * s;
         }
+      }
+      continue;
+    }
+    if (params_.specular_theta_d) {
+      // N_p does not depend on theta_r: one evaluation, times int_bin M cos.
+      if (t.open) p_last = last_order(t, -theta_i);
+      azimuthal(t, -theta_i, nb);
+      std::vector<double> wbin(nt, 0.0);
+      for (const ThetaPoint& pt : tp) wbin[pt.i] += pt.w;
+      for (int i = 0; i < nt; ++i) {
+        if (wbin[i] == 0.0) continue;
+        double* o = &lobe_out[static_cast<std::size_t>(i) * np * C];
+        for (std::size_t x = 0; x < nb.size(); ++x) o[x] += wbin[i] * nb[x];
       }
       continue;
     }

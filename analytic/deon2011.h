@@ -24,6 +24,9 @@
 //   below 1e-6, then that remainder spread uniformly in phi (d'Eon's and
 //   pbrt's residual term), with the last lobe's M. Energy is exact; only the
 //   remainder's phi shape is approximate.
+// - theta_d of N_p: the exit direction's (published) or, with
+//   ModelParams::specular_theta_d, the specular cone's -theta_i, which makes
+//   the model the simulator's exit_blur exactly (SPEC s3).
 // - Per-lobe parameters: v_p = beta_long_p^2, beta_p = beta_azim_p, alpha_p
 //   (lists indexed by p, the last entry for every larger p).
 // - Limits: beta_long = 0 gives M_p = delta(theta_r - alpha_p + theta_i) /

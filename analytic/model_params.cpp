@@ -18,7 +18,7 @@ namespace {
 
 const char* kKeys =
     "eta, sigma_a, beta_long, beta_azim, alpha, absorption, longitudinal, roots, eccentricity, "
-    "k_g, w_c, delta_eta, delta_h_m, lobes, quadrature_order, r_fresnel, max_order";
+    "k_g, w_c, delta_eta, delta_h_m, lobes, quadrature_order, r_fresnel, max_order, n_theta_d";
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
@@ -116,6 +116,10 @@ void apply_setting(ModelParams& p, const std::string& key_value) {
     p.lobes = integer(key, value, "an integer >= 1");
   } else if (key == "quadrature_order") {
     p.quadrature_order = integer(key, value, "an integer >= 1");
+  } else if (key == "n_theta_d") {
+    if (value == "exit") p.specular_theta_d = false;
+    else if (value == "specular") p.specular_theta_d = true;
+    else fail(key, value, "exit | specular");
   } else if (key == "max_order") {
     p.max_order = integer(key, value, "an integer >= 1");
   } else if (key == "r_fresnel") {
@@ -152,6 +156,7 @@ std::vector<ParamAttribute> to_attributes(const ModelParams& p) {
       num("quadrature_order", {static_cast<double>(p.quadrature_order)}),
       txt("r_fresnel", p.r_half_angle_fresnel ? "half_angle" : "per_h"),
       num("max_order", {static_cast<double>(p.max_order)}),
+      txt("n_theta_d", p.specular_theta_d ? "specular" : "exit"),
   };
 }
 

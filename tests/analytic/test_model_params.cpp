@@ -19,7 +19,7 @@ TEST(ModelParams, ParsesEveryKey) {
   apply_settings(p, {"eta=1.6", "sigma_a=0.1,0.2,0.3,0.4", "beta_long=5,10", "beta_azim=7",
                      "alpha=-6,3,12", "absorption=chord", "longitudinal=two_theta_h", "roots=exact",
                      "eccentricity=0.85", "k_g=0.4", "w_c=10", "delta_eta=0.2", "delta_h_m=0.5",
-                     "lobes=5", "quadrature_order=50", "r_fresnel=per_h", "max_order=30"});
+                     "lobes=5", "quadrature_order=50", "r_fresnel=per_h", "max_order=30", "n_theta_d=specular"});
   EXPECT_EQ(p.eta, 1.6);
   EXPECT_EQ(p.sigma_a.size(), 4u);
   EXPECT_NEAR(p.beta_long[1], deg_to_rad(10.0), 1e-15);
@@ -32,7 +32,8 @@ TEST(ModelParams, ParsesEveryKey) {
   EXPECT_EQ(p.quadrature_order, 50);
   EXPECT_FALSE(p.r_half_angle_fresnel);
   EXPECT_EQ(p.max_order, 30);
-  EXPECT_EQ(to_attributes(p).size(), 17u);
+  EXPECT_TRUE(p.specular_theta_d);
+  EXPECT_EQ(to_attributes(p).size(), 18u);
 }
 
 TEST(ModelParams, BadInputNamesTheKeyAndTheAllowedValues) {
