@@ -31,64 +31,60 @@ double mp_bin_probability(double v, double ti, double lo, double hi) {
   return s * h / 3.0;
 }
 
-TEST(ExitBlur, ThetaMarginalIsDeonMp) {
-  const double theta_i = deg_to_rad(35.0);
+// Multinomial chi-square of one lobe's theta-marginal against M_p(beta^2),
+// over the bins expecting >= 30 photons: chi-square with bins - 1 degrees of
+// freedom when M_p is right. White fiber: weights are 1, so S1 = counts.
+struct MarginalChi2 {
+  double chi2 = 0.0, expected_fraction = 0.0;
+  int dof = -1;
+};
+MarginalChi2 theta_marginal_vs_mp(const ResultFile& r, int lobe, double theta_i, double beta) {
+  const std::vector<double> m = testing::theta_marginal(r, 0, lobe, 0);
+  double n_lobe = 0.0, expected_total = 0.0;
+  for (double x : m) n_lobe += x;
+  MarginalChi2 out;
+  for (int i = 0; i < r.grid.n_theta(); ++i) {
+    const double e = n_lobe * mp_bin_probability(beta * beta, theta_i, r.grid.theta_edges[i],
+                                                  r.grid.theta_edges[i + 1]);
+    if (e < 30.0) continue;
+    out.chi2 += (m[i] - e) * (m[i] - e) / e;
+    expected_total += e;
+    ++out.dof;
+  }
+  out.expected_fraction = expected_total / n_lobe;
+  return out;
+}
+
+Settings exit_blur_circle(std::vector<double> beta_long_deg) {
   Settings s = testing::smooth_circle(35.0, 1000000);
   s.roughness.model = RoughnessModel::ExitBlur;
-  s.roughness.beta_long = {deg_to_rad(6.0), deg_to_rad(12.0), deg_to_rad(20.0)};
+  s.roughness.beta_long.clear();
+  for (double b : beta_long_deg) s.roughness.beta_long.push_back(deg_to_rad(b));
   s.roughness.beta_azim = {deg_to_rad(10.0)};
   s.tally.n_theta = 180;
   s.tally.n_phi = 8;
+  return s;
+}
+
+TEST(ExitBlur, ThetaMarginalIsDeonMp) {
+  const Settings s = exit_blur_circle({6.0, 12.0, 20.0});
   const ResultFile r = testing::run(s);
   for (int lobe = 0; lobe < 3; ++lobe) {
     const double beta = s.roughness.beta_long[lobe];
-    const std::vector<double> m = testing::theta_marginal(r, 0, lobe, 0);
-    double n_lobe = 0.0;
-    for (double x : m) n_lobe += x;  // white fiber: weights are 1, S1 = counts
-    // Multinomial chi-square over bins expecting >= 30 photons; dof = bins - 1.
-    double chi2 = 0.0, expected_total = 0.0;
-    int bins = 0;
-    for (int i = 0; i < r.grid.n_theta(); ++i) {
-      const double e = n_lobe * mp_bin_probability(beta * beta, theta_i, r.grid.theta_edges[i],
-                                                    r.grid.theta_edges[i + 1]);
-      if (e < 30.0) continue;
-      chi2 += (m[i] - e) * (m[i] - e) / e;
-      expected_total += e;
-      ++bins;
-    }
-    const int dof = bins - 1;
+    const MarginalChi2 c = theta_marginal_vs_mp(r, lobe, deg_to_rad(35.0), beta);
     std::printf("lobe %d, beta %.0f deg: chi2 %.1f over %d dof (threshold %.1f)\n", lobe,
-                rad_to_deg(beta), chi2, dof, testing::chi2_threshold(dof));
-    ASSERT_GT(dof, 10);
-    EXPECT_GT(expected_total, 0.99 * n_lobe);  // the tails left out are small
-    EXPECT_LT(chi2, testing::chi2_threshold(dof)) << "lobe " << lobe;
+                rad_to_deg(beta), c.chi2, c.dof, testing::chi2_threshold(c.dof));
+    ASSERT_GT(c.dof, 10);
+    EXPECT_GT(c.expected_fraction, 0.99);  // the tails left out are small
+    EXPECT_LT(c.chi2, testing::chi2_threshold(c.dof)) << "lobe " << lobe;
   }
 }
 
 // The same test must reject a wrong width: M_p at 1.1 beta fails.
 TEST(ExitBlur, ChiSquareRejectsWrongWidth) {
-  const double theta_i = deg_to_rad(35.0);
-  Settings s = testing::smooth_circle(35.0, 1000000);
-  s.roughness.model = RoughnessModel::ExitBlur;
-  s.roughness.beta_long = {deg_to_rad(10.0)};
-  s.roughness.beta_azim = {deg_to_rad(10.0)};
-  s.tally.n_theta = 180;
-  s.tally.n_phi = 8;
-  const ResultFile r = testing::run(s);
-  const std::vector<double> m = testing::theta_marginal(r, 0, 1, 0);
-  double n_lobe = 0.0;
-  for (double x : m) n_lobe += x;
-  const double beta = 1.1 * deg_to_rad(10.0);
-  double chi2 = 0.0;
-  int bins = 0;
-  for (int i = 0; i < r.grid.n_theta(); ++i) {
-    const double e = n_lobe * mp_bin_probability(beta * beta, theta_i, r.grid.theta_edges[i],
-                                                  r.grid.theta_edges[i + 1]);
-    if (e < 30.0) continue;
-    chi2 += (m[i] - e) * (m[i] - e) / e;
-    ++bins;
-  }
-  EXPECT_GT(chi2, 3.0 * testing::chi2_threshold(bins - 1));
+  const ResultFile r = testing::run(exit_blur_circle({10.0}));
+  const MarginalChi2 c = theta_marginal_vs_mp(r, 1, deg_to_rad(35.0), 1.1 * deg_to_rad(10.0));
+  EXPECT_GT(c.chi2, 3.0 * testing::chi2_threshold(c.dof));
 }
 
 }  // namespace
