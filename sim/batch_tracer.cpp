@@ -119,6 +119,37 @@ class LaneRandom {
     return out;
   }
 
+  // normal(first) then normal(second) lane by lane, with one Box-Muller
+  // generation instead of two: a lane that draws both uses its spare for one
+  // and generates the other, so it generates exactly once, and a lane that
+  // draws one generates only without a spare. Each lane's stream is consumed
+  // as by two calls of normal(). Lanes in `second` only must have made no
+  // other draw since `first` (true for the sampler's dl, da).
+  std::pair<Batch, Batch> normal_pair(const Mask& first, const Mask& second) {
+    const Mask gen_first = first & !has_spare_;
+    const Mask spare_after_first = (has_spare_ & !first) | gen_first;
+    const Mask gen_second = second & !spare_after_first;
+    const Mask generate = gen_first | gen_second;
+    Batch cs(0.0), sn(0.0);
+    if (xsimd::any(generate)) {
+      const Batch r = xsimd::sqrt(Batch(-2.0) * xsimd::log(uniform_open0(generate)));
+      const auto [s, c] = xsimd::sincos(Batch(6.283185307179586) * uniform(generate));
+      cs = r * c;
+      sn = r * s;
+    }
+    // First draw: spare, or the cosine of a new pair (sine kept).
+    const Batch a = xsimd::select(gen_first, cs, spare_);
+    // Second draw: spare (old or just made), or the cosine of a new pair.
+    const Batch spare_for_second = xsimd::select(gen_first, sn, spare_);
+    const Batch b = xsimd::select(gen_second, cs, spare_for_second);
+    // What is left as spare: the sine of a pair generated for the second
+    // draw, nothing if the second draw used a spare, otherwise unchanged.
+    spare_ = xsimd::select(gen_second, sn, xsimd::select(gen_first, sn, spare_));
+    const Mask used_second_spare = second & spare_after_first;
+    has_spare_ = (spare_after_first & !used_second_spare) | gen_second;
+    return {a, b};
+  }
+
   // sigma * |x| of a Normal weighted by |x| (Rayleigh), then a random sign.
   Batch signed_rayleigh(double sigma, const Mask& m) {
     if (!xsimd::any(m)) return Batch(0.0);
@@ -201,10 +232,12 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
     const Mask first = envelope & (pick < c);
     const Mask second = envelope & !first & (pick < c + w_long);
     const Mask third = envelope & !first & !second;
-    const Batch dl_normal = Batch(beta_long) * rng.normal(pending & !second);
-    const Batch dl = xsimd::select(second, rng.signed_rayleigh(beta_long, pending & second), dl_normal);
-    const Batch da_normal = Batch(beta_azim) * rng.normal(pending & !third);
-    const Batch da = xsimd::select(third, rng.signed_rayleigh(beta_azim, pending & third), da_normal);
+    // Per lane: dl then da, each a normal or (envelope) a signed Rayleigh.
+    const Batch dl_rayleigh = rng.signed_rayleigh(beta_long, pending & second);
+    const auto [n_long, n_azim] = rng.normal_pair(pending & !second, pending & !third);
+    const Batch da_rayleigh = rng.signed_rayleigh(beta_azim, pending & third);
+    const Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
+    const Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
     const Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
     const auto [st, ct] = xsimd::sincos(theta_n + dl);
     const auto [sa, ca] = xsimd::sincos(da);
