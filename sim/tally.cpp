@@ -5,19 +5,17 @@ namespace fiberlab::sim {
 Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
     : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels) {
   const std::size_t bins = static_cast<std::size_t>(lobes) * n_theta * n_phi;
-  s1_.assign(bins * channels, 0);
-  s2_.assign(bins * channels, 0);
-  count_.assign(bins, 0);
+  bins_.assign(bins * block(), 0);
   exited_.assign(static_cast<std::size_t>(lobes) * channels, 0);
   absorbed_.assign(channels, 0);
   truncated_.assign(channels, 0);
 }
 
 void Tally::score_exit(int lobe, int i_theta, int i_phi, const double* weight) {
-  const std::size_t b = bin_index(lobe, i_theta, i_phi);
-  ++count_[b];
-  Fixed* s1 = &s1_[b * channels_];
-  Fixed* s2 = &s2_[b * channels_];
+  Fixed* cell = &bins_[bin_index(lobe, i_theta, i_phi) * block()];
+  ++cell[0];
+  Fixed* s1 = cell + 1;
+  Fixed* s2 = cell + 1 + channels_;
   for (int c = 0; c < channels_; ++c) {
     const Fixed w = to_fixed(weight[c]);
     s1[c] += w;
@@ -38,11 +36,7 @@ void Tally::score_truncated(const double* weight) {
 
 void Tally::add(const Tally& o) {
   photons_ += o.photons_;
-  for (std::size_t i = 0; i < s1_.size(); ++i) {
-    s1_[i] += o.s1_[i];
-    s2_[i] += o.s2_[i];
-  }
-  for (std::size_t i = 0; i < count_.size(); ++i) count_[i] += o.count_[i];
+  for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] += o.bins_[i];
   for (std::size_t i = 0; i < exited_.size(); ++i) exited_[i] += o.exited_[i];
   for (int c = 0; c < channels_; ++c) {
     absorbed_[c] += o.absorbed_[c];
@@ -56,8 +50,24 @@ std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
   return out;
 }
 
-std::vector<double> Tally::weight_sum() const { return to_double(s1_); }
-std::vector<double> Tally::weight_sq_sum() const { return to_double(s2_); }
+std::vector<double> Tally::column(int offset) const {
+  const std::size_t bins = bins_.size() / block();
+  std::vector<double> out(bins * channels_);
+  for (std::size_t b = 0; b < bins; ++b)
+    for (int c = 0; c < channels_; ++c)
+      out[b * channels_ + c] = static_cast<double>(bins_[b * block() + offset + c]) / kScale;
+  return out;
+}
+
+std::vector<double> Tally::weight_sum() const { return column(1); }
+std::vector<double> Tally::weight_sq_sum() const { return column(1 + channels_); }
+
+std::vector<std::uint64_t> Tally::count() const {
+  const std::size_t bins = bins_.size() / block();
+  std::vector<std::uint64_t> out(bins);
+  for (std::size_t b = 0; b < bins; ++b) out[b] = static_cast<std::uint64_t>(bins_[b * block()]);
+  return out;
+}
 std::vector<double> Tally::exited() const { return to_double(exited_); }
 std::vector<double> Tally::absorbed() const { return to_double(absorbed_); }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }

@@ -38,7 +38,7 @@ class Tally {
   // Results as float64, in the HDF5 index order [lobe][theta][phi][channel].
   std::vector<double> weight_sum() const;
   std::vector<double> weight_sq_sum() const;
-  const std::vector<std::uint64_t>& count() const { return count_; }  // [lobe][theta][phi]
+  std::vector<std::uint64_t> count() const;  // [lobe][theta][phi]
   std::vector<double> exited() const;     // [lobe][channel]
   std::vector<double> absorbed() const;   // [channel]
   std::vector<double> truncated() const;  // [channel]
@@ -49,11 +49,14 @@ class Tally {
   }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
+  // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
+  // that scoring a photon touches one or two cache lines, not three arrays.
+  std::size_t block() const { return 2 * static_cast<std::size_t>(channels_) + 1; }
+  std::vector<double> column(int offset) const;  // S1 (offset 1) or S2 (1 + C)
 
   int lobes_, n_theta_, n_phi_, channels_;
   std::uint64_t photons_ = 0;
-  std::vector<Fixed> s1_, s2_;
-  std::vector<std::uint64_t> count_;
+  std::vector<Fixed> bins_;  // [bin][count, S1[C], S2[C]]
   std::vector<Fixed> exited_, absorbed_, truncated_;
 };
 
