@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
 
 #include "analytic/quadrature.h"
 #include "analytic/smooth_cylinder.h"
@@ -171,10 +172,15 @@ double G0(double phi, double beta, double refine) {
 // One group of orders sharing M_p and the detector: a single p, or (open)
 // every p >= p0 of the last lobe.
 struct Term {
-  int lobe, p0;
-  bool open;
+  int lobe, p0, p1;  // orders p0..p1 traced explicitly
+  bool residual;     // plus every p > p1, spread uniformly in phi
+  bool coarse;       // high orders (p > kFineOrders): base theta resolution
   double v, alpha, beta;
 };
+// Orders of the last lobe above this get the base Chebyshev count in theta_r:
+// their energy is small, so their (equally sharp) features need less
+// relative accuracy.
+constexpr int kFineOrders = 20;
 
 }  // namespace
 
@@ -251,14 +257,44 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
   const int list_len = static_cast<int>(std::max(
       {params_.beta_long.size(), params_.beta_azim.size(), params_.alpha.size()}));
   std::vector<Term> terms;
-  auto make_term = [&](int lobe, int p, bool open) {
+  auto make_term = [&](int lobe, int p, int p1, bool residual, bool coarse) {
     const double bl = for_lobe(params_.beta_long, p);
-    return Term{lobe, p, open, bl * bl, for_lobe(params_.alpha, p), for_lobe(params_.beta_azim, p)};
+    return Term{lobe, p, p1, residual, coarse, bl * bl, for_lobe(params_.alpha, p),
+                for_lobe(params_.beta_azim, p)};
   };
-  for (int l = 0; l < L - 1; ++l) terms.push_back(make_term(l, l, false));
+  for (int l = 0; l < L - 1; ++l) terms.push_back(make_term(l, l, l, false, false));
   const int p_open = std::max(L - 1, list_len - 1);
-  for (int p = L - 1; p < p_open; ++p) terms.push_back(make_term(L - 1, p, false));
-  terms.push_back(make_term(L - 1, p_open, true));
+  for (int p = L - 1; p < p_open; ++p) terms.push_back(make_term(L - 1, p, p, false, false));
+  // The last explicit order: where the remaining energy drops below
+  // kResidualTol (or max_order), judged at the specular direction, the M_p
+  // peak and 3 sigma either side; fixed for the whole theta_r range so that
+  // N_p stays smooth in theta_r.
+  std::vector<double> res;
+  int p_last = p_open;
+  {
+    const double bl = for_lobe(params_.beta_long, p_open), al = for_lobe(params_.alpha, p_open);
+    std::vector<double> probes{-theta_i};
+    if (!params_.specular_theta_d)
+      for (double d : {-3.0, 0.0, 3.0}) probes.push_back(al - theta_i + d * bl);
+    for (double tr : probes) {
+      tr = std::clamp(tr, -kPi / 2, kPi / 2);
+      const cylinder::Attenuation att(params_.eta, 0.5 * (tr - theta_i), params_.sigma_a,
+                                      params_.absorption);
+      for (int P = p_open;; ++P) {
+        residual_energy(att, P, res);
+        if (*std::max_element(res.begin(), res.end()) <= kResidualTol || P >= max_order_) {
+          p_last = std::max(p_last, P);
+          break;
+        }
+      }
+    }
+  }
+  if (p_last <= kFineOrders || p_open > kFineOrders) {
+    terms.push_back(make_term(L - 1, p_open, p_last, true, p_open > kFineOrders));
+  } else {
+    terms.push_back(make_term(L - 1, p_open, kFineOrders, false, false));
+    terms.push_back(make_term(L - 1, kFineOrders + 1, p_last, true, true));
+  }
 
   // Eq. 12 needs the R lobe's azimuthal shape at Gauss points of every phi bin.
   constexpr int kPhiOrder = 6;
@@ -276,26 +312,22 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
   }
 
   std::vector<cylinder::PathNode> nodes;
-  std::vector<double> a(C), res;
+  std::vector<double> a(C);
   // Phi-bin integrals of sum_{p in term} N_p at exit inclination theta_r: [j * C + c].
-  // The open term's last explicit order, fixed over theta_r so that N_p's
-  // theta_r dependence stays smooth (set per term below).
-  int p_last = 0;
-  auto last_order = [&](const Term& t, double theta_r) {
-    const cylinder::Attenuation att(params_.eta, 0.5 * (theta_r - theta_i), params_.sigma_a,
-                                    params_.absorption);
-    int P = t.p0;
-    for (;; ++P) {
-      residual_energy(att, P, res);
-      if (*std::max_element(res.begin(), res.end()) <= kResidualTol || P >= max_order_) break;
-    }
-    return P;
-  };
   auto azimuthal = [&](const Term& t, double theta_r, std::vector<double>& nb) {
     nb.assign(static_cast<std::size_t>(np) * C, 0.0);
     const cylinder::Attenuation att(params_.eta, 0.5 * (theta_r - theta_i), params_.sigma_a,
                                     params_.absorption);
-    for (int p = t.p0;; ++p) {
+    // Wide detectors: deposit through the Fourier series of Eq. 11 (terms up
+    // to g_n < 1e-17) when that is shorter than the erfc window per node.
+    int n_fourier = 0;
+    if (t.beta >= kSmoothBeta) {
+      const int n_max = static_cast<int>(std::ceil(8.9 / t.beta));
+      const double window = 17.0 * t.beta / dphi;
+      if (n_max <= 4.0 * window) n_fourier = n_max;
+    }
+    std::vector<std::complex<double>> fourier(static_cast<std::size_t>(n_fourier + 1) * C);
+    for (int p = t.p0; p <= t.p1; ++p) {
       if (p == 0 && r_special) {
         for (int j = 0; j < np; ++j) {
           double s = 0.0;
@@ -320,16 +352,42 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
         for (const auto& nd : nodes) {
           att.A(p, nd.gamma, a.data());
           for (int c = 0; c < C; ++c) a[c] *= nd.weight;
-          deposit_gaussian(nd.phi, t.beta, a.data(), C, np, nb);
+          if (n_fourier > 0) {
+            // Accumulate sum_nodes mass e^{-i n Phi}, n = 0..n_fourier.
+            const std::complex<double> e(std::cos(nd.phi), -std::sin(nd.phi));
+            std::complex<double> z(1.0, 0.0);
+            for (int n = 0; n <= n_fourier; ++n) {
+              for (int c = 0; c < C; ++c) fourier[static_cast<std::size_t>(n) * C + c] += a[c] * z;
+              z *= e;
+            }
+          } else {
+            deposit_gaussian(nd.phi, t.beta, a.data(), C, np, nb);
+          }
         }
       }
-      if (!t.open) return;
-      if (p >= p_last) {
-        residual_energy(att, p, res);
-        for (int j = 0; j < np; ++j)
-          for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += res[c] / np;
-        return;
+    }
+    if (n_fourier > 0) {
+      // Eq. 11 in Fourier form: the wrapped Gaussian's coefficients are
+      // g_n = exp(-n^2 beta^2 / 2), so the bin mass is
+      // F_0 dphi / 2pi + (1/pi) Re sum_{n>=1} F_n g_n (e^{i n b} - e^{i n a}) / (i n).
+      for (int j = 0; j < np; ++j) {
+        const double lo = -kPi + j * dphi, hi = lo + dphi;
+        for (int c = 0; c < C; ++c) {
+          double v = fourier[c].real() * dphi / kTwoPi;
+          for (int n = 1; n <= n_fourier; ++n) {
+            const double g = std::exp(-0.5 * n * n * t.beta * t.beta);
+            const std::complex<double> d = (std::polar(1.0, n * hi) - std::polar(1.0, n * lo)) /
+                                           std::complex<double>(0.0, n);
+            v += (fourier[static_cast<std::size_t>(n) * C + c] * g * d).real() / kPi;
+          }
+          nb[static_cast<std::size_t>(j) * C + c] += v;
+        }
       }
+    }
+    if (t.residual) {
+      residual_energy(att, t.p1, res);
+      for (int j = 0; j < np; ++j)
+        for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += res[c] / np;
     }
   };
 
@@ -343,13 +401,13 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       if (std::abs(tr) > kPi / 2) continue;  // shifted off the sphere (documented loss)
       const double w = std::cos(tr) / std::cos(theta_i);
       const double trn = params_.specular_theta_d ? -theta_i : tr;
-      if (t.open) p_last = last_order(t, trn);
       azimuthal(t, trn, nb);
       const int i = grid.theta_bin(tr);
       for (std::size_t k = 0; k < nb.size(); ++k) lobe_out[static_cast<std::size_t>(i) * np * C + k] += w * nb[k];
       continue;
     }
-    // Support of M_p cos(theta_r): where it is within e^-46 of its maximum.
+    // Support of M_p cos(theta_r): where it is within e^-30 (1e-13) of its
+    // maximum; what lies beyond is dropped (below 1e-12 of the lobe).
     auto log_weight = [&](double tr) {
       return deon2011::log_M_p(t.v, theta_i, tr - t.alpha) + std::log(std::max(std::cos(tr), 1e-300));
     };
@@ -360,7 +418,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     for (int s = 0; s <= kScan; ++s) peak = std::max(peak, lw[s] = log_weight(-kPi / 2 + s * step));
     int s0 = kScan, s1 = 0;
     for (int s = 0; s <= kScan; ++s)
-      if (lw[s] > peak - 46.0) s0 = std::min(s0, s), s1 = std::max(s1, s);
+      if (lw[s] > peak - 30.0) s0 = std::min(s0, s), s1 = std::max(s1, s);
     const double peak_at = std::clamp(t.alpha - theta_i, -kPi / 2, kPi / 2);
     double lo = std::max(-kPi / 2, std::min(-kPi / 2 + (s0 - 1) * step, peak_at - step));
     double hi = std::min(kPi / 2, std::max(-kPi / 2 + (s1 + 1) * step, peak_at + step));
@@ -392,7 +450,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
         }
       }
     }
-    if (t.p0 == 0 && r_special && !t.open && !params_.specular_theta_d) {
+    if (t.p0 == 0 && t.p1 == 0 && r_special && !t.residual && !params_.specular_theta_d) {
       // R with Eq. 12: F depends on (theta_r, phi) itself: direct 2D quadrature.
       std::vector<double> row(np);
       for (const ThetaPoint& pt : tp) {
@@ -411,7 +469,6 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     }
     if (params_.specular_theta_d) {
       // N_p does not depend on theta_r: one evaluation, times int_bin M cos.
-      if (t.open) p_last = last_order(t, -theta_i);
       azimuthal(t, -theta_i, nb);
       std::vector<double> wbin(nt, 0.0);
       for (const ThetaPoint& pt : tp) wbin[pt.i] += pt.w;
@@ -426,7 +483,10 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     // dependence. Its features (caustics moving with theta_d) are about
     // beta_azim wide in phi: more points for narrow detectors (measured:
     // 8x the base count at 2 deg reaches 1e-7 of the bin probabilities).
-    const double narrow = std::clamp(deg_to_rad(16.0) / std::max(t.beta, 1e-12), 1.0, 16.0);
+    // Orders p > 2 move their caustics faster with theta_d: twice the points.
+    const double narrow = t.coarse ? 1.0
+                                   : std::clamp(deg_to_rad(16.0) / std::max(t.beta, 1e-12), 1.0, 16.0) *
+                                         (t.p1 > 2 ? 2.0 : 1.0);
     const int nc = std::clamp(static_cast<int>(std::ceil(refine_ * narrow * (4.0 + 8.0 * (hi - lo)))), 3, 200);
     std::vector<double> xs(nc), bw(nc);
     for (int k = 0; k < nc; ++k) {
@@ -449,10 +509,6 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       } else {
         for (int k = 0; k < nc; ++k) row[k] += pt.w * lk[k] / den;
       }
-    }
-    if (t.open) {
-      p_last = t.p0;
-      for (int k = 0; k < nc; ++k) p_last = std::max(p_last, last_order(t, xs[k]));
     }
     for (int k = 0; k < nc; ++k) {
       azimuthal(t, xs[k], nb);

@@ -19,7 +19,7 @@
 //   Eq. 14 like the other orders (r_fresnel=per_h). They agree for v, beta -> 0;
 //   only per_h conserves energy exactly for rough fibers.
 // - Lobes: 0..L-2 one order each; lobe L-1 sums p >= L-1: orders up to the
-//   first P (<= ModelParams::max_order, default 20) after which the remaining energy, computed in
+//   first P (<= ModelParams::max_order, default 40) after which the remaining energy, computed in
 //   closed form per h (sum_{p>P} A = (1-f)^2 f^P T^(P+1) / (1 - f T)), is
 //   below 1e-6, then that remainder spread uniformly in phi (d'Eon's and
 //   pbrt's residual term), with the last lobe's M. Energy is exact; only the
@@ -88,7 +88,7 @@ class Deon2011 : public Model {
   // h panels, M panels) by `factor`, to measure convergence (tests).
   void set_refinement(double factor) { refine_ = factor; }
   int max_order() const { return max_order_; }
-  // Highest order traced explicitly in the last lobe (default 20).
+  // Highest order traced explicitly in the last lobe (default 40).
   void set_max_order(int p) { max_order_ = p; }
 
  private:

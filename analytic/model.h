@@ -41,7 +41,7 @@ struct ModelParams {
   bool r_half_angle_fresnel = true;
   // d'Eon 2011 only: highest order p traced explicitly in the last lobe; the
   // energy of the orders above goes to the uniform residual (`max_order=N`).
-  int max_order = 20;
+  int max_order = 40;
   // d'Eon 2011 only: theta_d at which N_p is evaluated. false (published):
   // theta_d = (theta_r - theta_i)/2 of the exit direction; true: theta_d =
   // -theta_i, the specular cone's, so that S = M_p(theta_r) N_p(phi) is a

@@ -26,7 +26,7 @@ namespace fiberlab::analytic {
 //   lobes            integer >= 1
 //   quadrature_order integer >= 1                    (deon2011)
 //   r_fresnel        half_angle | per_h              (deon2011)
-//   max_order        integer >= 1, default 20        (deon2011: last explicit p)
+//   max_order        integer >= 1, default 40        (deon2011: last explicit p)
 //   n_theta_d        exit | specular                 (deon2011: theta_d of N_p)
 // Throws fiberlab::Error, one line naming the key and the allowed values.
 void apply_setting(ModelParams& params, const std::string& key_value);
