@@ -246,3 +246,38 @@ TEST(Deon2011, NoNanOrInfAnywhere) {
     for (double t : {-kPi / 2, kPi / 2})
       EXPECT_TRUE(std::isfinite(deon2011::M_p(v, t, -t)) && std::isfinite(deon2011::M_p(v, t, t)));
 }
+
+TEST(Deon2011, SpecularThetaDIsTheExitBlurProduct) {
+  // n_theta_d=specular, r_fresnel=per_h, chord absorption: the simulator's
+  // exit_blur (SPEC s3): lobe p's theta-marginal is E_p(theta_i) times the
+  // bin integral of M_p cos(theta_r) (E_p from the exact smooth cylinder).
+  const BinGrid grid = BinGrid::make(60, 90, ThetaBinning::Uniform);
+  ModelParams p;
+  p.sigma_a = {0.3};
+  p.absorption = Absorption::Chord;
+  p.r_half_angle_fresnel = false;
+  p.specular_theta_d = true;
+  p.beta_long = {deg_to_rad(4.0), deg_to_rad(9.0), deg_to_rad(15.0)};
+  p.beta_azim = {deg_to_rad(6.0), deg_to_rad(3.0), deg_to_rad(12.0)};
+  const double ti = deg_to_rad(37.0);
+  const auto bins = Deon2011(p).bin_probabilities(grid, ti, 0.0);
+  const auto ex = smooth_cylinder_prediction(p.eta, ti, p.sigma_a, p.absorption, 4, 90);
+  const GaussLegendre& gl = gauss_legendre(16);
+  for (int lobe = 0; lobe < 3; ++lobe) {
+    const double v = p.beta_long[lobe] * p.beta_long[lobe];
+    for (int i = 0; i < 60; ++i) {
+      double m = 0.0;
+      const double t0 = grid.theta_edges[i], t1 = grid.theta_edges[i + 1];
+      for (int k = 0; k < 8; ++k) {  // 8 panels x 16 points per bin
+        const double a = t0 + k * (t1 - t0) / 8, b = a + (t1 - t0) / 8;
+        for (int q = 0; q < 16; ++q) {
+          const double tr = 0.5 * (a + b) + 0.5 * (b - a) * gl.x[q];
+          m += 0.5 * (b - a) * gl.w[q] * deon2011::M_p(v, ti, tr) * std::cos(tr);
+        }
+      }
+      double marg = 0.0;
+      for (int j = 0; j < 90; ++j) marg += bins[(static_cast<std::size_t>(lobe) * 60 + i) * 90 + j];
+      EXPECT_NEAR(marg, ex.energy[lobe] * m, 1e-9) << lobe << " " << i;
+    }
+  }
+}
