@@ -84,6 +84,18 @@ class Deon2011 : public Model {
   // with panels on which Phi moves by at most min(beta_p, 0.25).
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
                                         double phi_i) const override;
+  //
+  // Accuracy (measured against set_refinement(2) and (4), and max_order 100,
+  // on 90 x 180 bins, sigma_a = 0, the hardest case): lobes R, TT, TRT agree
+  // to < 1e-10 absolute per bin; the p >= 3 lobe to < 1e-7 for theta_i <= 60
+  // deg and ~1e-6 at theta_i = 85 deg (theta_d -> 90 deg makes eta' vary
+  // fast in theta_r), against a 1e8-photon Monte Carlo standard error of
+  // 1e-7 .. 2e-6 in those bins. Energy: the sum over all bins is 1 to 1e-10
+  // (r_fresnel=per_h, sigma_a = 0), to ~5e-6 at theta_i = 85 deg, beta = 2 deg.
+  // Zero roughness reproduces the exact smooth cylinder bin for bin.
+  // Speed: 0.1-0.8 s per incidence with absorption, up to ~2 s for white
+  // fibers (sigma_a = 0: many orders) with beta_azim <= 5 deg.
+  //
   // Multiplies every node density of bin_probabilities() (Chebyshev nodes,
   // h panels, M panels) by `factor`, to measure convergence (tests).
   void set_refinement(double factor) { refine_ = factor; }
