@@ -214,8 +214,8 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
                        const Mask& live, LaneRandom& rng, Batch& tries, Mask& ready,
                        Mask& failed, long& draws) {
   constexpr double kSqrt2OverPi = 0.7978845608028654;
-  const Batch theta_n = xsimd::asin(f.x);
-  const Batch inv = Batch(1.0) / xsimd::sqrt(f.y * f.y + f.z * f.z);
+  const Batch sin_n = f.x, cos_n = xsimd::sqrt(f.y * f.y + f.z * f.z);
+  const Batch inv = Batch(1.0) / cos_n;
   const Batch pv = f.y * inv, pw = f.z * inv;
   const Batch c = xsimd::max(Batch(0.0), -d.dot(f));
   const Batch w_long(beta_long * kSqrt2OverPi), w_azim(beta_azim * kSqrt2OverPi);
@@ -239,7 +239,8 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
     const Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
     const Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
     const Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
-    const auto [st, ct] = xsimd::sincos(theta_n + dl);
+    const auto [sl, cl] = xsimd::sincos(dl);
+    const Batch st = sin_n * cl + cos_n * sl, ct = cos_n * cl - sin_n * sl;
     const auto [sa, ca] = xsimd::sincos(da);
     const Vec3B candidate{st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
     const Batch visible = -d.dot(candidate);

@@ -12,12 +12,14 @@ Vec3 smooth_normal(const Vec3& d, const BoundaryNormals& n) {
 namespace {
 
 // m for a longitudinal offset dl and an azimuthal offset da (SPEC section 3):
-// n_f = sin(theta_n) u + cos(theta_n) n_perp is tilted to inclination
-// theta_n + dl in its plane with u, then turned by da about u.
-inline Vec3 rotated_normal(double theta_n, double pv, double pw, double dl, double da) {
-  const double t = theta_n + dl;
-  const double ct = std::cos(t), ca = std::cos(da), sa = std::sin(da);
-  return Vec3(std::sin(t), ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca));
+// n_f = sin(theta_n) u + cos(theta_n) n_perp (n_perp = (pv, pw) in the normal
+// plane) is tilted to inclination theta_n + dl in its plane with u, then
+// turned by da about u. sin and cos of theta_n + dl by the angle-sum rule.
+inline Vec3 rotated_normal(double sin_n, double cos_n, double pv, double pw, double dl,
+                           double da) {
+  const double sl = std::sin(dl), cl = std::cos(dl), ca = std::cos(da), sa = std::sin(da);
+  const double st = sin_n * cl + cos_n * sl, ct = cos_n * cl - sin_n * sl;
+  return Vec3(st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca));
 }
 
 // |x| for x ~ Normal(0, sigma^2) weighted by |x|: a Rayleigh deviate.
@@ -47,8 +49,9 @@ std::optional<Vec3> gaussian_normal(const Vec3& d, const Vec3& n_facing, double 
                                     double beta_azim, PhotonRandom& rng, int max_tries,
                                     long& tries) {
   // n_f is never parallel to u: |tilt| < 45 deg.
-  const double theta_n = std::asin(n_facing.x());
-  const double inv = 1.0 / std::hypot(n_facing.y(), n_facing.z());
+  const double sin_n = n_facing.x();
+  const double cos_n = std::sqrt(n_facing.y() * n_facing.y() + n_facing.z() * n_facing.z());
+  const double inv = 1.0 / cos_n;
   const double pv = n_facing.y() * inv, pw = n_facing.z() * inv;
   const double c = std::max(0.0, -d.dot(n_facing));
   constexpr double kSqrt2OverPi = 0.7978845608028654;
@@ -78,7 +81,7 @@ std::optional<Vec3> gaussian_normal(const Vec3& d, const Vec3& n_facing, double 
       }
       bound = c + std::abs(dl) + std::abs(da);
     }
-    const Vec3 m = rotated_normal(theta_n, pv, pw, dl, da);
+    const Vec3 m = rotated_normal(sin_n, cos_n, pv, pw, dl, da);
     const double visible = -d.dot(m);
     if (visible > 0.0 && rng.uniform() * bound < visible) return m;
   }
