@@ -15,6 +15,7 @@
 
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/result_layout.h"
 #include "common/units.h"
 #include "compare/comparison.h"
 #include "compare/energy.h"
@@ -36,14 +37,6 @@ struct EnergyOptions {
   long long photons = -1;
   int threads = 0, channel = 0, n_theta = 180, n_phi = 90;
 };
-
-bool is_hdf5(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw Error(fmt::format("{}: cannot open", path));
-  char magic[8] = {};
-  f.read(magic, 8);
-  return f.gcount() == 8 && std::string(magic, 8) == std::string("\x89HDF\r\n\x1a\n", 8);
-}
 
 std::vector<double> parse_degrees(const std::string& option, const std::string& text) {
   std::vector<double> out;
@@ -120,7 +113,7 @@ std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
 
 void energy_command(const EnergyOptions& o) {
   if (o.n_theta < 1 || o.n_phi < 1) throw Error("--grid: both sizes must be >= 1");
-  const bool from_result = is_hdf5(o.input);
+  const bool from_result = is_hdf5_file(o.input);
   sim::ResultFile result;
   sim::Settings settings;
   bool simulated = false;

@@ -19,6 +19,7 @@
 #include "common/result_layout.h"
 #include "common/units.h"
 #include "compare/model_defaults.h"
+#include "sim/result_file.h"
 #include "sim/settings.h"
 
 namespace fiberlab::cli {
@@ -30,29 +31,8 @@ struct PredictOptions {
   std::vector<std::string> settings;
 };
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
-// A YAML config, or a result file's stored `config_yaml`.
-sim::Settings load_input(const std::string& path) {
-  h5::quiet_hdf5_errors();
-  if (H5Fis_hdf5(path.c_str()) > 0) {
-    const h5::File f = h5::File::open_read(path);
-    if (!f.has_attr("/", "config_yaml"))
-      throw Error(fmt::format("{}: HDF5 file without a config_yaml root attribute (not a fiberlab result)", path));
-    return sim::parse_settings_yaml(f.attr_string("/", "config_yaml"), path);
-  }
-  return sim::load_settings(path);
-}
-
 void predict(const PredictOptions& o) {
-  const sim::Settings s = load_input(o.input);
+  const sim::Settings s = sim::load_settings_or_result(o.input);
   analytic::ModelParams params = compare::model_params_from_settings(s, o.model);
   analytic::apply_settings(params, o.settings);
   const std::unique_ptr<analytic::Model> model = analytic::make_model(o.model, params);
@@ -88,10 +68,7 @@ void predict(const PredictOptions& o) {
   }
 
   h5::File f = h5::File::create(out.temp_path());
-  f.set_attr("/", "format", std::string("fiber-prediction"));
-  f.set_attr("/", "format_version", static_cast<std::int64_t>(kFormatVersion));
-  f.set_attr("/", "software_version", std::string(FIBERLAB_VERSION));
-  f.set_attr("/", "created_utc", utc_now());
+  write_file_identity(f, "fiber-prediction", utc_timestamp());
   f.set_attr("/", "config_yaml", sim::to_yaml(s));
   write_bins(f, grid);
   write_incidences(f, theta_i, phi_i);

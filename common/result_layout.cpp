@@ -1,10 +1,38 @@
 #include "common/result_layout.h"
 
+#include <fmt/core.h>
+
 #include <cmath>
+#include <ctime>
+#include <fstream>
 
 #include "common/error.h"
 
 namespace fiberlab {
+
+std::string utc_timestamp() {
+  const std::time_t t = std::time(nullptr);
+  std::tm tm{};
+  gmtime_r(&t, &tm);
+  char buf[32];
+  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
+  return buf;
+}
+
+void write_file_identity(h5::File& f, const std::string& format, const std::string& created_utc) {
+  f.set_attr("/", "format", format);
+  f.set_attr("/", "format_version", static_cast<std::int64_t>(kFormatVersion));
+  f.set_attr("/", "software_version", std::string(FIBERLAB_VERSION));
+  f.set_attr("/", "created_utc", created_utc);
+}
+
+bool is_hdf5_file(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(fmt::format("{}: cannot open", path));
+  char magic[8] = {};
+  in.read(magic, 8);
+  return in.gcount() == 8 && std::string(magic, 8) == std::string("\x89HDF\r\n\x1a\n", 8);
+}
 
 void write_bins(h5::File& f, const BinGrid& grid) {
   if (!f.exists("/bins")) f.create_group("/bins");

@@ -2,6 +2,7 @@
 // Writers and readers for the groups that every fiberlab HDF5 file shares
 // (SPEC section 9): /bins and /source. Used by the simulation's result file
 // and by `fiberlab predict`.
+#include <string>
 #include <vector>
 
 #include "common/bin_grid.h"
@@ -10,6 +11,17 @@
 namespace fiberlab {
 
 inline constexpr int kFormatVersion = 1;
+
+// The current time as ISO 8601 UTC, e.g. 2026-11-22T10:30:00Z.
+std::string utc_timestamp();
+
+// The root attributes every fiberlab file carries: format (the file type,
+// e.g. "fiber-histogram"), format_version, software_version, created_utc.
+void write_file_identity(h5::File& f, const std::string& format, const std::string& created_utc);
+
+// Whether `path` starts with the HDF5 signature. Throws fiberlab::Error when
+// it cannot be read.
+bool is_hdf5_file(const std::string& path);
 
 // /bins/theta_edges, /bins/phi_edges, /bins/solid_angle, and the attribute
 // /bins@theta_bins ("uniform" | "equal_area").

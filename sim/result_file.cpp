@@ -16,15 +16,6 @@ namespace fiberlab::sim {
 
 namespace {
 
-std::string utc_now() {
-  const std::time_t t = std::time(nullptr);
-  std::tm tm{};
-  gmtime_r(&t, &tm);
-  char buf[32];
-  std::strftime(buf, sizeof buf, "%Y-%m-%dT%H:%M:%SZ", &tm);
-  return buf;
-}
-
 template <typename T>
 void append(std::vector<T>& to, const std::vector<T>& from) {
   to.insert(to.end(), from.begin(), from.end());
@@ -54,7 +45,7 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
   r.config_yaml = to_yaml(settings);
   r.seeds = {settings.seed};
   r.software_version = FIBERLAB_VERSION;
-  r.created_utc = utc_now();
+  r.created_utc = utc_timestamp();
   r.grid = grid;
   for (const Settings::Incidence& inc : settings.incidences()) {
     r.theta_i.push_back(inc.theta_i);
@@ -78,10 +69,7 @@ void write_result(const ResultFile& r, const std::string& path) {
   AtomicOutput out(path);
   {
     h5::File f = h5::File::create(out.temp_path());
-    f.set_attr("/", "format", std::string("fiber-histogram"));
-    f.set_attr("/", "format_version", static_cast<std::int64_t>(kFormatVersion));
-    f.set_attr("/", "software_version", r.software_version);
-    f.set_attr("/", "created_utc", r.created_utc);
+    write_file_identity(f, "fiber-histogram", r.created_utc);
     f.set_attr("/", "seed", static_cast<std::int64_t>(r.seeds.front()));
     std::vector<double> seeds(r.seeds.begin(), r.seeds.end());
     f.set_attr("/", "merged_seeds", seeds);
@@ -180,9 +168,17 @@ ResultFile merge_results(const std::vector<ResultFile>& parts,
   }
   sum.settings.photons = sum.photons.front();  // every configuration has the same count
   sum.config_yaml = to_yaml(sum.settings);
-  sum.created_utc = utc_now();
+  sum.created_utc = utc_timestamp();
   sum.software_version = FIBERLAB_VERSION;
   return sum;
+}
+
+Settings load_settings_or_result(const std::string& path) {
+  if (!is_hdf5_file(path)) return load_settings(path);
+  const h5::File f = h5::File::open_read(path);
+  if (!f.has_attr("/", "config_yaml"))
+    throw Error(fmt::format("{}: HDF5 file without a config_yaml root attribute (not a fiberlab result)", path));
+  return parse_settings_yaml(f.attr_string("/", "config_yaml"), path + ":/config_yaml");
 }
 
 Estimate bin_estimate(double s1, double s2, std::uint64_t n) {

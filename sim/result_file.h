@@ -49,6 +49,10 @@ ResultFile read_result(const std::string& path);
 ResultFile merge_results(const std::vector<ResultFile>& parts,
                          const std::vector<std::string>& names);
 
+// The settings of a YAML config, or those stored in a result file's
+// config_yaml (told apart by the HDF5 signature).
+Settings load_settings_or_result(const std::string& path);
+
 // Estimators of SPEC section 6 for one lobe's total energy (all bins).
 struct Estimate {
   double mean, std_error;
