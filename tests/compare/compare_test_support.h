@@ -11,31 +11,20 @@
 #include "sim/result_file.h"
 #include "sim/settings.h"
 #include "sim/simulation.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::compare::testing {
 
-// A white or absorbing circular fiber without tilt; `model` picks roughness.
+// A white circular fiber without tilt (the simulator tests' smooth circle,
+// seed 4242); `model` picks roughness.
 inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::RoughnessModel model) {
-  sim::Settings s;
-  s.photons = photons;
+  sim::Settings s = sim::testing::smooth_circle(theta_i_deg, photons);
   s.seed = 4242;
-  s.fiber.eta = 1.55;
-  s.fiber.sigma_a = {0.0};
   s.roughness.model = model;
-  s.roughness.beta_long = {0.0};
-  s.roughness.beta_azim = {0.0};
-  s.source.theta_i = {deg_to_rad(theta_i_deg)};
-  s.source.phi_i = {0.0};
-  s.tally.n_theta = 90;
-  s.tally.n_phi = 180;
-  s.tally.lobes = 4;
   return s;
 }
 
-inline sim::ResultFile run(const sim::Settings& s, int threads = 2) {
-  sim::Simulation simulation(s);
-  return sim::make_result(s, simulation.grid(), simulation.run(threads));
-}
+using sim::testing::run;
 
 // Model params for a result (compare/model_defaults.h) plus --set overrides.
 inline analytic::ModelParams params(const sim::ResultFile& r, const std::string& model,
