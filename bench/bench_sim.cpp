@@ -3,11 +3,14 @@
 //  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
 //  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg.
 // One thread, so the rate is per core. Counters: photons/s, interface events
-// and candidate normals per photon.
+// and candidate normals per photon. `trace` is the batched SIMD tracer that
+// `fiberlab run` uses for unpolarised light (binning and tally included);
+// `trace_reference` the scalar reference tracer (tracing only).
 #include <benchmark/benchmark.h>
 
 #include "common/units.h"
 #include "sim/simulation.h"
+#include "sim/source.h"
 
 namespace {
 
@@ -55,9 +58,33 @@ void trace(benchmark::State& state, char which) {
   state.counters["normals_per_photon"] = counters.normal_draws / photons;
 }
 
+// The reference (scalar, one photon at a time) tracer on the same cases, for
+// comparison; it is the one `polarization: stokes` uses.
+void trace_reference(benchmark::State& state, char which) {
+  const Settings s = bench_case(which);
+  const Tracer tracer(s);
+  const Source source(s.seed, 0, s.source.theta_i[0], s.source.phi_i[0], false);
+  TracerCounters counters;
+  std::uint64_t photon = 0;
+  double sink = 0.0;
+  for (auto _ : state) {
+    for (int k = 0; k < 4096; ++k) {
+      LaunchedPhoton p = source.launch(photon++);
+      sink += tracer.trace(p.wi, p.h, p.rng, &counters).path_length;
+    }
+  }
+  benchmark::DoNotOptimize(sink);
+  state.counters["photons_per_s"] =
+      benchmark::Counter(static_cast<double>(photon), benchmark::Counter::kIsRate);
+}
+
 BENCHMARK_CAPTURE(trace, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+BENCHMARK_CAPTURE(trace_reference, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_CAPTURE(trace_reference, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_CAPTURE(trace_reference, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 }  // namespace
 
