@@ -338,10 +338,10 @@ void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& count
     const Vec3B refracted = (ratio * d + (ratio * cos_i - cos_t) * m).normalized();
     d = select(act, select(reflect, reflected, refracted), d);
     const Mask flip = act & !reflect;
-    const Mask now_inside = (flip & !inside) | (!flip & inside);
+    const Mask now_inside = (flip & (!inside)) | ((!flip) & inside);
     // Consistency rule, judged with the untilted normal.
     const Batch dn = d.dot(n0);
-    const Mask consistent = (now_inside & (dn < Batch(0.0))) | (!now_inside & (dn > Batch(0.0)));
+    const Mask consistent = (now_inside & (dn < Batch(0.0))) | ((!now_inside) & (dn > Batch(0.0)));
     Batch code = xsimd::select(consistent, xsimd::select(now_inside, Batch(kTravel), Batch(kExited)),
                                Batch(kAtBoundary));
     code = xsimd::select(failed, Batch(kTruncated), code);

@@ -47,7 +47,9 @@ TEST(Energy, WhiteFiberFurnace) {
     EXPECT_NEAR(sim_e.ledger[k], 1.0, 1e-12);
     EXPECT_NEAR(sim_e.total(k, 0), 1.0, 1e-12);
     EXPECT_NEAR(deon.total(k, 0), 1.0, 1e-3);
-    if (k < 2) EXPECT_NEAR(deon_pub.total(k, 0), 1.0, 1e-3);
+    if (k < 2) {
+      EXPECT_NEAR(deon_pub.total(k, 0), 1.0, 1e-3);
+    }
   }
   // Small theta_i: Marschner's theta_h Gaussian doubles the energy.
   for (std::size_t k = 0; k < 2; ++k) {
