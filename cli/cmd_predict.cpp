@@ -19,6 +19,7 @@
 #include "common/result_layout.h"
 #include "common/units.h"
 #include "compare/model_defaults.h"
+#include "compare/models.h"
 #include "sim/result_file.h"
 #include "sim/settings.h"
 
@@ -49,21 +50,8 @@ void predict(const PredictOptions& o) {
   for (std::size_t k = 0; k < inc.size(); ++k) {
     theta_i.push_back(inc[k].theta_i);
     phi_i.push_back(inc[k].phi_i);
-    std::vector<double> p;
-    if (std::isnan(inc[k].phi_i) && params.eccentricity != 1.0) {
-      // A randomly rotated elliptical fiber: average over phi_i (period pi
-      // by the ellipse's symmetry), 32 midpoints.
-      constexpr int kRot = 32;
-      p.assign(per_k, 0.0);
-      for (int r = 0; r < kRot; ++r) {
-        const std::vector<double> q = model->bin_probabilities(grid, inc[k].theta_i, (r + 0.5) * kPi / kRot);
-        for (std::size_t x = 0; x < per_k; ++x) p[x] += q[x] / kRot;
-      }
-    } else {
-      p = model->bin_probabilities(grid, inc[k].theta_i, std::isnan(inc[k].phi_i) ? 0.0 : inc[k].phi_i);
-    }
-    if (p.size() != per_k)
-      throw Error(fmt::format("model {} returned {} bin values, expected {}", o.model, p.size(), per_k));
+    const std::vector<double> p = compare::predict_bins(*model, grid, inc[k].theta_i, inc[k].phi_i, L, C,
+                                                        s.fiber.eccentricity != 1.0);
     std::copy(p.begin(), p.end(), prob.begin() + static_cast<std::ptrdiff_t>(k * per_k));
   }
 

@@ -63,11 +63,21 @@ analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
 }
 
 std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& grid, double theta_i,
-                                 double phi_i, int lobes, int channels) {
+                                 double phi_i, int lobes, int channels, bool elliptical) {
   if (model.lobes() != lobes)
     throw Error(fmt::format("model {} predicts {} lobes, the histogram has {}", model.name(),
                             model.lobes(), lobes));
-  std::vector<double> out = model.bin_probabilities(grid, theta_i, std::isnan(phi_i) ? 0.0 : phi_i);
+  std::vector<double> out;
+  if (std::isnan(phi_i) && elliptical) {
+    constexpr int kRotations = 32;
+    for (int r = 0; r < kRotations; ++r) {
+      const std::vector<double> q = model.bin_probabilities(grid, theta_i, (r + 0.5) * kPi / kRotations);
+      if (out.empty()) out.assign(q.size(), 0.0);
+      for (std::size_t x = 0; x < q.size() && x < out.size(); ++x) out[x] += q[x] / kRotations;
+    }
+  } else {
+    out = model.bin_probabilities(grid, theta_i, std::isnan(phi_i) ? 0.0 : phi_i);
+  }
   const std::size_t expect = static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
   if (out.size() != expect)
     throw Error(fmt::format("model {} gives {} channels, the histogram has {} (set sigma_a with one "
@@ -89,7 +99,8 @@ std::vector<std::vector<double>> predict_result(const analytic::Model& model,
 #pragma omp parallel for schedule(dynamic) if (parallel && K > 1)
   for (long k = 0; k < K; ++k) {
     try {
-      out[k] = predict_bins(model, r.grid, r.theta_i[k], r.phi_i[k], r.lobes, r.channels);
+      out[k] = predict_bins(model, r.grid, r.theta_i[k], r.phi_i[k], r.lobes, r.channels,
+                            r.settings.fiber.eccentricity != 1.0);
     } catch (const std::exception& e) {
 #pragma omp critical
       error = e.what();

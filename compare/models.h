@@ -39,8 +39,13 @@ analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
 // Bin probabilities of one incident configuration, [lobe][theta][phi][channel]
 // in the result's layout. The model's channels must equal `channels`, lobes
 // must equal `lobes` (both checked; fiberlab::Error otherwise).
+// phi_i NaN is a randomly rotated fiber (SPEC section 5, phi_i: uniform):
+// for an elliptical one (`elliptical`) the prediction is averaged over 32
+// midpoint rotations of phi_i in [0, pi) (the ellipse has period pi); a
+// circle does not depend on phi_i.
 std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& grid,
-                                 double theta_i, double phi_i, int lobes, int channels);
+                                 double theta_i, double phi_i, int lobes, int channels,
+                                 bool elliptical = false);
 
 }  // namespace fiberlab::compare
 
