@@ -21,7 +21,7 @@ constexpr int W = static_cast<int>(Batch::size);
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // What a lane's photon does next (kept as a double per lane).
-enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kDone = 4 };
+enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3 };
 
 UMask to_umask(const Mask& m) {
   return xsimd::bitwise_cast<UBatch>(xsimd::select(m, Batch(1.0), Batch(0.0))) != UBatch(0);
@@ -91,6 +91,32 @@ class LaneRandom {
         spare_(Batch::load_aligned(l.spare + o)),
         has_spare_(Batch::load_aligned(l.has_spare + o) != Batch(0.0)) {}
 
+  // Fresh streams: PhotonRandom(seed, config, photon) for W photons at once.
+  LaneRandom(std::uint64_t key, const UBatch& photon) : spare_(0.0), has_spare_(Batch(0.0) != Batch(0.0)) {
+    UBatch x = splitmix(UBatch(key) ^ photon);
+    s0_ = x = splitmix(x);
+    s1_ = x = splitmix(x);
+    s2_ = x = splitmix(x);
+    s3_ = splitmix(x);
+  }
+
+  // Stores lanes [o, o + n) (n <= W), at any offset.
+  void store_unaligned(BatchTracer::Lanes& l, int o, int n) const {
+    alignas(64) std::uint64_t a0[W], a1[W], a2[W], a3[W];
+    s0_.store_aligned(a0);
+    s1_.store_aligned(a1);
+    s2_.store_aligned(a2);
+    s3_.store_aligned(a3);
+    for (int i = 0; i < n; ++i) {
+      l.s0[o + i] = a0[i];
+      l.s1[o + i] = a1[i];
+      l.s2[o + i] = a2[i];
+      l.s3[o + i] = a3[i];
+      l.spare[o + i] = 0.0;
+      l.has_spare[o + i] = 0.0;
+    }
+  }
+
   void store(BatchTracer::Lanes& l, int o) const {
     s0_.store_aligned(l.s0 + o);
     s1_.store_aligned(l.s1 + o);
@@ -159,6 +185,12 @@ class LaneRandom {
 
  private:
   static UBatch rotl(const UBatch& x, int k) { return (x << k) | (x >> (64 - k)); }
+  static UBatch splitmix(UBatch z) {  // PhotonRandom::splitmix, lane by lane
+    z = z + UBatch(0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * UBatch(0xbf58476d1ce4e5b9ULL);
+    z = (z ^ (z >> 27)) * UBatch(0x94d049bb133111ebULL);
+    return z ^ (z >> 31);
+  }
   static Batch to_unit(const UBatch& x) {
     return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x >> 11)) *
            Batch(0x1.0p-53);
@@ -288,6 +320,37 @@ void BatchTracer::launch(Lanes& l, int i, const Source& source, const Eigen::Vec
   l.set_rng_state(i, p.rng.state());
 }
 
+// launch() for `n` <= W photons of a fixed incident direction d (beam
+// geometry g) into lanes [o, o + n), their streams seeded and their entry
+// points computed side by side.
+void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, std::uint64_t key,
+                               const Vec3& d, const Eigen::Vector2d& g, double phi_i) const {
+  alignas(64) std::uint64_t index[W];
+  for (int i = 0; i < W; ++i) index[i] = photon0 + static_cast<std::uint64_t>(i);
+  LaneRandom rng(key, UBatch::load_aligned(index));
+  const Batch h = Batch(2.0) * rng.uniform(Batch(0.0) == Batch(0.0)) - Batch(1.0);
+  const Batch root = xsimd::sqrt(xsimd::max(Batch(0.0), Batch(1.0) - h * h));
+  // EllipseCrossSection::entry_point_in_beam: q = h g_perp - sqrt(1 - h^2) g.
+  const Batch px = Batch(ellipse_.r_v()) * (h * Batch(-g.y()) - root * Batch(g.x()));
+  const Batch py = Batch(ellipse_.r_w()) * (h * Batch(g.x()) - root * Batch(g.y()));
+  alignas(64) double ax[W], ay[W];
+  px.store_aligned(ax);
+  py.store_aligned(ay);
+  for (int i = 0; i < n; ++i) {
+    const int lane = o + i;
+    l.px[lane] = ax[i];
+    l.py[lane] = ay[i];
+    l.dx[lane] = d.x();
+    l.dy[lane] = d.y();
+    l.dz[lane] = d.z();
+    l.inside[lane] = l.path[lane] = l.segments[lane] = l.events_here[lane] = l.tries[lane] = 0.0;
+    l.code[lane] = kAtBoundary;
+    l.phi_i[lane] = phi_i;
+    l.photon[lane] = index[i];
+  }
+  rng.store_unaligned(l, o, n);
+}
+
 // One interface event for every photon in flight (SPEC section 3): the
 // vectorised ScalarLight::interact with the normal models of Tracer.
 void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& counters) const {
@@ -351,13 +414,16 @@ void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& count
       xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), d.x))).store_aligned(l.theta_out + o);
       xsimd::atan2(d.z, d.y).store_aligned(l.phi_out + o);
     }
-    code.store_aligned(l.code + o);
     d.x.store_aligned(l.dx + o);
     d.y.store_aligned(l.dy + o);
     d.z.store_aligned(l.dz + o);
     xsimd::select(now_inside, Batch(1.0), Batch(0.0)).store_aligned(l.inside + o);
-    (Batch::load_aligned(l.events_here + o) + xsimd::select(act, Batch(1.0), Batch(0.0)))
-        .store_aligned(l.events_here + o);
+    const Batch events_here =
+        Batch::load_aligned(l.events_here + o) + xsimd::select(act, Batch(1.0), Batch(0.0));
+    events_here.store_aligned(l.events_here + o);
+    // Still undecided after max_events_per_point events at this point: truncated.
+    const Mask stuck = act & (!consistent) & (events_here >= Batch(settings_.max_events_per_point));
+    xsimd::select(stuck, Batch(kTruncated), code).store_aligned(l.code + o);
     rng.store(l, o);
     counters.events += popcount(act);
   }
@@ -369,9 +435,17 @@ void BatchTracer::travel(Lanes& l, int n_active) const {
   const Batch inv_rv2(1.0 / (ellipse_.r_v() * ellipse_.r_v()));
   const Batch inv_rw2(1.0 / (ellipse_.r_w() * ellipse_.r_w()));
   for (int o = 0; o < n_active; o += W) {
-    const Batch code = Batch::load_aligned(l.code + o);
+    Batch code = Batch::load_aligned(l.code + o);
+    // A photon that did not leave at the boundary ending its last allowed
+    // segment is truncated (SPEC section 5).
+    const Mask at_limit = (code == Batch(kTravel)) &
+                          (Batch::load_aligned(l.segments + o) >= Batch(settings_.max_segments));
+    code = xsimd::select(at_limit, Batch(kTruncated), code);
     const Mask go = code == Batch(kTravel);
-    if (!xsimd::any(go)) continue;
+    if (!xsimd::any(go)) {
+      code.store_aligned(l.code + o);
+      continue;
+    }
     const Batch px = Batch::load_aligned(l.px + o), py = Batch::load_aligned(l.py + o);
     const Batch dy = Batch::load_aligned(l.dy + o), dz = Batch::load_aligned(l.dz + o);
     const Batch a = dy * dy * inv_rv2 + dz * dz * inv_rw2;
@@ -400,8 +474,6 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
   const std::uint64_t end = first + n;
   std::uint64_t next = first;
   int n_active = 0;
-  const double max_segments = settings_.max_segments;
-  const double max_events = settings_.max_events_per_point;
   const bool blur = settings_.roughness.model == RoughnessModel::ExitBlur;
   std::vector<double> blur_v;
   for (double b : settings_.roughness.beta_long) blur_v.push_back(b * b);
@@ -425,26 +497,31 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
       }
     }
     sink(l.photon[i], l.phi_i[i], out);
-    l.code[i] = kDone;
   };
 
   const Source source(settings_.seed, config, theta_i, phi_i, settings_.source.phi_i_uniform);
-  const Eigen::Vector2d beam = ellipse_.beam_direction(-direction_from_angles(theta_i, phi_i));
+  const Vec3 d0 = -direction_from_angles(theta_i, phi_i);
+  const Eigen::Vector2d beam = ellipse_.beam_direction(d0);
+  const std::uint64_t key = PhotonRandom::stream_key(settings_.seed, config);
   while (true) {
-    while (n_active < kPoolLanes && next < end) launch(l, n_active++, source, beam, next++);
+    if (source.fixed_direction()) {
+      while (n_active < kPoolLanes && next < end) {
+        const int n = static_cast<int>(std::min<std::uint64_t>(
+            std::min(W, kPoolLanes - n_active), end - next));
+        launch_group(l, n_active, n, next, key, d0, beam, phi_i);
+        n_active += n;
+        next += n;
+      }
+    } else {
+      while (n_active < kPoolLanes && next < end) launch(l, n_active++, source, beam, next++);
+    }
     if (n_active == 0) break;
     interface_events(l, n_active, counters);
-    for (int i = 0; i < n_active; ++i) {
-      const int code = static_cast<int>(l.code[i]);
-      if (code == kExited) finish(i, PhotonFate::Exited);
-      else if (code == kTruncated) finish(i, PhotonFate::Truncated);
-      else if (code == kAtBoundary && l.events_here[i] >= max_events) finish(i, PhotonFate::Truncated);
-      else if (code == kTravel && l.segments[i] >= max_segments) finish(i, PhotonFate::Truncated);
-    }
     travel(l, n_active);
-    for (int i = 0; i < n_active;) {  // drop finished lanes: the last lane takes the slot
-      if (static_cast<int>(l.code[i]) == kTruncated) finish(i, PhotonFate::Truncated);
-      if (static_cast<int>(l.code[i]) == kDone) {
+    for (int i = 0; i < n_active;) {  // report finished photons; the last lane takes the slot
+      const int code = static_cast<int>(l.code[i]);
+      if (code == kExited || code == kTruncated) {
+        finish(i, code == kExited ? PhotonFate::Exited : PhotonFate::Truncated);
         l.move(i, --n_active);
       } else {
         ++i;

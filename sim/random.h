@@ -25,10 +25,20 @@ class PhotonRandom {
   RandomState state() const { return {{s_[0], s_[1], s_[2], s_[3]}, spare_, has_spare_}; }
 
   PhotonRandom(std::uint64_t seed, std::uint64_t config, std::uint64_t photon) {
-    std::uint64_t x = splitmix(seed ^ 0x6a09e667f3bcc909ULL);
-    x = splitmix(x ^ config);
-    x = splitmix(x ^ photon);
+    std::uint64_t x = splitmix(stream_key(seed, config) ^ photon);
     for (auto& s : s_) s = x = splitmix(x);
+  }
+
+  // What the streams of one incident configuration share; a photon's state is
+  // SplitMix64 applied to (key ^ photon), then four more times.
+  static std::uint64_t stream_key(std::uint64_t seed, std::uint64_t config) {
+    return splitmix(splitmix(seed ^ 0x6a09e667f3bcc909ULL) ^ config);
+  }
+  static std::uint64_t splitmix(std::uint64_t z) {
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
   }
 
   // Uniform in [0, 1).
@@ -50,12 +60,6 @@ class PhotonRandom {
   }
 
  private:
-  static std::uint64_t splitmix(std::uint64_t z) {
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
   static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
   std::uint64_t next() {
     const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
