@@ -28,6 +28,15 @@ inline Settings smooth_circle(double theta_i_deg, std::uint64_t photons) {
   return s;
 }
 
+// Gaussian roughness of `beta_deg` (longitudinal and azimuthal) and a cuticle
+// tilt of `tilt_deg`.
+inline void make_rough(Settings& s, double beta_deg, double tilt_deg = 0.0) {
+  s.fiber.scale_tilt = deg_to_rad(tilt_deg);
+  s.roughness.model = RoughnessModel::Gaussian;
+  s.roughness.beta_long = {deg_to_rad(beta_deg)};
+  s.roughness.beta_azim = {deg_to_rad(beta_deg)};
+}
+
 inline ResultFile run(const Settings& s, int threads = 2) {
   Simulation sim(s);
   return make_result(s, sim.grid(), sim.run(threads));

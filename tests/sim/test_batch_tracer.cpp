@@ -56,11 +56,8 @@ TEST(BatchTracer, SmoothCircleMatchesReference) {
 TEST(BatchTracer, RoughTiltedAbsorbingEllipseMatchesReference) {
   Settings s = testing::smooth_circle(17.0, 1);
   s.fiber.eccentricity = 0.8;
-  s.fiber.scale_tilt = deg_to_rad(3.0);
   s.fiber.sigma_a = {0.2, 0.4, 0.8};
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(7.5)};
-  s.roughness.beta_azim = {deg_to_rad(7.5)};
+  testing::make_rough(s, 7.5, 3.0);
   s.source.phi_i = {deg_to_rad(11.0)};
   expect_same_photons(s, "rough tilted ellipse");
   s.source.phi_i_uniform = true;
@@ -80,10 +77,7 @@ TEST(BatchTracer, ExitBlurMatchesReference) {
 
 TEST(BatchTracer, GuidedPhotonsAndSegmentLimitMatchReference) {
   Settings s = testing::smooth_circle(30.0, 1);
-  s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(5.0)};
-  s.roughness.beta_azim = {deg_to_rad(5.0)};
+  testing::make_rough(s, 5.0, 3.0);
   s.max_segments = 20;  // many photons reach the limit
   expect_same_photons(s, "max_segments 20");
 }

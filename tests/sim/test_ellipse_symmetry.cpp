@@ -38,9 +38,7 @@ Settings rough_ellipse(double phi_i_deg, std::uint64_t seed) {
   s.seed = seed;
   s.fiber.eccentricity = 0.85;
   s.fiber.sigma_a = {0.3};
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(8.0)};
-  s.roughness.beta_azim = {deg_to_rad(8.0)};
+  testing::make_rough(s, 8.0);
   s.source.phi_i = {deg_to_rad(phi_i_deg)};
   s.tally.n_theta = 30;
   s.tally.n_phi = 36;

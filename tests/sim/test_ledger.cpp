@@ -13,10 +13,7 @@ using testing::run;
 Settings rough_tilted_ellipse() {
   Settings s = testing::smooth_circle(30.0, 200000);
   s.fiber.eccentricity = 0.8;
-  s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(10.0)};
-  s.roughness.beta_azim = {deg_to_rad(10.0)};
+  testing::make_rough(s, 10.0, 3.0);
   s.source.phi_i = {deg_to_rad(17.0)};
   return s;
 }
@@ -61,10 +58,7 @@ TEST(Ledger, AbsorbingChannelsSumToLaunched) {
 // "about" as +-1e-4 (4 standard errors).
 TEST(Ledger, LightGuidedFractionAsSpecSection5) {
   Settings s = testing::smooth_circle(30.0, 1000000);
-  s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(5.0)};
-  s.roughness.beta_azim = {deg_to_rad(5.0)};
+  testing::make_rough(s, 5.0, 3.0);
   const ResultFile r = run(s);
   const double truncated = r.truncated[0] / static_cast<double>(r.photons[0]);
   std::printf("truncated fraction %.3e\n", truncated);

@@ -14,11 +14,8 @@ namespace {
 Settings rough_absorbing() {
   Settings s = testing::smooth_circle(31.0, 60000);
   s.fiber.eccentricity = 0.9;
-  s.fiber.scale_tilt = deg_to_rad(3.0);
   s.fiber.sigma_a = {0.2, 0.4, 0.8};
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(5.0)};
-  s.roughness.beta_azim = {deg_to_rad(5.0)};
+  testing::make_rough(s, 5.0, 3.0);
   s.source.theta_i = {deg_to_rad(31.0), deg_to_rad(-12.0)};
   s.source.phi_i = {deg_to_rad(11.0)};
   return s;
