@@ -33,13 +33,15 @@ Batch lane_index() {
   return Batch::load_aligned(idx);
 }
 
-int popcount(const Mask& m) {
-  alignas(64) double v[W];
-  xsimd::select(m, Batch(1.0), Batch(0.0)).store_aligned(v);
-  int n = 0;
-  for (int i = 0; i < W; ++i) n += v[i] != 0.0;
-  return n;
-}
+// Counts lanes over many masks without leaving the vector unit; total() at the end.
+class LaneCounter {
+ public:
+  void add(const Mask& m) { sum_ = sum_ + xsimd::select(m, Batch(1.0), Batch(0.0)); }
+  long total() const { return static_cast<long>(xsimd::hadd(sum_)); }
+
+ private:
+  Batch sum_ = Batch(0.0);
+};
 
 }  // namespace
 
@@ -58,6 +60,7 @@ struct BatchTracer::Lanes {
   alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
   alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
   alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
+  LaneCounter events, normal_draws;  // for TracerCounters
 
   void move(int to, int from) {
     px[to] = px[from]; py[to] = py[from];
@@ -244,7 +247,7 @@ constexpr int kRoundsPerCall = 2;
 
 Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double beta_azim,
                        const Mask& live, LaneRandom& rng, Batch& tries, Mask& ready,
-                       Mask& failed, long& draws) {
+                       Mask& failed, LaneCounter& draws) {
   constexpr double kSqrt2OverPi = 0.7978845608028654;
   const Batch sin_n = f.x, cos_n = xsimd::sqrt(f.y * f.y + f.z * f.z);
   const Batch inv = Batch(1.0) / cos_n;
@@ -258,7 +261,7 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   Mask pending = live & !failed;
   Vec3B m{Batch(0.0), Batch(0.0), Batch(0.0)};
   for (int k = 0; k < kRoundsPerCall && xsimd::any(pending); ++k) {
-    draws += popcount(pending);
+    draws.add(pending);
     tries = tries + xsimd::select(pending, Batch(1.0), Batch(0.0));
     const Batch pick = w_total * rng.uniform(pending & envelope);
     const Mask first = envelope & (pick < c);
@@ -353,7 +356,7 @@ void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, st
 
 // One interface event for every photon in flight (SPEC section 3): the
 // vectorised ScalarLight::interact with the normal models of Tracer.
-void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& counters) const {
+void BatchTracer::interface_events(Lanes& l, int n_active) const {
   const double eta = settings_.fiber.eta;
   const RoughnessModel model = settings_.roughness.model;
   const double beta_long = settings_.roughness.beta_long.front();
@@ -379,7 +382,7 @@ void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& count
     if (model == RoughnessModel::Gaussian) {
       Batch tries = Batch::load_aligned(l.tries + o);
       m = gaussian_normals(d, facing, beta_long, beta_azim, live, rng, tries, ready, failed,
-                           counters.normal_draws);
+                           l.normal_draws);
       tries.store_aligned(l.tries + o);
     } else {
       m = select(d.dot(facing) < Batch(0.0), facing, side * n0);
@@ -425,7 +428,7 @@ void BatchTracer::interface_events(Lanes& l, int n_active, TracerCounters& count
     const Mask stuck = act & (!consistent) & (events_here >= Batch(settings_.max_events_per_point));
     xsimd::select(stuck, Batch(kTruncated), code).store_aligned(l.code + o);
     rng.store(l, o);
-    counters.events += popcount(act);
+    l.events.add(act);
   }
 }
 
@@ -516,7 +519,7 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
       while (n_active < kPoolLanes && next < end) launch(l, n_active++, source, beam, next++);
     }
     if (n_active == 0) break;
-    interface_events(l, n_active, counters);
+    interface_events(l, n_active);
     travel(l, n_active);
     for (int i = 0; i < n_active;) {  // report finished photons; the last lane takes the slot
       const int code = static_cast<int>(l.code[i]);
@@ -528,6 +531,8 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
       }
     }
   }
+  counters.events += l.events.total();
+  counters.normal_draws += l.normal_draws.total();
 }
 
 }  // namespace fiberlab::sim

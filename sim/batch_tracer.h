@@ -40,7 +40,7 @@ class BatchTracer {
   void launch_group(Lanes& lanes, int first_lane, int n, std::uint64_t first_photon,
                     std::uint64_t stream_key, const Vec3& d, const Eigen::Vector2d& beam,
                     double phi_i) const;
-  void interface_events(Lanes& lanes, int n_active, TracerCounters& counters) const;
+  void interface_events(Lanes& lanes, int n_active) const;
   void travel(Lanes& lanes, int n_active) const;
 
   const Settings settings_;
