@@ -26,8 +26,7 @@ struct RunOptions {
 sim::ProgressCallback progress_printer(bool quiet) {
   if (quiet) return {};
   const auto start = std::chrono::steady_clock::now();
-  auto shown = std::make_shared<bool>(false);
-  return [start, shown](std::uint64_t done, std::uint64_t total) {
+  return [start](std::uint64_t done, std::uint64_t total) {
     const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (t < 1.0) return;
     const double rate = done / t;
@@ -35,7 +34,6 @@ sim::ProgressCallback progress_printer(bool quiet) {
     fmt::print(stderr, "\r{:>14} / {} photons  {:8.3f} M/s  ETA {:6.0f} s", done, total,
                rate * 1e-6, eta);
     if (done == total) fmt::print(stderr, "\n");
-    *shown = true;
   };
 }
 

@@ -433,7 +433,8 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
 }
 
 // One internal segment for the photons about to cross the fiber (SPEC
-// sections 2 and 4): the far root t = -B/A of the ellipse from a boundary point.
+// sections 2 and 4): the vector form of EllipseCrossSection's
+// distance_to_boundary (the far root t = -B/A) and advance.
 void BatchTracer::travel(Lanes& l, int n_active) const {
   const Batch inv_rv2(1.0 / (ellipse_.r_v() * ellipse_.r_v()));
   const Batch inv_rw2(1.0 / (ellipse_.r_w() * ellipse_.r_w()));
@@ -478,8 +479,7 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
   std::uint64_t next = first;
   int n_active = 0;
   const bool blur = settings_.roughness.model == RoughnessModel::ExitBlur;
-  std::vector<double> blur_v;
-  for (double b : settings_.roughness.beta_long) blur_v.push_back(b * b);
+  const ExitBlur exit_blur(settings_.roughness);
 
   auto finish = [&](int i, PhotonFate fate) {
     PhotonOutcome out;
@@ -492,9 +492,7 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
       out.phi = l.phi_out[i];
       if (blur) {
         PhotonRandom rng(l.rng_state(i));
-        out.direction = blur_exit_direction(
-            out.direction, RoughnessSettings::for_lobe(blur_v, out.segments),
-            RoughnessSettings::for_lobe(settings_.roughness.beta_azim, out.segments), rng);
+        out.direction = exit_blur.apply(out.direction, out.segments, rng);
         out.theta = inclination(out.direction);
         out.phi = azimuth(out.direction);
       }

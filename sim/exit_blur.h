@@ -6,8 +6,11 @@
 // offset (wrapped by the caller's relative-azimuth arithmetic).
 #include <cmath>
 
+#include <vector>
+
 #include "common/fiber_frame.h"
 #include "sim/random.h"
+#include "sim/settings.h"
 
 namespace fiberlab::sim {
 
@@ -35,5 +38,21 @@ inline Vec3 blur_exit_direction(const Vec3& d, double v, double beta_azim, Photo
   const double phi = azimuth(d) + (beta_azim > 0.0 ? beta_azim * rng.normal() : 0.0);
   return direction_from_angles(theta, phi);
 }
+
+// The exit blur of a configuration: v_p = beta_long_p^2 and beta_azim_p,
+// indexed by the lobe p (the last entry for every larger p).
+class ExitBlur {
+ public:
+  explicit ExitBlur(const RoughnessSettings& r) : beta_azim_(r.beta_azim) {
+    for (double b : r.beta_long) v_.push_back(b * b);
+  }
+  Vec3 apply(const Vec3& d, int p, PhotonRandom& rng) const {
+    return blur_exit_direction(d, RoughnessSettings::for_lobe(v_, p),
+                               RoughnessSettings::for_lobe(beta_azim_, p), rng);
+  }
+
+ private:
+  std::vector<double> v_, beta_azim_;
+};
 
 }  // namespace fiberlab::sim

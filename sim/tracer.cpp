@@ -25,11 +25,9 @@ Tracer::Tracer(const Settings& s)
       sin_tilt_(std::sin(s.fiber.scale_tilt)),
       beta_long_(s.roughness.beta_long.front()),
       beta_azim_(s.roughness.beta_azim.front()),
+      exit_blur_(s.roughness),
       max_segments_(s.max_segments),
-      max_events_(s.max_events_per_point) {
-  for (double b : s.roughness.beta_long) blur_v_.push_back(b * b);
-  blur_beta_ = s.roughness.beta_azim;
-}
+      max_events_(s.max_events_per_point) {}
 
 // Returns false when the photon must be truncated (too many events at this
 // point, or no visible normal found). On return d is the new direction and
@@ -93,9 +91,7 @@ PhotonOutcome Tracer::trace_with(const Vec3& wi, double h, PhotonRandom& rng,
     if (!inside) {  // left the fiber
       out.fate = PhotonFate::Exited;
       if (model_ == RoughnessModel::ExitBlur) {
-        const int p_lobe = out.segments;
-        d = blur_exit_direction(d, RoughnessSettings::for_lobe(blur_v_, p_lobe),
-                                RoughnessSettings::for_lobe(blur_beta_, p_lobe), rng);
+        d = exit_blur_.apply(d, out.segments, rng);
       }
       out.direction = d;
       out.theta = inclination(d);

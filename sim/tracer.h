@@ -6,6 +6,7 @@
 // and the caller turns it into a Beer-Lambert weight per channel.
 #include "common/fiber_frame.h"
 #include "sim/ellipse_cross_section.h"
+#include "sim/exit_blur.h"
 #include "sim/random.h"
 #include "sim/settings.h"
 
@@ -55,7 +56,7 @@ class Tracer {
   double eta_;
   double cos_tilt_, sin_tilt_;
   double beta_long_, beta_azim_;          // gaussian
-  std::vector<double> blur_v_, blur_beta_; // exit_blur, indexed by p
+  ExitBlur exit_blur_;
   int max_segments_, max_events_;
 };
 
