@@ -5,7 +5,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(
-  build-essential cmake pkg-config
+  build-essential cmake pkg-config ccache
   libeigen3-dev libhdf5-dev libyaml-cpp-dev libcli11-dev libfmt-dev libxsimd-dev
   googletest libgtest-dev libbenchmark-dev libboost-dev libboost-math-dev
   python3 python3-h5py python3-numpy python3-matplotlib
