@@ -6,6 +6,7 @@
 #include <cmath>
 #include <complex>
 
+#include "analytic/model_registry.h"
 #include "analytic/quadrature.h"
 #include "analytic/smooth_cylinder.h"
 #include "common/error.h"
@@ -528,6 +529,68 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
 
 std::unique_ptr<Model> make_deon2011(const ModelParams& params) {
   return std::make_unique<Deon2011>(params);
+}
+
+}  // namespace fiberlab::analytic
+
+// ---- Parameter table and registry entry -------------------------------------------
+
+namespace fiberlab::analytic {
+
+namespace {
+std::vector<std::string> deon_approximations(const ModelParams& p) {
+  std::vector<std::string> out;
+  out.push_back(p.absorption == Absorption::Published
+                    ? "absorption=published: exp(-4 sigma_a' cos^2 gamma_t) (as published; not the chord)"
+                    : "absorption=chord: the chord length (SPEC s7)");
+  if (p.r_half_angle_fresnel)
+    out.push_back("r_fresnel=half_angle: R lobe Fresnel at half the angle between wi and wr (Eq. 12), "
+                  "not per h (Eq. 14)");
+  out.push_back(p.specular_theta_d
+                    ? "n_theta_d=specular: N_p at theta_d = -theta_i (the simulator's exit_blur exactly)"
+                    : "n_theta_d=exit: N_p evaluated at each exit direction's theta_d (per bin), as published");
+  out.push_back("M_p: von Mises-Fisher longitudinal lobe (Eq. 7); tilt as a shift of theta_r (alpha)");
+  out.push_back(fmt::format("orders p > {} of the last lobe: their energy spread uniformly in phi",
+                            p.max_order));
+  return out;
+}
+}  // namespace
+
+ModelInfo deon2011_info() {
+  ModelInfo m;
+  m.name = "deon2011";
+  m.reference = "d'Eon, Francois, Hill, Letteri, Aubry 2011, An Energy-Conserving Hair Reflectance Model";
+  m.params = {
+      eta_param(),
+      sigma_a_param(),
+      beta_long_param("longitudinal width per lobe p: v_p = beta_long_p^2 in M_p (Eq. 7), ~ the sd of theta_r"),
+      beta_azim_param("azimuthal width per lobe p: sd of the Gaussian detector D_p (Eq. 11)"),
+      alpha_param("shift of theta_r per lobe p (M_p(theta_r - alpha_p))"),
+      absorption_param("published"),
+      lobes_param(),
+      integer_param("quadrature_order", "Gauss-Legendre order of the N_p integral over h (density())", "35",
+                    &ModelParams::quadrature_order, 1),
+      choice_param(
+          "r_fresnel", "Fresnel of the R lobe: Eq. 12 half angle (published) or Eq. 14 per h", "half_angle",
+          {"half_angle", "per_h"}, [](ModelParams& p, int i) { p.r_half_angle_fresnel = i == 0; },
+          [](const ModelParams& p) { return p.r_half_angle_fresnel ? 0 : 1; }),
+      integer_param("max_order", "highest order p traced explicitly in the last lobe", "40",
+                    &ModelParams::max_order, 1),
+      choice_param(
+          "n_theta_d", "theta_d of N_p: the exit direction's (published) or the specular cone's", "exit",
+          {"exit", "specular"}, [](ModelParams& p, int i) { p.specular_theta_d = i == 1; },
+          [](const ModelParams& p) { return p.specular_theta_d ? 1 : 0; }),
+  };
+  m.make = make_deon2011;
+  m.approximations = deon_approximations;
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+    if (f.eccentricity != 1.0)
+      throw Error(fmt::format("model deon2011: circular fibers only; this fiber has eccentricity {:g}",
+                              f.eccentricity));
+    apply_fiber_basics(f, p);
+    apply_fiber_roughness(f, p, WidthVariable::ThetaR);
+  };
+  return m;
 }
 
 }  // namespace fiberlab::analytic

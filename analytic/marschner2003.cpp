@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "analytic/model_registry.h"
 #include "analytic/quadrature.h"
 #include "common/error.h"
 #include "common/units.h"
@@ -507,6 +508,78 @@ thread_local std::vector<double> Marschner2003::n_;
 
 std::unique_ptr<Model> make_marschner2003(const ModelParams& params) {
   return std::make_unique<Marschner2003>(params);
+}
+
+}  // namespace fiberlab::analytic
+
+// ---- Parameter table and registry entry -------------------------------------------
+
+namespace fiberlab::analytic {
+
+namespace {
+std::vector<std::string> marschner_approximations(const ModelParams& p) {
+  std::vector<std::string> out;
+  out.push_back(p.absorption == Absorption::Published
+                    ? "absorption=published: exp(-4 sigma_a' cos^2 gamma_t) (s4.3; not the chord)"
+                    : "absorption=chord: the chord length (SPEC s7)");
+  out.push_back(p.two_theta_h
+                    ? "longitudinal=two_theta_h: M a Gaussian in 2 theta_h (Zinke & Weber; energy-correct)"
+                    : "longitudinal=theta_h: M a Gaussian in theta_h as published: about twice the energy "
+                      "for small beta (d'Eon 2011 s4.1)");
+  out.push_back(p.exact_roots ? "roots=exact: Phi(p, h) of Eq. 3 solved exactly"
+                              : "roots=cubic: h from the cubic of Eq. 10 (< 0.75 deg error in phi)");
+  if (p.w_c > 0.0)
+    out.push_back(fmt::format(
+        "TRT caustics replaced by glints (s5.2.2): w_c={:g} deg, k_g={:g}, delta_eta={:g}, delta_h_m={:g}",
+        rad_to_deg(p.w_c), p.k_g, p.delta_eta, p.delta_h_m));
+  else
+    out.push_back("caustic smoothing off (w_c=0): N_TRT is the exact Eq. 8 sum over roots");
+  if (p.eccentricity != 1.0)
+    out.push_back(fmt::format("eccentricity {:g}: eta*(phi_h) in N_TRT only (s5.2.3)", p.eccentricity));
+  out.push_back("lobes p >= 3 are not modelled (zero)");
+  return out;
+}
+}  // namespace
+
+ModelInfo marschner2003_info() {
+  ModelInfo m;
+  m.name = "marschner2003";
+  m.reference = "Marschner, Jensen, Cammarano, Worley, Hanrahan 2003, Light Scattering from Human Hair Fibers";
+  const auto nonneg = [](double x) { return x >= 0.0; };
+  m.params = {
+      eta_param(),
+      sigma_a_param(),
+      beta_long_param("sd of the Gaussian M_p per lobe p, in theta_h (published) or 2 theta_h; > 0"),
+      alpha_param("shift of theta_r per lobe p (Marschner's alpha_p, a shift of theta_h, is half)"),
+      absorption_param("published"),
+      lobes_param(),
+      eccentricity_param("a number in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; }),
+      choice_param(
+          "longitudinal", "variable of the Gaussian M: theta_h (published) or 2 theta_h (Zinke & Weber)",
+          "theta_h", {"theta_h", "two_theta_h"}, [](ModelParams& p, int i) { p.two_theta_h = i == 1; },
+          [](const ModelParams& p) { return p.two_theta_h ? 1 : 0; }),
+      choice_param(
+          "roots", "roots of Phi(p, h) = phi: the cubic of Eq. 10 (published) or Eq. 3 exactly", "cubic",
+          {"cubic", "exact"}, [](ModelParams& p, int i) { p.exact_roots = i == 1; },
+          [](const ModelParams& p) { return p.exact_roots ? 1 : 0; }),
+      number_param("k_g", "glint scale factor k_G (Table 1: 0.5 to 5)", "", "0.5", "a number >= 0",
+                   &ModelParams::k_g, nonneg),
+      number_param("w_c", "azimuthal width of the caustic (Table 1: 10 to 25 deg); 0 = no caustic smoothing",
+                   "deg", "10", "degrees >= 0", &ModelParams::w_c, nonneg),
+      number_param("delta_eta", "fade range of eta' past the caustic merge (Table 1: 0.2 to 0.4)", "", "0.3",
+                   "a number >= 0", &ModelParams::delta_eta, nonneg),
+      number_param("delta_h_m", "caustic intensity limit Delta h_M (Table 1: 0.5)", "", "0.5",
+                   "a number >= 0", &ModelParams::delta_h_m, nonneg),
+  };
+  m.make = make_marschner2003;
+  m.approximations = marschner_approximations;
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+    apply_fiber_basics(f, p);
+    p.eccentricity = f.eccentricity;
+    apply_fiber_roughness(f, p, p.two_theta_h ? WidthVariable::ThetaR : WidthVariable::ThetaH,
+                          kMinMarschnerBeta);
+  };
+  return m;
 }
 
 }  // namespace fiberlab::analytic

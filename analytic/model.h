@@ -17,9 +17,13 @@ namespace fiberlab::analytic {
 
 enum class Absorption { Published, Chord };
 
-// Every model parameter, settable by name with `--set KEY=VALUE`. Lists are
-// indexed by lobe p, the last entry applying to every larger p. Angles in
-// radians here (degrees on the command line).
+// The values of the models' parameters. Each model reads the fields its
+// parameter table names (model_params.h, model_registry.h): only those are
+// settable with `--set KEY=VALUE` for that model, and only those are written
+// to its predictions. The defaults here are neutral values for code that
+// builds a model directly (tests); a model's defaults on the command line are
+// its table's. Lists are indexed by lobe p, the last entry applying to every
+// larger p. Angles in radians here (degrees on the command line).
 struct ModelParams {
   double eta = 1.55;
   std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel

@@ -1,13 +1,10 @@
 #include "analytic/model_params.h"
 
 #include <fmt/core.h>
-#include <fmt/ranges.h>
 
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
-#include <functional>
-#include <map>
 
 #include "common/error.h"
 #include "common/units.h"
@@ -15,10 +12,6 @@
 namespace fiberlab::analytic {
 
 namespace {
-
-const char* kKeys =
-    "eta, sigma_a, beta_long, beta_azim, alpha, absorption, longitudinal, roots, eccentricity, "
-    "k_g, w_c, delta_eta, delta_h_m, lobes, quadrature_order, r_fresnel, max_order, n_theta_d";
 
 std::string trim(const std::string& s) {
   const auto b = s.find_first_not_of(" \t");
@@ -40,124 +33,205 @@ bool parse_double(const std::string& text, double& out) {
   throw Error(fmt::format("--set {}={}: invalid value; allowed: {}", key, value, allowed));
 }
 
-double number(const std::string& key, const std::string& value, const std::string& allowed,
-              const std::function<bool(double)>& ok) {
-  double x;
-  if (!parse_double(value, x) || !ok(x)) fail(key, value, allowed);
-  return x;
-}
+// Degrees on the command line, radians inside.
+double to_internal(const std::string& unit) { return unit == "deg" ? deg_to_rad(1.0) : 1.0; }
 
-std::vector<double> list(const std::string& key, const std::string& value,
-                         const std::string& allowed, const std::function<bool(double)>& ok,
-                         double scale) {
-  std::vector<double> out;
-  std::size_t start = 0;
-  while (true) {
-    const auto comma = value.find(',', start);
-    const std::string item = value.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
-    double x;
-    if (!parse_double(item, x) || !ok(x)) fail(key, value, allowed);
-    out.push_back(x * scale);
-    if (comma == std::string::npos) break;
-    start = comma + 1;
-  }
-  return out;
-}
+std::string number_text(double x) { return fmt::format("{:g}", x); }
 
-int integer(const std::string& key, const std::string& value, const std::string& allowed) {
-  double x;
-  if (!parse_double(value, x) || x != std::floor(x) || x < 1 || x > 1e6) fail(key, value, allowed);
-  return static_cast<int>(x);
+std::string list_text(const std::vector<double>& v, double scale) {
+  std::string s;
+  for (double x : v) s += (s.empty() ? "" : ",") + number_text(x / scale);
+  return s;
 }
 
 }  // namespace
 
-void apply_setting(ModelParams& p, const std::string& key_value) {
+ParamSpec number_param(std::string key, std::string meaning, std::string unit,
+                       std::string default_value, std::string allowed, double ModelParams::*field,
+                       std::function<bool(double)> ok) {
+  const double scale = to_internal(unit);
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}};
+  s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
+    double x;
+    if (!parse_double(value, x) || !ok(x)) fail(key, value, allowed);
+    p.*field = x * scale;
+  };
+  s.show = [field, scale](const ModelParams& p) { return number_text(p.*field / scale); };
+  s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", {p.*field}}; };
+  return s;
+}
+
+ParamSpec list_param(std::string key, std::string meaning, std::string unit,
+                     std::string default_value, std::string allowed,
+                     std::vector<double> ModelParams::*field, std::function<bool(double)> ok) {
+  const double scale = to_internal(unit);
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}};
+  s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
+    std::vector<double> out;
+    std::size_t start = 0;
+    while (true) {
+      const auto comma = value.find(',', start);
+      const std::string item =
+          value.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+      double x;
+      if (!parse_double(item, x) || !ok(x)) fail(key, value, allowed);
+      out.push_back(x * scale);
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    p.*field = out;
+  };
+  s.show = [field, scale](const ModelParams& p) { return list_text(p.*field, scale); };
+  s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", p.*field}; };
+  return s;
+}
+
+ParamSpec integer_param(std::string key, std::string meaning, std::string default_value,
+                        int ModelParams::*field, int min_value) {
+  const std::string allowed = fmt::format("an integer >= {}", min_value);
+  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}};
+  s.set = [key, allowed, field, min_value](ModelParams& p, const std::string& value) {
+    double x;
+    if (!parse_double(value, x) || x != std::floor(x) || x < min_value || x > 1e6)
+      fail(key, value, allowed);
+    p.*field = static_cast<int>(x);
+  };
+  s.show = [field](const ModelParams& p) { return std::to_string(p.*field); };
+  s.attribute = [key, field](const ModelParams& p) {
+    return ParamAttribute{key, false, "", {static_cast<double>(p.*field)}};
+  };
+  return s;
+}
+
+ParamSpec choice_param(std::string key, std::string meaning, std::string default_value,
+                       std::vector<std::string> choices, std::function<void(ModelParams&, int)> set,
+                       std::function<int(const ModelParams&)> get) {
+  std::string allowed;
+  for (const auto& c : choices) allowed += (allowed.empty() ? "" : " | ") + c;
+  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}};
+  s.set = [key, allowed, choices, set](ModelParams& p, const std::string& value) {
+    const std::string v = trim(value);
+    for (std::size_t i = 0; i < choices.size(); ++i)
+      if (v == choices[i]) return set(p, static_cast<int>(i));
+    fail(key, value, allowed);
+  };
+  s.show = [choices, get](const ModelParams& p) { return choices.at(get(p)); };
+  s.attribute = [key, choices, get](const ModelParams& p) {
+    return ParamAttribute{key, true, choices.at(get(p)), {}};
+  };
+  return s;
+}
+
+// ---- Shared parameters ----------------------------------------------------------
+
+ParamSpec eta_param() {
+  ParamSpec s = number_param("eta", "refractive index of the fiber relative to the medium", "", "1.55",
+                             "a number > 1", &ModelParams::eta, [](double x) { return x > 1.0; });
+  s.from_fiber = "fiber.eta";
+  return s;
+}
+
+ParamSpec sigma_a_param() {
+  ParamSpec s = list_param("sigma_a", "absorption coefficient per channel", "1/R", "0,0,0",
+                           "a comma list of numbers >= 0, one per channel", &ModelParams::sigma_a,
+                           [](double x) { return x >= 0.0; });
+  s.from_fiber = "fiber.sigma_a (or melanin)";
+  return s;
+}
+
+ParamSpec lobes_param() {
+  ParamSpec s = integer_param("lobes", "tally lobes: 0..L-2 one order p each, L-1 every larger p", "4",
+                              &ModelParams::lobes, 1);
+  s.from_fiber = "tally.lobes";
+  return s;
+}
+
+ParamSpec beta_long_param(std::string meaning) {
+  ParamSpec s = list_param("beta_long", std::move(meaning), "deg", "0",
+                           "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_long,
+                           [](double x) { return x >= 0.0; });
+  s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
+  return s;
+}
+
+ParamSpec beta_azim_param(std::string meaning) {
+  ParamSpec s = list_param("beta_azim", std::move(meaning), "deg", "0",
+                           "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_azim,
+                           [](double x) { return x >= 0.0; });
+  s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
+  return s;
+}
+
+ParamSpec alpha_param(std::string meaning) {
+  ParamSpec s = list_param("alpha", std::move(meaning), "deg", "0",
+                           "a comma list of degrees, indexed by lobe p", &ModelParams::alpha,
+                           [](double) { return true; });
+  s.from_fiber = "fiber.scale_tilt (SPEC s7: R -2a, TT +a, TRT +4a, p >= 3: 0)";
+  return s;
+}
+
+ParamSpec eccentricity_param(std::string allowed, std::function<bool(double)> ok) {
+  ParamSpec s = number_param("eccentricity", "minor/major axis ratio of the cross-section", "", "1",
+                             std::move(allowed), &ModelParams::eccentricity, std::move(ok));
+  s.from_fiber = "fiber.eccentricity";
+  return s;
+}
+
+ParamSpec absorption_param(std::string default_value) {
+  return choice_param(
+      "absorption",
+      "segment attenuation: chord = exp(-sigma_a' 2 cos gamma_t) (SPEC s7, exact); published = "
+      "exp(-4 sigma_a' cos^2 gamma_t) (Marschner 2003 s4.3, d'Eon 2011)",
+      std::move(default_value), {"published", "chord"},
+      [](ModelParams& p, int i) { p.absorption = i == 1 ? Absorption::Chord : Absorption::Published; },
+      [](const ModelParams& p) { return p.absorption == Absorption::Chord ? 1 : 0; });
+}
+
+// ---- Tables -------------------------------------------------------------------------
+
+const ParamSpec* find_param(const ParamTable& table, const std::string& key) {
+  for (const ParamSpec& s : table)
+    if (s.key == key) return &s;
+  return nullptr;
+}
+
+std::string key_list(const ParamTable& table) {
+  std::string s;
+  for (const ParamSpec& p : table) s += (s.empty() ? "" : ", ") + p.key;
+  return s;
+}
+
+void apply_setting(const std::string& model_name, const ParamTable& table, ModelParams& params,
+                   const std::string& key_value) {
   const auto eq = key_value.find('=');
   if (eq == std::string::npos)
-    throw Error(fmt::format("--set {}: expected KEY=VALUE; allowed keys: {}", key_value, kKeys));
+    throw Error(fmt::format("--set {}: expected KEY=VALUE; allowed keys of {}: {}", key_value, model_name,
+                            key_list(table)));
   const std::string key = trim(key_value.substr(0, eq)), value = trim(key_value.substr(eq + 1));
-  const double deg = deg_to_rad(1.0);
-  auto nonneg = [](double x) { return x >= 0.0; };
-  auto any = [](double) { return true; };
-  if (key == "eta") {
-    p.eta = number(key, value, "a number > 1", [](double x) { return x > 1.0; });
-  } else if (key == "sigma_a") {
-    p.sigma_a = list(key, value, "a comma list of numbers >= 0 (1/R per channel)", nonneg, 1.0);
-  } else if (key == "beta_long") {
-    p.beta_long = list(key, value, "a comma list of degrees >= 0, indexed by p", nonneg, deg);
-  } else if (key == "beta_azim") {
-    p.beta_azim = list(key, value, "a comma list of degrees >= 0, indexed by p", nonneg, deg);
-  } else if (key == "alpha") {
-    p.alpha = list(key, value, "a comma list of degrees, indexed by p", any, deg);
-  } else if (key == "absorption") {
-    if (value == "published") p.absorption = Absorption::Published;
-    else if (value == "chord") p.absorption = Absorption::Chord;
-    else fail(key, value, "published | chord");
-  } else if (key == "longitudinal") {
-    if (value == "theta_h") p.two_theta_h = false;
-    else if (value == "two_theta_h") p.two_theta_h = true;
-    else fail(key, value, "theta_h | two_theta_h");
-  } else if (key == "roots") {
-    if (value == "cubic") p.exact_roots = false;
-    else if (value == "exact") p.exact_roots = true;
-    else fail(key, value, "cubic | exact");
-  } else if (key == "eccentricity") {
-    p.eccentricity = number(key, value, "a number in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; });
-  } else if (key == "k_g") {
-    p.k_g = number(key, value, "a number >= 0", nonneg);
-  } else if (key == "w_c") {
-    p.w_c = number(key, value, "degrees >= 0", nonneg) * deg;
-  } else if (key == "delta_eta") {
-    p.delta_eta = number(key, value, "a number >= 0 (unitless)", nonneg);
-  } else if (key == "delta_h_m") {
-    p.delta_h_m = number(key, value, "a number >= 0 (unitless, in h)", nonneg);
-  } else if (key == "lobes") {
-    p.lobes = integer(key, value, "an integer >= 1");
-  } else if (key == "quadrature_order") {
-    p.quadrature_order = integer(key, value, "an integer >= 1");
-  } else if (key == "n_theta_d") {
-    if (value == "exit") p.specular_theta_d = false;
-    else if (value == "specular") p.specular_theta_d = true;
-    else fail(key, value, "exit | specular");
-  } else if (key == "max_order") {
-    p.max_order = integer(key, value, "an integer >= 1");
-  } else if (key == "r_fresnel") {
-    if (value == "half_angle") p.r_half_angle_fresnel = true;
-    else if (value == "per_h") p.r_half_angle_fresnel = false;
-    else fail(key, value, "half_angle | per_h");
-  } else {
-    throw Error(fmt::format("--set {}: unknown key; allowed: {}", key, kKeys));
-  }
+  const ParamSpec* spec = find_param(table, key);
+  if (!spec)
+    throw Error(fmt::format("--set {}: model {} has no parameter '{}'; allowed keys: {}", key_value,
+                            model_name, key, key_list(table)));
+  spec->set(params, value);
 }
 
-void apply_settings(ModelParams& params, const std::vector<std::string>& key_values) {
-  for (const auto& kv : key_values) apply_setting(params, kv);
+ModelParams table_defaults(const ParamTable& table) {
+  ModelParams p;
+  for (const ParamSpec& s : table) s.set(p, s.default_value);
+  return p;
 }
 
-std::vector<ParamAttribute> to_attributes(const ModelParams& p) {
-  auto num = [](std::string n, std::vector<double> v) { return ParamAttribute{std::move(n), false, "", std::move(v)}; };
-  auto txt = [](std::string n, std::string t) { return ParamAttribute{std::move(n), true, std::move(t), {}}; };
-  return {
-      num("eta", {p.eta}),
-      num("sigma_a", p.sigma_a),
-      num("beta_long", p.beta_long),
-      num("beta_azim", p.beta_azim),
-      num("alpha", p.alpha),
-      txt("absorption", p.absorption == Absorption::Chord ? "chord" : "published"),
-      txt("longitudinal", p.two_theta_h ? "two_theta_h" : "theta_h"),
-      txt("roots", p.exact_roots ? "exact" : "cubic"),
-      num("eccentricity", {p.eccentricity}),
-      num("k_g", {p.k_g}),
-      num("w_c", {p.w_c}),
-      num("delta_eta", {p.delta_eta}),
-      num("delta_h_m", {p.delta_h_m}),
-      num("lobes", {static_cast<double>(p.lobes)}),
-      num("quadrature_order", {static_cast<double>(p.quadrature_order)}),
-      txt("r_fresnel", p.r_half_angle_fresnel ? "half_angle" : "per_h"),
-      num("max_order", {static_cast<double>(p.max_order)}),
-      txt("n_theta_d", p.specular_theta_d ? "specular" : "exit"),
-  };
+std::string describe(const ParamTable& table, const ModelParams& params) {
+  std::string s;
+  for (const ParamSpec& spec : table)
+    s += fmt::format("{}{}={}", s.empty() ? "" : " ", spec.key, spec.show(params));
+  return s;
+}
+
+std::vector<ParamAttribute> to_attributes(const ParamTable& table, const ModelParams& params) {
+  std::vector<ParamAttribute> out;
+  for (const ParamSpec& spec : table) out.push_back(spec.attribute(params));
+  return out;
 }
 
 }  // namespace fiberlab::analytic

@@ -1,6 +1,15 @@
 #pragma once
-// ModelParams from the command line (`--set KEY=VALUE`, angles in degrees)
-// and back out as a list of attributes for result files (angles in radians).
+// Each model owns its parameters: a ParamTable per model (name, meaning,
+// unit, default, allowed range) from which `--set KEY=VALUE` parsing and
+// checking, the defaults, `fiberlab models` / `--help`, the README section
+// and the attributes of a prediction file all come. The tables themselves
+// live with their models (exact_params() in smooth_cylinder.cpp, ...) and are
+// listed in model_registry.cpp.
+//
+// The values are held in ModelParams (model.h), a plain bag of fields that
+// the model code reads; a table says which of those fields its model uses.
+// A key that is not in the model's table is refused.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -8,37 +17,77 @@
 
 namespace fiberlab::analytic {
 
-// Keys (lists are comma separated, indexed by lobe p, the last entry for
-// every larger p):
-//   eta              > 1
-//   sigma_a          list, >= 0, 1/R per channel
-//   beta_long        list, degrees, >= 0
-//   beta_azim        list, degrees, >= 0
-//   alpha            list, degrees (shift of theta_r per p)
-//   absorption       published | chord
-//   longitudinal     theta_h | two_theta_h          (marschner2003)
-//   roots            cubic | exact                   (marschner2003)
-//   eccentricity     (0, 1]
-//   k_g              >= 0                            (marschner2003)
-//   w_c              degrees, >= 0                   (marschner2003)
-//   delta_eta        >= 0, unitless                  (marschner2003)
-//   delta_h_m        >= 0, unitless (in h, Marschner's Delta h_M = 0.5)
-//   lobes            integer >= 1
-//   quadrature_order integer >= 1                    (deon2011)
-//   r_fresnel        half_angle | per_h              (deon2011)
-//   max_order        integer >= 1, default 40        (deon2011: last explicit p)
-//   n_theta_d        exit | specular                 (deon2011: theta_d of N_p)
-// Throws fiberlab::Error, one line naming the key and the allowed values.
-void apply_setting(ModelParams& params, const std::string& key_value);
-void apply_settings(ModelParams& params, const std::vector<std::string>& key_values);
-
-// Every parameter by its --set name, as a string or as numbers (radians).
+// A parameter as written to a file: text, or numbers (angles in radians).
 struct ParamAttribute {
   std::string name;
   bool is_text = false;
   std::string text;
   std::vector<double> numbers;
 };
-std::vector<ParamAttribute> to_attributes(const ModelParams& params);
+
+struct ParamSpec {
+  std::string key;            // the --set name
+  std::string meaning;        // one line
+  std::string unit;           // "deg", "1/R", "" (unitless), "integer", "choice"
+  std::string default_value;  // as on the command line; what the model uses unless told
+  std::string allowed;        // the allowed values, for errors and listings
+  // Where a simulation's config sets it (empty: only the table's default).
+  std::string from_fiber;
+  // Parse `value` (command-line units: degrees for angles) into params.
+  // Throws fiberlab::Error "--set KEY=VALUE: invalid value; allowed: ...".
+  std::function<void(ModelParams&, const std::string& value)> set;
+  // The current value, in command-line units (degrees), as text.
+  std::function<std::string(const ModelParams&)> show;
+  // The current value for files (radians).
+  std::function<ParamAttribute(const ModelParams&)> attribute;
+};
+
+using ParamTable = std::vector<ParamSpec>;
+
+// Builders for the usual kinds of parameter; `field` is the ModelParams
+// member the key sets. Angles (unit "deg") are degrees on the command line,
+// radians in ModelParams and in files.
+ParamSpec number_param(std::string key, std::string meaning, std::string unit,
+                       std::string default_value, std::string allowed, double ModelParams::*field,
+                       std::function<bool(double)> ok);
+// A comma list indexed by lobe p (or channel), the last entry for every larger p.
+ParamSpec list_param(std::string key, std::string meaning, std::string unit,
+                     std::string default_value, std::string allowed,
+                     std::vector<double> ModelParams::*field, std::function<bool(double)> ok);
+ParamSpec integer_param(std::string key, std::string meaning, std::string default_value,
+                        int ModelParams::*field, int min_value);
+// One of `choices`; `set(params, i)` stores choice i, `get(params)` returns it.
+ParamSpec choice_param(std::string key, std::string meaning, std::string default_value,
+                       std::vector<std::string> choices,
+                       std::function<void(ModelParams&, int)> set,
+                       std::function<int(const ModelParams&)> get);
+
+// Parameters shared by several models (one definition each).
+ParamSpec eta_param();
+ParamSpec sigma_a_param();
+ParamSpec lobes_param();
+ParamSpec beta_long_param(std::string meaning);
+ParamSpec beta_azim_param(std::string meaning);
+ParamSpec alpha_param(std::string meaning);
+ParamSpec eccentricity_param(std::string allowed, std::function<bool(double)> ok);
+ParamSpec absorption_param(std::string default_value);
+
+// The spec of `key` in `table`, or nullptr.
+const ParamSpec* find_param(const ParamTable& table, const std::string& key);
+
+// Applies "KEY=VALUE" for the model `model_name` with table `table`. A key
+// not in the table: fiberlab::Error naming the key, the model and its keys.
+void apply_setting(const std::string& model_name, const ParamTable& table, ModelParams& params,
+                   const std::string& key_value);
+
+// The table's defaults applied to a ModelParams.
+ModelParams table_defaults(const ParamTable& table);
+
+// "key=value key=value ..." of every parameter in the table (command-line units).
+std::string describe(const ParamTable& table, const ModelParams& params);
+// Every parameter of the table, for files.
+std::vector<ParamAttribute> to_attributes(const ParamTable& table, const ModelParams& params);
+// The keys of a table, comma separated.
+std::string key_list(const ParamTable& table);
 
 }  // namespace fiberlab::analytic

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analytic/model_registry.h"
 #include "analytic/quadrature.h"
 #include "common/error.h"
 #include "common/fresnel.h"
@@ -315,6 +316,42 @@ std::vector<double> SmoothCylinder::bin_probabilities(const BinGrid& grid, doubl
 
 std::unique_ptr<Model> make_smooth_cylinder(const ModelParams& params) {
   return std::make_unique<SmoothCylinder>(params);
+}
+
+}  // namespace fiberlab::analytic
+
+// ---- Parameter table and registry entry -------------------------------------------
+
+namespace fiberlab::analytic {
+
+namespace {
+std::vector<std::string> exact_approximations(const ModelParams& p) {
+  std::vector<std::string> out{
+      "smooth circular fiber, no tilt: light only on the specular cone theta_r = -theta_i"};
+  if (p.absorption == Absorption::Published)
+    out.push_back("absorption=published: exp(-4 sigma_a' cos^2 gamma_t), not the chord 2 cos gamma_t "
+                  "(the exact model is then not exact)");
+  else
+    out.push_back("absorption=chord: the exact chord length (SPEC s7)");
+  return out;
+}
+}  // namespace
+
+ModelInfo exact_info() {
+  ModelInfo m;
+  m.name = "exact";
+  m.reference = "the exact smooth circular cylinder (SPEC s7): every order p, 3D Fresnel, chord absorption";
+  m.params = {eta_param(), sigma_a_param(), absorption_param("chord"), lobes_param()};
+  m.make = make_smooth_cylinder;
+  m.approximations = exact_approximations;
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+    if (f.eccentricity != 1.0)
+      throw Error(fmt::format("model exact: circular fibers only; this fiber has eccentricity {:g}",
+                              f.eccentricity));
+    apply_fiber_basics(f, p);
+    p.alpha = {0.0};  // no tilt in this model
+  };
+  return m;
 }
 
 }  // namespace fiberlab::analytic

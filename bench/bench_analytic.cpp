@@ -5,7 +5,7 @@
 
 #include <memory>
 
-#include "analytic/model_factory.h"
+#include "analytic/model_registry.h"
 #include "common/bin_grid.h"
 #include "common/units.h"
 

@@ -16,6 +16,10 @@
 #include "compare/comparison.h"
 #include "compare/fit.h"
 #include "compare/models.h"
+#include "compare/prediction_file.h"
+#include "compare/verdict.h"
+#include "compare/verdict_tables.h"
+#include "analytic/model_registry.h"
 #include "compare/report.h"
 #include "sim/result_file.h"
 
@@ -24,131 +28,12 @@ namespace fiberlab::cli {
 namespace {
 
 struct CompareOptions {
-  std::string result, model, fit, report;
+  std::string result, model, prediction, fit, report;
   std::vector<std::string> settings;
-  // <= 0: per lobe, 1 + 5 sqrt(2 / dof) (five standard deviations of
-  // chi2/dof above its mean for a correct model, SPEC s10).
-  double max_chi2 = 0.0;
+  double max_chi2 = 0.0;  // <= 0: the five-sigma rule of compare/verdict.h
   double min_effective = 30.0, model_error = 1e-4, min_energy = 1e-4;
   int channel = 0;
 };
-
-double threshold(const CompareOptions& o, int dof) {
-  return o.max_chi2 > 0.0 ? o.max_chi2 : 1.0 + 5.0 * std::sqrt(2.0 / std::max(dof, 1));
-}
-
-std::string degrees_list(const std::vector<double>& v) {
-  std::string s;
-  for (double x : v) s += fmt::format("{}{:g}", s.empty() ? "" : ",", rad_to_deg(x));
-  return s;
-}
-
-std::string describe(const analytic::ModelParams& p) {
-  std::string sa;
-  for (double x : p.sigma_a) sa += fmt::format("{}{:g}", sa.empty() ? "" : ",", x);
-  return fmt::format("eta={:g} sigma_a={} beta_long={} beta_azim={} alpha={} absorption={} lobes={}",
-                     p.eta, sa, degrees_list(p.beta_long), degrees_list(p.beta_azim),
-                     degrees_list(p.alpha),
-                     p.absorption == analytic::Absorption::Chord ? "chord" : "published", p.lobes);
-}
-
-std::string params_json(const analytic::ModelParams& p) {
-  auto list = [](const std::vector<double>& v, double scale) {
-    std::string s;
-    for (double x : v) s += fmt::format("{}{}", s.empty() ? "" : ", ", compare::json_number(x * scale));
-    return "[" + s + "]";
-  };
-  const double d = 180.0 / kPi;
-  return fmt::format(
-      "{{\"eta\": {}, \"sigma_a\": {}, \"beta_long_deg\": {}, \"beta_azim_deg\": {}, \"alpha_deg\": {}, "
-      "\"absorption\": \"{}\", \"lobes\": {}}}",
-      compare::json_number(p.eta), list(p.sigma_a, 1.0), list(p.beta_long, d), list(p.beta_azim, d),
-      list(p.alpha, d), p.absorption == analytic::Absorption::Chord ? "chord" : "published", p.lobes);
-}
-
-struct Judged {
-  std::vector<compare::LobeComparison> rows;
-  std::vector<bool> accepted;
-  bool all = true;
-  int judged = 0;
-};
-
-Judged judge(std::vector<compare::LobeComparison> rows, const CompareOptions& o) {
-  Judged j;
-  j.rows = std::move(rows);
-  for (const auto& r : j.rows) {
-    const bool ok = !r.judged || r.bins.per_dof() <= threshold(o, r.bins.dof);
-    j.accepted.push_back(ok);
-    if (r.judged) ++j.judged;
-    j.all = j.all && ok;
-  }
-  return j;
-}
-
-void print_table(const Judged& j, int lobes) {
-  fmt::print("{:>7} {:>5} {:>2} {:>21} {:>10} {:>7} {:>10} {:>5} {:>8} {:>8} {:>6} {:>8} {:>8} {:>8}  {}\n",
-             "theta_i", "lobe", "c", "E_sim +- se", "E_model", "z", "chi2/dof", "dof", "theta", "phi",
-             "L1", "cen_sim", "cen_mod", "shift", "verdict");
-  for (std::size_t i = 0; i < j.rows.size(); ++i) {
-    const auto& r = j.rows[i];
-    fmt::print("{:7.2f} {:>5} {:>2} {:>21} {:10.6f} {:7.1f} {:10.3f} {:5d} {:8.3f} {:8.3f} {:6.3f} {:8.3f} {:8.3f} {:8.3f}  {}\n",
-               rad_to_deg(r.theta_i), compare::lobe_name(r.lobe, lobes), r.channel,
-               fmt::format("{:.6f} +- {:.6f}", r.sim_energy, r.sim_error), r.model_energy, r.energy_z,
-               r.bins.per_dof(), r.bins.dof, r.theta_marginal.per_dof(), r.phi_marginal.per_dof(), r.l1,
-               rad_to_deg(r.centroid_sim), rad_to_deg(r.centroid_model), rad_to_deg(r.measured_shift),
-               !r.judged ? "not judged" : (j.accepted[i] ? "ok" : "REJECTED"));
-  }
-}
-
-std::string metrics_csv(const Judged& j, int lobes, const CompareOptions& o) {
-  std::string s =
-      "theta_i_deg,phi_i_deg,lobe,lobe_name,channel,sim_energy,sim_error,model_energy,energy_z,chi2,dof,"
-      "chi2_per_dof,compared_bins,rest_sim,rest_model,theta_chi2_per_dof,theta_dof,phi_chi2_per_dof,"
-      "phi_dof,l1,peak_sim_deg,peak_model_deg,centroid_sim_deg,centroid_sim_error_deg,"
-      "centroid_model_deg,alpha_model_deg,measured_shift_deg,judged,threshold,accepted\n";
-  for (std::size_t i = 0; i < j.rows.size(); ++i) {
-    const auto& r = j.rows[i];
-    s += fmt::format("{:.6g},{:.6g},{},{},{},{:.9g},{:.3g},{:.9g},{:.4g},{:.6g},{},{:.6g},{},{:.6g},{:.6g},"
-                     "{:.6g},{},{:.6g},{},{:.6g},{:.6g},{:.6g},{:.6g},{:.4g},{:.6g},{:.6g},{:.6g},{},{:.4g},{}\n",
-                     rad_to_deg(r.theta_i), rad_to_deg(r.phi_i), r.lobe, compare::lobe_name(r.lobe, lobes),
-                     r.channel, r.sim_energy, r.sim_error, r.model_energy, r.energy_z, r.bins.chi2,
-                     r.bins.dof, r.bins.per_dof(), r.compared_bins, r.rest_sim, r.rest_model,
-                     r.theta_marginal.per_dof(), r.theta_marginal.dof, r.phi_marginal.per_dof(),
-                     r.phi_marginal.dof, r.l1, rad_to_deg(r.peak_sim), rad_to_deg(r.peak_model),
-                     rad_to_deg(r.centroid_sim), rad_to_deg(r.centroid_sim_error),
-                     rad_to_deg(r.centroid_model), rad_to_deg(r.alpha_model),
-                     rad_to_deg(r.measured_shift), r.judged ? 1 : 0, threshold(o, r.bins.dof),
-                     j.accepted[i] ? 1 : 0);
-  }
-  return s;
-}
-
-std::string rows_json(const Judged& j, int lobes, const CompareOptions& o) {
-  using compare::json_number;
-  std::string s = "[";
-  for (std::size_t i = 0; i < j.rows.size(); ++i) {
-    const auto& r = j.rows[i];
-    s += fmt::format(
-        "{}\n    {{\"theta_i_deg\": {}, \"phi_i_deg\": {}, \"k\": {}, \"lobe\": {}, \"lobe_name\": \"{}\", "
-        "\"channel\": {}, \"sim_energy\": {}, \"sim_error\": {}, \"model_energy\": {}, \"energy_z\": {}, "
-        "\"chi2\": {}, \"dof\": {}, \"chi2_per_dof\": {}, \"theta_marginal_chi2_per_dof\": {}, "
-        "\"theta_marginal_dof\": {}, \"phi_marginal_chi2_per_dof\": {}, \"phi_marginal_dof\": {}, "
-        "\"l1\": {}, \"peak_sim_deg\": {}, \"peak_model_deg\": {}, \"centroid_sim_deg\": {}, "
-        "\"centroid_sim_error_deg\": {}, \"centroid_model_deg\": {}, \"alpha_model_deg\": {}, "
-        "\"measured_shift_deg\": {}, \"judged\": {}, \"threshold\": {}, \"accepted\": {}}}",
-        i ? "," : "", json_number(rad_to_deg(r.theta_i)), json_number(rad_to_deg(r.phi_i)), r.k, r.lobe,
-        compare::lobe_name(r.lobe, lobes), r.channel, json_number(r.sim_energy), json_number(r.sim_error),
-        json_number(r.model_energy), json_number(r.energy_z), json_number(r.bins.chi2), r.bins.dof,
-        json_number(r.bins.per_dof()), json_number(r.theta_marginal.per_dof()), r.theta_marginal.dof,
-        json_number(r.phi_marginal.per_dof()), r.phi_marginal.dof, json_number(r.l1),
-        json_number(rad_to_deg(r.peak_sim)), json_number(rad_to_deg(r.peak_model)),
-        json_number(rad_to_deg(r.centroid_sim)), json_number(rad_to_deg(r.centroid_sim_error)),
-        json_number(rad_to_deg(r.centroid_model)), json_number(rad_to_deg(r.alpha_model)),
-        json_number(rad_to_deg(r.measured_shift)), r.judged ? "true" : "false",
-        json_number(threshold(o, r.bins.dof)), j.accepted[i] ? "true" : "false");
-  }
-  return s + "\n  ]";
-}
 
 std::vector<std::string> split_commas(const std::string& s) {
   std::vector<std::string> out;
@@ -159,28 +44,69 @@ std::vector<std::string> split_commas(const std::string& s) {
   return out;
 }
 
+// The model's bins (or the prediction file's), their label and the lines
+// that describe them.
+struct Predicted {
+  std::string label, header;
+  std::vector<std::vector<double>> bins;
+  std::vector<double> alpha;  // the model's theta_r shifts (empty for a file)
+};
+
+Predicted predicted_by_model(const sim::ResultFile& result, const compare::ModelSpec& spec,
+                             const analytic::ModelParams& params) {
+  Predicted p;
+  p.label = spec.label;
+  p.header = compare::model_header(spec, params);
+  p.bins = compare::predict_result(*compare::make_model(spec.name, params), result);
+  p.alpha = params.alpha;
+  return p;
+}
+
+Predicted predicted_by_file(const sim::ResultFile& result, const CompareOptions& o) {
+  const compare::PredictionFile file = compare::read_prediction(o.prediction);
+  Predicted p;
+  p.label = fmt::format("{} (model {})", o.prediction, file.model.empty() ? "not named" : file.model);
+  p.header = "prediction " + p.label + "\n";
+  if (!file.approximations.empty()) {
+    p.header += "  approximations in effect (from the file):\n";
+    for (const auto& a : file.approximations) p.header += "  - " + a + "\n";
+  }
+  p.bins = compare::prediction_bins_for(file, result, o.result);
+  return p;
+}
+
 void compare_command(const CompareOptions& o) {
   if (o.max_chi2 < 0.0) throw Error(fmt::format("--max-chi2 = {} must be > 0", o.max_chi2));
   if (!(o.min_effective > 0.0)) throw Error("--min-effective must be > 0");
+  const bool from_file = !o.prediction.empty();
+  if (from_file == !o.model.empty())
+    throw Error("compare: give either --model NAME or --prediction PRED.h5 (exactly one)");
+  if (from_file && (!o.settings.empty() || !o.fit.empty()))
+    throw Error("compare --prediction: --set and --fit need a --model (a file's parameters cannot be changed)");
   const sim::ResultFile result = sim::read_result(o.result);
   if (o.channel < 0 || o.channel >= result.channels)
     throw Error(fmt::format("--channel {} out of range (the result has {} channels)", o.channel, result.channels));
-  const compare::ModelSpec spec = compare::parse_model_spec(o.model);
-  analytic::ModelParams params = compare::params_for(result.settings, spec, o.settings);
+  compare::ModelSpec spec;
+  analytic::ModelParams params;
+  if (!from_file) {
+    spec = compare::parse_model_spec(o.model);
+    params = compare::params_for(result.settings, spec, o.settings);
+    analytic::make_model(spec.name, params);  // the model's own checks, before any output
+  }
   compare::Options copt;
   copt.min_effective = o.min_effective;
   copt.model_rel_error = o.model_error;
   copt.min_lobe_energy = o.min_energy;
+  const Predicted pred = from_file ? predicted_by_file(result, o) : Predicted{};
   if (!o.report.empty()) compare::make_report_dir(o.report);
 
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print("{}: {} incident direction(s), {} lobes, {} channel(s), {} x {} bins\n", o.result,
              result.configs(), result.lobes, result.channels, result.grid.n_theta(), result.grid.n_phi());
-  fmt::print("model {}: {}\n", spec.label, describe(params));
-  auto model = compare::make_model(spec.name, params);
-  auto bins = compare::predict_result(*model, result);
-  Judged j = judge(compare::compare(result, bins, params.alpha, copt), o);
-  print_table(j, result.lobes);
+  Predicted current = from_file ? pred : predicted_by_model(result, spec, params);
+  fmt::print("{}", current.header);
+  compare::Verdict v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), o.max_chi2);
+  fmt::print("{}", compare::verdict_table(v, result.lobes));
 
   std::string fit_json = "null", fit_md;
   if (!o.fit.empty()) {
@@ -211,46 +137,32 @@ void compare_command(const CompareOptions& o) {
         fr.converged ? "true" : "false");
     // The verdict and the report use the fitted model.
     params = fr.params;
-    model = compare::make_model(spec.name, params);
-    bins = compare::predict_result(*model, result);
-    j = judge(compare::compare(result, bins, params.alpha, copt), o);
-    fmt::print("\nafter the fit: {}\n", describe(params));
-    print_table(j, result.lobes);
+    current = predicted_by_model(result, spec, params);
+    v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), o.max_chi2);
+    fmt::print("\nafter the fit: {}", current.header);
+    fmt::print("{}", compare::verdict_table(v, result.lobes));
   }
 
-  int rejected = 0;
-  for (std::size_t i = 0; i < j.rows.size(); ++i) rejected += j.rows[i].judged && !j.accepted[i];
-  const std::string limit = o.max_chi2 > 0 ? fmt::format("chi2/dof <= {:g}", o.max_chi2)
-                                           : std::string("chi2/dof <= 1 + 5 sqrt(2/dof)");
-  fmt::print("\n{} of {} judged lobes accepted ({}); {:.1f} s\n", j.judged - rejected, j.judged, limit,
+  fmt::print("\n{} of {} judged lobes accepted ({}); {:.1f} s\n", v.judged - v.rejected, v.judged, v.criterion,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
   if (!o.report.empty()) {
-    compare::write_text(o.report, "metrics.csv", metrics_csv(j, result.lobes, o));
+    compare::write_text(o.report, "metrics.csv", compare::verdict_csv(v, result.lobes));
+    const std::string params_json = from_file ? "null" : compare::params_json(spec.name, params);
     const std::string json = fmt::format(
         "{{\n  \"kind\": \"compare\",\n  \"result\": {},\n  \"model\": {},\n  \"params\": {},\n  \"criterion\": {},\n"
         "  \"accepted\": {},\n  \"fit\": {},\n  \"lobes\": {}\n}}\n",
-        compare::json_string(o.result), compare::json_string(spec.label), params_json(params),
-        compare::json_string(limit), j.all ? "true" : "false", fit_json, rows_json(j, result.lobes, o));
+        compare::json_string(o.result), compare::json_string(current.label), params_json,
+        compare::json_string(v.criterion), v.all_accepted ? "true" : "false", fit_json,
+        compare::verdict_json_rows(v, result.lobes));
     compare::write_text(o.report, "metrics.json", json);
-    compare::write_compare_data(o.report, result, bins, spec.label, o.channel);
+    compare::write_compare_data(o.report, result, current.bins, current.label, o.channel);
     const compare::PlotOutcome plots = compare::make_plots("compare", o.report);
-    std::string md = fmt::format("# {} against {}\n\nModel parameters: `{}`\n\nCriterion per lobe: {}. "
+    std::string md = fmt::format("# {} against {}\n\n```\n{}```\n\nCriterion per lobe: {}. "
                                  "Verdict: **{}** ({} of {} judged lobes accepted).\n\n",
-                                 o.result, spec.label, describe(params), limit,
-                                 j.all ? "accepted" : "rejected", j.judged - rejected, j.judged);
-    md += "| theta_i | lobe | channel | E_sim +- se | E_model | chi2/dof (dof) | theta marg. | phi marg. | L1 | "
-          "centroid sim / model (deg) | shift (deg) | verdict |\n|---|---|---|---|---|---|---|---|---|---|---|---|\n";
-    for (std::size_t i = 0; i < j.rows.size(); ++i) {
-      const auto& r = j.rows[i];
-      md += fmt::format("| {:.2f} | {} | {} | {:.5f} +- {:.5f} | {:.5f} | {:.3f} ({}) | {:.3f} | {:.3f} | {:.3f} | "
-                        "{:.2f} / {:.2f} | {:.2f} | {} |\n",
-                        rad_to_deg(r.theta_i), compare::lobe_name(r.lobe, result.lobes), r.channel,
-                        r.sim_energy, r.sim_error, r.model_energy, r.bins.per_dof(), r.bins.dof,
-                        r.theta_marginal.per_dof(), r.phi_marginal.per_dof(), r.l1,
-                        rad_to_deg(r.centroid_sim), rad_to_deg(r.centroid_model), rad_to_deg(r.measured_shift),
-                        !r.judged ? "not judged" : (j.accepted[i] ? "ok" : "rejected"));
-    }
+                                 o.result, current.label, current.header, v.criterion,
+                                 v.all_accepted ? "accepted" : "rejected", v.judged - v.rejected, v.judged);
+    md += compare::verdict_markdown(v, result.lobes);
     md += "\n" + fit_md;
     md += "\n## Plots\n\n";
     if (!plots.ran) md += plots.message + "\n\n";
@@ -259,7 +171,7 @@ void compare_command(const CompareOptions& o) {
     compare::write_text(o.report, "report.md", md);
     fmt::print("report: {}/report.md{}\n", o.report, plots.ran ? "" : " (" + plots.message + ")");
   }
-  exit_code = j.all ? 0 : 1;
+  exit_code = v.all_accepted ? 0 : 1;
 }
 
 }  // namespace
@@ -270,9 +182,11 @@ void add_compare_command(CLI::App& app) {
       "compare", "Validate a model against a result's histograms (exit 0 accepted, 1 rejected, 2 bad input)");
   cmd->add_option("result", o->result, "Result file (.h5)")->required();
   cmd->add_option("--model", o->model,
-                  "exact | deon2011 | marschner2003, optionally NAME:KEY=VALUE:... (per-model --set)")
-      ->required();
-  cmd->add_option("--set", o->settings, "Model parameter KEY=VALUE (angles in degrees); repeatable");
+                  "exact | deon2011 | marschner2003, optionally NAME:KEY=VALUE:... (per-model --set)");
+  cmd->add_option("--prediction", o->prediction,
+                  "Judge a prediction file instead of a built-in model (format: README, \"Prediction files\")");
+  cmd->add_option("--set", o->settings,
+                  "Model parameter KEY=VALUE (angles in degrees; repeatable; `fiberlab models` lists the keys)");
   cmd->add_option("--fit", o->fit,
                   "Comma-separated parameters to fit: eta, sigma_a, beta_long, beta_azim, alpha, scale_tilt, "
                   "or NAME[p] for one lobe's entry");

@@ -1,4 +1,4 @@
-// `fiberlab info RESULT.h5`: what a result file holds.
+// `fiberlab info RESULT.h5`: what a result (or prediction) file holds.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -7,6 +7,7 @@
 #include "cli/commands.h"
 #include "cli/summary_table.h"
 #include "common/units.h"
+#include "compare/prediction_file.h"
 #include "sim/result_file.h"
 
 namespace fiberlab::cli {
@@ -20,6 +21,10 @@ std::string degrees(const std::vector<double>& radians) {
 }
 
 void info(const std::string& path) {
+  if (compare::is_prediction_file(path)) {  // issue 7: info reads predictions too
+    fmt::print("{}", compare::describe_prediction(compare::read_prediction(path)));
+    return;
+  }
   const sim::ResultFile r = sim::read_result(path);
   const sim::Settings& s = r.settings;
   fmt::print("{}: fiberlab result (software {}, created {})\n", path, r.software_version, r.created_utc);

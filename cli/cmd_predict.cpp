@@ -10,15 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "analytic/model_factory.h"
-#include "analytic/model_params.h"
+#include "analytic/model_registry.h"
 #include "cli/commands.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 #include "common/units.h"
-#include "compare/model_defaults.h"
 #include "compare/models.h"
 #include "sim/result_file.h"
 #include "sim/settings.h"
@@ -34,9 +32,10 @@ struct PredictOptions {
 
 void predict(const PredictOptions& o) {
   const sim::Settings s = sim::load_settings_or_result(o.input);
-  analytic::ModelParams params = compare::model_params_from_settings(s, o.model);
-  analytic::apply_settings(params, o.settings);
-  const std::unique_ptr<analytic::Model> model = analytic::make_model(o.model, params);
+  const compare::ModelSpec spec = compare::parse_model_spec(o.model);
+  const analytic::ModelParams params = compare::params_for(s, spec, o.settings);
+  const std::unique_ptr<analytic::Model> model = analytic::make_model(spec.name, params);
+  fmt::print("{}", compare::model_header(spec, params));
 
   const BinGrid grid = BinGrid::make(s.tally.n_theta, s.tally.n_phi, s.tally.theta_bins);
   const std::vector<sim::Settings::Incidence> inc = s.incidences();
@@ -65,8 +64,12 @@ void predict(const PredictOptions& o) {
           {static_cast<hsize_t>(inc.size()), static_cast<hsize_t>(L), static_cast<hsize_t>(nt),
            static_cast<hsize_t>(np), static_cast<hsize_t>(C)},
           prob);
-  f.set_attr("/prediction", "model", o.model);
-  for (const analytic::ParamAttribute& a : analytic::to_attributes(params)) {
+  f.set_attr("/prediction", "model", spec.name);
+  std::string approx;
+  for (const std::string& a : analytic::approximations(spec.name, params)) approx += a + "\n";
+  f.set_attr("/prediction", "approximations", approx);
+  // Only this model's parameters (its table), angles in radians.
+  for (const analytic::ParamAttribute& a : analytic::param_attributes(spec.name, params)) {
     if (a.is_text) f.set_attr("/prediction", a.name, a.text);
     else if (a.numbers.size() == 1) f.set_attr("/prediction", a.name, a.numbers[0]);
     else f.set_attr("/prediction", a.name, a.numbers);
@@ -82,9 +85,12 @@ void add_predict_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "predict", "Bin probabilities of an analytic model for a config or a result's config");
   cmd->add_option("input", o->input, "Config (.yaml) or result (.h5)")->required();
-  cmd->add_option("--model", o->model, "exact | deon2011 | marschner2003")->required();
+  cmd->add_option("--model", o->model,
+                  "exact | deon2011 | marschner2003 (optionally NAME:KEY=VALUE:...); keys: `fiberlab models`")
+      ->required();
   cmd->add_option("--set", o->settings,
-                  "KEY=VALUE model parameter override (repeatable; angles in degrees)");
+                  "KEY=VALUE parameter of the model (repeatable; angles in degrees; `fiberlab models` lists "
+                  "each model's keys)");
   cmd->add_option("-o,--output", o->output, "Prediction file (.h5)")->required();
   cmd->callback([o] { predict(*o); });
 }

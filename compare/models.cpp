@@ -6,11 +6,10 @@
 #include <cstdlib>
 #include <sstream>
 
-#include "analytic/model_factory.h"
-#include "analytic/model_params.h"
+#include "analytic/model_registry.h"
 #include "common/error.h"
 #include "common/units.h"
-#include "compare/model_defaults.h"
+#include "compare/report.h"
 
 namespace fiberlab::compare {
 
@@ -33,15 +32,26 @@ std::vector<std::string> split(const std::string& s, char sep) {
 
 }  // namespace
 
-// Both forward to analytic/ (model_factory.h, model_params.h), which own
-// the model names and the --set keys.
 std::unique_ptr<analytic::Model> make_model(const std::string& name,
                                             const analytic::ModelParams& params) {
   return analytic::make_model(name, params);
 }
 
-void apply_setting(analytic::ModelParams& p, const std::string& key_value) {
-  analytic::apply_setting(p, key_value);
+analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
+  analytic::PhysicalFiber f;
+  f.eta = s.fiber.eta;
+  f.eccentricity = s.fiber.eccentricity;
+  f.scale_tilt = s.fiber.scale_tilt;
+  f.sigma_a = s.fiber.sigma_a;
+  f.lobes = s.tally.lobes;
+  switch (s.roughness.model) {
+    case sim::RoughnessModel::Smooth: f.roughness = analytic::PhysicalFiber::Roughness::Smooth; break;
+    case sim::RoughnessModel::Gaussian: f.roughness = analytic::PhysicalFiber::Roughness::Gaussian; break;
+    case sim::RoughnessModel::ExitBlur: f.roughness = analytic::PhysicalFiber::Roughness::ExitBlur; break;
+  }
+  f.beta_long = s.roughness.beta_long;
+  f.beta_azim = s.roughness.beta_azim;
+  return f;
 }
 
 ModelSpec parse_model_spec(const std::string& spec) {
@@ -54,11 +64,32 @@ ModelSpec parse_model_spec(const std::string& spec) {
   return m;
 }
 
+std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params) {
+  std::string s = fmt::format("model {}: {}\n", spec.label, analytic::describe_params(spec.name, params));
+  s += "  approximations in effect:\n";
+  for (const std::string& a : analytic::approximations(spec.name, params)) s += "  - " + a + "\n";
+  return s;
+}
+
+std::string params_json(const std::string& model_name, const analytic::ModelParams& params) {
+  std::string s;
+  for (const analytic::ParamSpec& spec : analytic::model_info(model_name).params)
+    s += fmt::format("{}{}: {{\"value\": {}, \"unit\": {}}}", s.empty() ? "" : ", ", json_string(spec.key),
+                     json_string(spec.show(params)), json_string(spec.unit));
+  return "{" + s + "}";
+}
+
 analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
                                  const std::vector<std::string>& settings) {
-  analytic::ModelParams p = model_params_from_settings(s, spec.name);
-  for (const std::string& kv : settings) compare::apply_setting(p, kv);
-  for (const std::string& kv : spec.settings) compare::apply_setting(p, kv);
+  const analytic::ModelInfo& info = analytic::model_info(spec.name);
+  auto overrides = [&](analytic::ModelParams& p) {
+    analytic::apply_settings(spec.name, p, settings);
+    analytic::apply_settings(spec.name, p, spec.settings);
+  };
+  analytic::ModelParams p = analytic::default_params(spec.name);
+  overrides(p);
+  info.from_fiber(physical_fiber(s), p);
+  overrides(p);
   return p;
 }
 

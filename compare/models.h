@@ -1,25 +1,26 @@
 #pragma once
-// The comparison tools' view of the analytic models: build a Model by name
-// from ModelParams, and apply `--set KEY=VALUE` overrides. This is an adapter
-// over analytic/ (model_factory.h and model_params.h, which own the names and
-// the keys); compare/ only forwards, so every tool accepts the same names and
-// keys as `fiberlab predict`.
+// The comparison tools' view of the analytic models: a model's parameters
+// for a simulation (the model's own physical defaults, analytic/
+// model_registry.h, then --set overrides) and its bin probabilities in a
+// result's layout. analytic/ owns the names, the keys and the rules;
+// compare/ only forwards, so every tool accepts the same names and keys as
+// `fiberlab predict`.
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/physical_defaults.h"
 #include "sim/result_file.h"
 
 namespace fiberlab::compare {
 
-// "exact" | "deon2011" | "marschner2003". Throws fiberlab::Error otherwise.
+// A registered model by name (analytic::make_model). Throws fiberlab::Error otherwise.
 std::unique_ptr<analytic::Model> make_model(const std::string& name,
                                             const analytic::ModelParams& params);
 
-// Applies one "KEY=VALUE" (angles in degrees, lists comma-separated), as
-// `fiberlab predict --set` does. Throws fiberlab::Error naming the key.
-void apply_setting(analytic::ModelParams& params, const std::string& key_value);
+// The simulator's settings as the models see a fiber (a copy, no physics).
+analytic::PhysicalFiber physical_fiber(const sim::Settings& s);
 
 // A model specification as given on the command line: "NAME" or
 // "NAME:KEY=VALUE:KEY=VALUE" (the overrides apply to this model only, e.g.
@@ -31,8 +32,18 @@ struct ModelSpec {
 };
 ModelSpec parse_model_spec(const std::string& spec);
 
-// Model parameters for a simulation's settings (compare/model_defaults.h),
-// then `settings` (global --set), then the spec's own overrides.
+// The lines `predict` and `compare` print about a model before their
+// results: its parameters and the published approximations in effect.
+std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params);
+// The model's parameters as a JSON object {"key": {"value": "...", "unit": "..."}}
+// (command-line units: degrees for angles).
+std::string params_json(const std::string& model_name, const analytic::ModelParams& params);
+
+// Model parameters for a simulation's settings: the model's table defaults,
+// its physical defaults for the fiber (ModelInfo::from_fiber), then
+// `settings` (global --set), then the spec's own overrides. The overrides are
+// also applied before the physical defaults, so that a choice such as
+// longitudinal=two_theta_h decides how the roughness maps to beta.
 analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
                                  const std::vector<std::string>& settings);
 

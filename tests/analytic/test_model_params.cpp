@@ -4,9 +4,9 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
-#include "analytic/model_factory.h"
-#include "analytic/model_params.h"
+#include "analytic/model_registry.h"
 #include "common/error.h"
 #include "common/h5_file.h"
 #include "common/units.h"
@@ -14,34 +14,47 @@
 using namespace fiberlab;
 using namespace fiberlab::analytic;
 
-TEST(ModelParams, ParsesEveryKey) {
-  ModelParams p;
-  apply_settings(p, {"eta=1.6", "sigma_a=0.1,0.2,0.3,0.4", "beta_long=5,10", "beta_azim=7",
-                     "alpha=-6,3,12", "absorption=chord", "longitudinal=two_theta_h", "roots=exact",
-                     "eccentricity=0.85", "k_g=0.4", "w_c=10", "delta_eta=0.2", "delta_h_m=0.5",
-                     "lobes=5", "quadrature_order=50", "r_fresnel=per_h", "max_order=30", "n_theta_d=specular"});
-  EXPECT_EQ(p.eta, 1.6);
-  EXPECT_EQ(p.sigma_a.size(), 4u);
+// Every key of every model's table parses a good value, and its default.
+TEST(ModelParams, EveryTableKeyParses) {
+  const std::map<std::string, std::string> good{
+      {"eta", "1.6"}, {"sigma_a", "0.1,0.2,0.3,0.4"}, {"beta_long", "5,10"}, {"beta_azim", "7"},
+      {"alpha", "-6,3,12"}, {"absorption", "chord"}, {"longitudinal", "two_theta_h"}, {"roots", "exact"},
+      {"eccentricity", "0.85"}, {"k_g", "0.4"}, {"w_c", "10"}, {"delta_eta", "0.2"}, {"delta_h_m", "0.5"},
+      {"lobes", "5"}, {"quadrature_order", "50"}, {"r_fresnel", "per_h"}, {"max_order", "30"},
+      {"n_theta_d", "specular"}};
+  for (const ModelInfo& m : registered_models()) {
+    ModelParams p = default_params(m.name);
+    for (const ParamSpec& spec : m.params) {
+      ASSERT_TRUE(good.count(spec.key)) << m.name << " " << spec.key;
+      apply_setting(m.name, p, spec.key + "=" + good.at(spec.key));
+      EXPECT_EQ(spec.show(p), good.at(spec.key)) << m.name << " " << spec.key;
+    }
+    EXPECT_EQ(param_attributes(m.name, p).size(), m.params.size());
+  }
+  ModelParams p = default_params("deon2011");
+  apply_setting("deon2011", p, "beta_long=5,10");
   EXPECT_NEAR(p.beta_long[1], deg_to_rad(10.0), 1e-15);
-  EXPECT_NEAR(p.alpha[0], deg_to_rad(-6.0), 1e-15);
-  EXPECT_EQ(p.absorption, Absorption::Chord);
-  EXPECT_TRUE(p.two_theta_h && p.exact_roots);
-  EXPECT_NEAR(p.w_c, deg_to_rad(10.0), 1e-15);
-  EXPECT_EQ(p.delta_h_m, 0.5);
-  EXPECT_EQ(p.lobes, 5);
-  EXPECT_EQ(p.quadrature_order, 50);
-  EXPECT_FALSE(p.r_half_angle_fresnel);
-  EXPECT_EQ(p.max_order, 30);
-  EXPECT_TRUE(p.specular_theta_d);
-  EXPECT_EQ(to_attributes(p).size(), 18u);
+}
+
+// The defaults that matter: the exact model is exact (chord absorption);
+// Marschner's caustic parameters are Table 1's.
+TEST(ModelParams, DefaultsAreTheModelsOwn) {
+  EXPECT_EQ(default_params("exact").absorption, Absorption::Chord);
+  EXPECT_EQ(default_params("deon2011").absorption, Absorption::Published);
+  const ModelParams m = default_params("marschner2003");
+  EXPECT_EQ(m.absorption, Absorption::Published);
+  EXPECT_NEAR(m.w_c, deg_to_rad(10.0), 1e-15);
+  EXPECT_EQ(m.k_g, 0.5);
+  EXPECT_EQ(m.delta_eta, 0.3);
+  EXPECT_EQ(m.delta_h_m, 0.5);
 }
 
 TEST(ModelParams, BadInputNamesTheKeyAndTheAllowedValues) {
-  ModelParams p;
   for (const char* bad : {"eta=1", "eta=abc", "sigma_a=0.1,,0.2", "beta_long=-1", "absorption=foo",
-                          "lobes=0", "lobes=2.5", "eccentricity=1.5", "nokey", "colour=red"}) {
+                          "lobes=0", "lobes=2.5", "nokey", "colour=red"}) {
+    ModelParams p = default_params("deon2011");
     try {
-      apply_setting(p, bad);
+      apply_setting("deon2011", p, bad);
       ADD_FAILURE() << bad;
     } catch (const Error& e) {
       const std::string msg = e.what();
@@ -51,11 +64,28 @@ TEST(ModelParams, BadInputNamesTheKeyAndTheAllowedValues) {
       EXPECT_EQ(msg.find('\n'), std::string::npos);
     }
   }
+  ModelParams p;
   EXPECT_THROW(make_model("phong", p), Error);
   ModelParams q;
   q.beta_long = {deg_to_rad(5.0)};
   q.beta_azim = {deg_to_rad(5.0)};
   for (const auto& n : model_names()) EXPECT_EQ(make_model(n, q)->lobes(), 4);
+}
+
+// A key the model does not use is refused, naming the key and listing the
+// model's own keys.
+TEST(ModelParams, KeyOfAnotherModelIsRefused) {
+  ModelParams p = default_params("exact");
+  try {
+    apply_setting("exact", p, "k_g=5");
+    ADD_FAILURE();
+  } catch (const Error& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("k_g"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("eta, sigma_a, absorption, lobes"), std::string::npos) << msg;
+  }
+  EXPECT_THROW(apply_setting("deon2011", p, "w_c=10"), Error);
+  EXPECT_THROW(apply_setting("marschner2003", p, "beta_azim=10"), Error);
 }
 
 TEST(Predict, WritesAPredictionFileOrNothing) {
@@ -72,6 +102,10 @@ TEST(Predict, WritesAPredictionFileOrNothing) {
     const h5::File f = h5::File::open_read(out);
     EXPECT_EQ(f.attr_string("/", "format"), "fiber-prediction");
     EXPECT_EQ(f.attr_string("/prediction", "model"), "exact");
+    // Only the exact model's parameters, with chord absorption by default.
+    EXPECT_EQ(f.attr_string("/prediction", "absorption"), "chord");
+    for (const char* other : {"k_g", "w_c", "roots", "longitudinal", "quadrature_order", "beta_long", "alpha"})
+      EXPECT_FALSE(f.has_attr("/prediction", other)) << other;
     h5::Dims dims;
     const auto p = f.read_doubles("/prediction/probability", &dims);
     ASSERT_EQ(dims.size(), 5u);
@@ -82,6 +116,9 @@ TEST(Predict, WritesAPredictionFileOrNothing) {
   const std::string bad = (dir / "bad.h5").string();
   fs::remove(bad);
   rc = std::system((bin + " predict " + cfg + " --model deon2011 --set beta_long=x -o " + bad + " 2>/dev/null").c_str());
+  EXPECT_EQ(WEXITSTATUS(rc), 2);
+  EXPECT_FALSE(fs::exists(bad));
+  rc = std::system((bin + " predict " + cfg + " --model exact --set k_g=5 -o " + bad + " 2>/dev/null").c_str());
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_FALSE(fs::exists(bad));
   rc = std::system((bin + " predict " + cfg + " --model nosuch -o " + bad + " 2>/dev/null").c_str());

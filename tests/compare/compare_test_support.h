@@ -26,7 +26,7 @@ inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::Roug
 
 using sim::testing::run;
 
-// Model params for a result (compare/model_defaults.h) plus --set overrides.
+// Model params for a result (analytic/physical_defaults.h, via compare::params_for) plus --set overrides.
 inline analytic::ModelParams params(const sim::ResultFile& r, const std::string& model,
                                     const std::vector<std::string>& settings = {}) {
   return params_for(r.settings, parse_model_spec(model), settings);

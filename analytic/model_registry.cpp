@@ -1,0 +1,93 @@
+#include "analytic/model_registry.h"
+
+#include <fmt/core.h>
+#include <fmt/ranges.h>
+
+#include "common/error.h"
+
+namespace fiberlab::analytic {
+
+// Each model's entry, defined beside the model.
+ModelInfo exact_info();          // smooth_cylinder.cpp
+ModelInfo deon2011_info();       // deon2011.cpp
+ModelInfo marschner2003_info();  // marschner2003.cpp
+
+const std::vector<ModelInfo>& registered_models() {
+  // To add a model: declare its info function above and list it here.
+  static const std::vector<ModelInfo> models{exact_info(), deon2011_info(), marschner2003_info()};
+  return models;
+}
+
+std::vector<std::string> model_names() {
+  std::vector<std::string> names;
+  for (const ModelInfo& m : registered_models()) names.push_back(m.name);
+  return names;
+}
+
+const ModelInfo& model_info(const std::string& name) {
+  for (const ModelInfo& m : registered_models())
+    if (m.name == name) return m;
+  throw Error(fmt::format("--model {}: unknown model; allowed: {}", name, fmt::join(model_names(), " | ")));
+}
+
+ModelParams default_params(const std::string& name) { return table_defaults(model_info(name).params); }
+
+ModelParams params_for_fiber(const std::string& name, const PhysicalFiber& fiber) {
+  const ModelInfo& m = model_info(name);
+  ModelParams p = table_defaults(m.params);
+  m.from_fiber(fiber, p);
+  return p;
+}
+
+void apply_setting(const std::string& name, ModelParams& params, const std::string& key_value) {
+  const ModelInfo& m = model_info(name);
+  apply_setting(m.name, m.params, params, key_value);
+}
+
+void apply_settings(const std::string& name, ModelParams& params,
+                    const std::vector<std::string>& key_values) {
+  for (const std::string& kv : key_values) apply_setting(name, params, kv);
+}
+
+std::unique_ptr<Model> make_model(const std::string& name, const ModelParams& params) {
+  return model_info(name).make(params);
+}
+
+std::string describe_params(const std::string& name, const ModelParams& params) {
+  return describe(model_info(name).params, params);
+}
+
+std::vector<ParamAttribute> param_attributes(const std::string& name, const ModelParams& params) {
+  return to_attributes(model_info(name).params, params);
+}
+
+std::vector<std::string> approximations(const std::string& name, const ModelParams& params) {
+  return model_info(name).approximations(params);
+}
+
+std::string models_listing(bool markdown) {
+  std::string s;
+  for (const ModelInfo& m : registered_models()) {
+    if (markdown) {
+      s += fmt::format("#### `{}`: {}\n\n| key | meaning | unit | default | allowed | from a simulation |\n"
+                       "|---|---|---|---|---|---|\n",
+                       m.name, m.reference);
+      for (const ParamSpec& p : m.params)
+        s += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", p.key, p.meaning, p.unit, p.default_value,
+                         p.allowed, p.from_fiber.empty() ? "-" : p.from_fiber);
+      s += "\n";
+    } else {
+      s += fmt::format("{}: {}\n", m.name, m.reference);
+      for (const ParamSpec& p : m.params) {
+        s += fmt::format("  {:<17} {}\n", p.key, p.meaning);
+        s += fmt::format("  {:<17} unit {}, default {}, allowed {}{}\n", "", p.unit.empty() ? "-" : p.unit,
+                         p.default_value, p.allowed,
+                         p.from_fiber.empty() ? "" : "; from a simulation: " + p.from_fiber);
+      }
+      s += "\n";
+    }
+  }
+  return s;
+}
+
+}  // namespace fiberlab::analytic

@@ -1,0 +1,84 @@
+#pragma once
+// From a physical fiber (what the simulator traces: SPEC sections 2-4) to a
+// model's parameters: the rules `predict` and `compare` use unless told
+// otherwise with --set.
+//
+// - eta, sigma_a, lobes (and eccentricity where the model has it) are copied.
+// - Tilt: alpha_p, shifts of theta_r, by SPEC s7: R -2a, TT +a, TRT +4a,
+//   p >= 3: 0 (rays through the fiber's centre; the comparison measures the
+//   real shift).
+// - Roughness:
+//   * smooth: every beta 0 (d'Eon's exact v -> 0 limits; Marschner's Gaussian
+//     M needs beta > 0 and is floored at kMinMarschnerBeta);
+//   * exit_blur: beta_long / beta_azim lists used as given (SPEC s3: the exit
+//     blur *is* d'Eon's M_p and Gaussian detector);
+//   * gaussian (microfacet tilts of standard deviation beta_long, beta_azim at
+//     every event): a *calibrated* rule, gaussian_lobe_widths(): the theta_r
+//     spread of each lobe measured in simulations over a grid of roughness
+//     and theta_i (scripts/calibrate_widths.py regenerates the table below),
+//     expressed in each model's width convention.
+#include <string>
+#include <vector>
+
+namespace fiberlab::analytic {
+
+struct PhysicalFiber {
+  enum class Roughness { Smooth, Gaussian, ExitBlur };
+  double eta = 1.55;
+  double eccentricity = 1.0;
+  double scale_tilt = 0.0;  // radians, towards the root
+  std::vector<double> sigma_a{0.0, 0.0, 0.0};
+  Roughness roughness = Roughness::Smooth;
+  std::vector<double> beta_long{0.0};  // radians; indexed by p for exit_blur
+  std::vector<double> beta_azim;       // radians; empty: beta_long
+  int lobes = 4;
+};
+
+// SPEC s7's shifts of theta_r for tilt a: {-2a, a, 4a, 0}.
+std::vector<double> tilt_shifts(double scale_tilt);
+
+// How a model's longitudinal width parameter relates to the theta_r spread
+// (standard deviation) of its lobe for small widths:
+// - ThetaR: a spread in theta_r itself (d'Eon's M_p with v = beta^2:
+//   M_p ~ exp(cos(theta_i + theta_r)/v), a Gaussian of sd beta in theta_r;
+//   Marschner with longitudinal=two_theta_h);
+// - ThetaH: a Gaussian in theta_h = (theta_i + theta_r)/2 (Marschner as
+//   published): sd beta in theta_h is sd 2 beta in theta_r, so beta is half
+//   the spread.
+enum class WidthVariable { ThetaR, ThetaH };
+
+struct LobeWidths {
+  std::vector<double> beta_long, beta_azim;  // radians, indexed by p (0..lobes-1)
+};
+
+// The calibrated rule for a gaussian-rough fiber (see the .cpp for the
+// fitted coefficients, the grid they come from and their measured error).
+// beta_long, beta_azim: the simulator's gaussian roughness (radians).
+LobeWidths gaussian_lobe_widths(double beta_long, double beta_azim, double eta, int lobes,
+                                WidthVariable variable);
+
+// The first-order (small-angle, h = 0, normal incidence) theta_r spread of
+// lobe p per unit of gaussian microfacet tilt: a reflection deviates a ray
+// by 2 delta; a refraction by (eta - 1) delta once the exit refraction has
+// magnified it; an internal reflection by 2 eta delta outside; independent
+// events add in variance: p = 0: 2, p >= 1: sqrt(2 (eta-1)^2 + 4 eta^2 (p-1)).
+// Used for the azimuthal widths (not calibrated) and for lobes p >= 3.
+double first_order_spread(double eta, int p);
+
+inline constexpr double kMinMarschnerBeta = 0.1 * 3.14159265358979323846 / 180.0;  // 0.1 deg
+
+}  // namespace fiberlab::analytic
+
+#include "analytic/model.h"
+
+namespace fiberlab::analytic {
+
+// The part of every model's physical defaults that is the same for all:
+// eta, sigma_a, lobes copied, alpha from the tilt (tilt_shifts).
+void apply_fiber_basics(const PhysicalFiber& fiber, ModelParams& params);
+// beta_long / beta_azim from the roughness (see the top of this file), in
+// the model's width variable; every beta_long at least min_beta_long.
+void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params, WidthVariable variable,
+                           double min_beta_long = 0.0);
+
+}  // namespace fiberlab::analytic

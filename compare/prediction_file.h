@@ -1,0 +1,60 @@
+#pragma once
+// Prediction files ("bring your own model"): the bin probabilities of any
+// model, written by `fiberlab predict` or by any HDF5 writer (h5py), judged
+// by `fiberlab compare RESULT --prediction PRED.h5`.
+//
+// Format (angles in radians, index order as in result files, SPEC s9):
+//   root attribute  format = "fiber-prediction"            (required)
+//   /bins/theta_edges   n_theta + 1                          (required)
+//   /bins/phi_edges     n_phi + 1                            (required)
+//   /source/theta_i     K                                    (required)
+//   /source/phi_i       K (NaN for a randomly rotated fiber)  (required)
+//   /prediction/probability  K x L x n_theta x n_phi x C, float64: the
+//       probability that a photon of incident direction k leaves in lobe l
+//       through bin (i, j), channel c (required; finite)
+//   /prediction attribute model (text, optional); `fiberlab predict` also
+//       writes the model's parameters and its approximations there.
+#include <string>
+#include <vector>
+
+#include "common/bin_grid.h"
+#include "sim/result_file.h"
+
+namespace fiberlab::compare {
+
+struct PredictionFile {
+  std::string path;
+  std::string model;           // "" when the file does not say
+  std::string format_version;  // "" when absent
+  BinGrid grid;
+  std::vector<double> theta_i, phi_i;  // K
+  int lobes = 0, channels = 0;
+  std::vector<double> probability;     // K x L x n_theta x n_phi x C
+  std::vector<std::string> approximations;
+  std::size_t configs() const { return theta_i.size(); }
+  std::size_t per_config() const {
+    return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
+  }
+};
+
+// Whether `path` is an HDF5 file whose root attribute format is
+// "fiber-prediction" (false for anything else, including missing files).
+bool is_prediction_file(const std::string& path);
+
+// Reads and checks a prediction file: every required name present, shapes
+// consistent, values finite. fiberlab::Error (exit 2) naming the file and
+// the offending name otherwise.
+PredictionFile read_prediction(const std::string& path);
+
+// The prediction's bin probabilities per incident direction of `result`, in
+// the layout of compare(). Bins, incident directions (theta_i, phi_i, same
+// order), lobes and channels must match the result's: fiberlab::Error
+// naming the first mismatch otherwise.
+std::vector<std::vector<double>> prediction_bins_for(const PredictionFile& pred,
+                                                     const sim::ResultFile& result,
+                                                     const std::string& result_path);
+
+// What `fiberlab info` prints for a prediction file.
+std::string describe_prediction(const PredictionFile& pred);
+
+}  // namespace fiberlab::compare
