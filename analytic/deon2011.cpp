@@ -588,7 +588,7 @@ ModelInfo deon2011_info() {
       throw Error(fmt::format("model deon2011: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));
     apply_fiber_basics(f, p);
-    apply_fiber_roughness(f, p, WidthVariable::ThetaR);
+    apply_fiber_roughness(f, p, deon2011_width_calibration());
   };
   return m;
 }

@@ -9,6 +9,7 @@
 
 #include <fmt/core.h>
 
+#include "analytic/cylinder_paths.h"
 #include "analytic/model_registry.h"
 #include "analytic/quadrature.h"
 #include "common/error.h"
@@ -81,11 +82,7 @@ double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bo
 
 // ---- Appendix B ---------------------------------------------------------------
 
-double eta_prime(double eta, double theta) {
-  const double s = std::sin(theta);
-  const double c = std::max(std::cos(theta), 1e-12);
-  return std::sqrt(eta * eta - s * s) / c;
-}
+double eta_prime(double eta, double theta) { return cylinder::eta_prime(eta, theta); }
 
 double eta_double_prime(double eta, double theta) {
   const double s = std::sin(theta);
@@ -104,15 +101,10 @@ double F(double eta_p, double eta_pp, double gamma) {
 
 // ---- Eq. 3, Eq. 10 ------------------------------------------------------------
 
-double Phi(int p, double gamma_i, double eta_p) {
-  return 2.0 * p * gamma_t_exact(gamma_i, eta_p) - 2.0 * gamma_i + p * kPi;
-}
+// Eq. 3 and its derivative: the one cylinder module's.
+double Phi(int p, double gamma_i, double eta_p) { return cylinder::Phi(p, gamma_i, eta_p); }
 
-double dPhi_dgamma(int p, double gamma_i, double eta_p) {
-  const double s = std::sin(gamma_i);
-  // d gamma_t / d gamma_i = cos(gamma_i) / (eta' cos gamma_t) = cos / sqrt(eta'^2 - sin^2).
-  return 2.0 * p * std::cos(gamma_i) / std::sqrt(eta_p * eta_p - s * s) - 2.0;
-}
+double dPhi_dgamma(int p, double gamma_i, double eta_p) { return cylinder::dPhi_dgamma(p, gamma_i, eta_p); }
 
 double gamma_t_cubic(double gamma_i, double eta_p) {
   const double c = c_of(eta_p);
@@ -216,12 +208,8 @@ std::vector<double> gamma_roots_exact(int p, double phi, double eta_p) {
 // ---- Section 4.3 --------------------------------------------------------------
 
 double T(double sigma_a_prime, double gamma_t, Absorption absorption) {
-  if (absorption == Absorption::Chord)
-    return std::exp(-sigma_a_prime * 2.0 * std::cos(gamma_t));
-  // As published: segment length 2 + 2 cos(2 gamma_t) (the garbled "law of
-  // cosines" sentence), T = exp(-2 sigma_a (1 + cos 2 gamma_t)); SPEC s7 notes
-  // that this is not the chord 2 cos(gamma_t).
-  return std::exp(-2.0 * sigma_a_prime * (1.0 + std::cos(2.0 * gamma_t)));
+  // Section 4.3 (published) or the chord: the one cylinder module's.
+  return cylinder::segment_transmittance(sigma_a_prime, std::cos(gamma_t), absorption);
 }
 
 double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
@@ -576,8 +564,7 @@ ModelInfo marschner2003_info() {
   m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
     apply_fiber_basics(f, p);
     p.eccentricity = f.eccentricity;
-    apply_fiber_roughness(f, p, p.two_theta_h ? WidthVariable::ThetaR : WidthVariable::ThetaH,
-                          kMinMarschnerBeta);
+    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), kMinMarschnerBeta);
   };
   return m;
 }

@@ -13,23 +13,27 @@ double first_order_spread(double eta, int p) {
 }
 
 namespace {
-
-// theta_r spread of lobe p (standard deviation of the lobe's theta-marginal,
-// radians) per radian of gaussian beta_long, measured by
-// scripts/calibrate_widths.py. Index p = 0 (R), 1 (TT), 2 (TRT); p >= 3 uses
-// the first-order rule.
-double measured_spread_per_beta(double eta, int p) { return first_order_spread(eta, p); }
-
+#include "analytic/calibrated_widths.inc"
 }  // namespace
 
+WidthCalibration deon2011_width_calibration() {
+  return {{kDeonWidthRatio[0], kDeonWidthRatio[1], kDeonWidthRatio[2]}, WidthVariable::ThetaR};
+}
+
+WidthCalibration marschner2003_width_calibration(bool two_theta_h) {
+  const double f = two_theta_h ? 2.0 : 1.0;
+  return {{f * kMarschnerWidthRatio[0], f * kMarschnerWidthRatio[1], f * kMarschnerWidthRatio[2]},
+          two_theta_h ? WidthVariable::ThetaR : WidthVariable::ThetaH};
+}
+
 LobeWidths gaussian_lobe_widths(double beta_long, double beta_azim, double eta, int lobes,
-                                WidthVariable variable) {
+                                const WidthCalibration& cal) {
   LobeWidths w;
   const int n = std::max(1, lobes);
   for (int p = 0; p < n; ++p) {
-    double spread = measured_spread_per_beta(eta, p) * beta_long;
-    if (variable == WidthVariable::ThetaH) spread *= 0.5;
-    w.beta_long.push_back(spread);
+    const double ratio =
+        p <= 2 ? cal.ratio[p] : cal.ratio[2] * first_order_spread(eta, p) / first_order_spread(eta, 2);
+    w.beta_long.push_back(ratio * beta_long);
     w.beta_azim.push_back(first_order_spread(eta, p) * beta_azim);
   }
   return w;
@@ -46,7 +50,7 @@ void apply_fiber_basics(const PhysicalFiber& f, ModelParams& p) {
   p.alpha = tilt_shifts(f.scale_tilt);
 }
 
-void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, WidthVariable variable,
+void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, const WidthCalibration& cal,
                            double min_beta_long) {
   const std::vector<double>& azim = f.beta_azim.empty() ? f.beta_long : f.beta_azim;
   switch (f.roughness) {
@@ -54,7 +58,7 @@ void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, WidthVariable
       // SPEC s3: the exit blur's vMF is d'Eon's M_p (a theta_r width); a
       // theta_h Gaussian needs half of it.
       p.beta_long = f.beta_long;
-      if (variable == WidthVariable::ThetaH)
+      if (cal.variable == WidthVariable::ThetaH)
         for (double& b : p.beta_long) b *= 0.5;
       p.beta_azim = azim;
       break;
@@ -65,7 +69,7 @@ void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, WidthVariable
     case PhysicalFiber::Roughness::Gaussian: {
       const double bl = f.beta_long.empty() ? 0.0 : f.beta_long.front();
       const double ba = azim.empty() ? bl : azim.front();
-      const LobeWidths w = gaussian_lobe_widths(bl, ba, f.eta, f.lobes, variable);
+      const LobeWidths w = gaussian_lobe_widths(bl, ba, f.eta, f.lobes, cal);
       p.beta_long = w.beta_long;
       p.beta_azim = w.beta_azim;
       break;

@@ -51,11 +51,25 @@ struct LobeWidths {
   std::vector<double> beta_long, beta_azim;  // radians, indexed by p (0..lobes-1)
 };
 
-// The calibrated rule for a gaussian-rough fiber (see the .cpp for the
-// fitted coefficients, the grid they come from and their measured error).
-// beta_long, beta_azim: the simulator's gaussian roughness (radians).
+// beta_model_p / beta_gaussian for p = 0 (R), 1 (TT), 2 (TRT), measured by
+// scripts/calibrate_widths.py (analytic/calibrated_widths.inc holds the
+// numbers, the grid they come from and their held-out error).
+struct WidthCalibration {
+  double ratio[3];
+  WidthVariable variable;  // the model's width variable the ratios are for
+};
+WidthCalibration deon2011_width_calibration();
+// Marschner's Gaussian in theta_h; with two_theta_h the same lobe needs a
+// width twice as large (a Gaussian in theta_r + theta_i).
+WidthCalibration marschner2003_width_calibration(bool two_theta_h);
+
+// The calibrated rule for a gaussian-rough fiber. beta_long, beta_azim: the
+// simulator's gaussian roughness (radians). Longitudinal: ratio[p] *
+// beta_long for p <= 2; p >= 3 scales TRT's ratio by the first-order spread
+// ratio (not calibrated: faint lobes). Azimuthal: the first-order rule below
+// (not calibrated; the target is the theta_r spread).
 LobeWidths gaussian_lobe_widths(double beta_long, double beta_azim, double eta, int lobes,
-                                WidthVariable variable);
+                                const WidthCalibration& calibration);
 
 // The first-order (small-angle, h = 0, normal incidence) theta_r spread of
 // lobe p per unit of gaussian microfacet tilt: a reflection deviates a ray
@@ -78,7 +92,7 @@ namespace fiberlab::analytic {
 void apply_fiber_basics(const PhysicalFiber& fiber, ModelParams& params);
 // beta_long / beta_azim from the roughness (see the top of this file), in
 // the model's width variable; every beta_long at least min_beta_long.
-void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params, WidthVariable variable,
-                           double min_beta_long = 0.0);
+void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params,
+                           const WidthCalibration& calibration, double min_beta_long = 0.0);
 
 }  // namespace fiberlab::analytic

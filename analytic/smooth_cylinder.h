@@ -17,68 +17,17 @@
 // piece, so every quadrature node lies inside one bin and the result is
 // exact to rounding through the caustics. Independent of any simulator code.
 //
-// The path machinery here (Bravais index, Phi, the fold, attenuation, node
-// sets over h) is shared with d'Eon 2011, whose N_p is the same integral
-// with a Gaussian detector instead of the delta.
+// The path machinery (Bravais index, Phi, the fold, attenuation, node sets
+// over h) is analytic/cylinder_paths.h, shared with d'Eon 2011 and
+// Marschner 2003.
 #include <memory>
 #include <vector>
 
+#include "analytic/cylinder_paths.h"
 #include "analytic/model.h"
 
 namespace fiberlab::analytic {
 
-namespace cylinder {
-
-// eta' of Bravais's law (Marschner 2003 Appendix B).
-double eta_prime(double eta, double theta);
-// Phi(p, gamma_i) and its derivative for the projected index eta_p.
-double Phi(int p, double gamma_i, double eta_p);
-double dPhi_dgamma(int p, double gamma_i, double eta_p);
-// gamma_c > 0 where dPhi/dgamma = 0 (sin^2 gamma_c = (p^2 - eta'^2)/(p^2 - 1)),
-// for p >= 2 and eta' < p; otherwise -1 (Phi monotonic). For p = 2 this is
-// the TRT caustic, h^2 = (4 - eta'^2)/3 (SPEC s8).
-double fold_gamma(int p, double eta_p);
-
-// The attenuation of paths at inclination theta (theta_i for the smooth
-// fiber, theta_d for d'Eon 2011). Precomputes what does not depend on h.
-class Attenuation {
- public:
-  Attenuation(double eta, double theta, const std::vector<double>& sigma_a, Absorption absorption);
-  double eta_p() const { return eta_p_; }
-  int channels() const { return static_cast<int>(sigma_a_prime_.size()); }
-  // f = F(eta, acos(cos theta cos gamma_i)).
-  double f(double gamma_i) const;
-  // T of one internal segment, per channel.
-  void T(double gamma_i, double* out) const;
-  // A(p, gamma_i) per channel (out[0..C)).
-  void A(int p, double gamma_i, double* out) const;
-  // Sum of A(p', gamma_i) over every p' > P (P >= 0), per channel, in closed
-  // form: (1 - f)^2 f^P T^(P+1) / (1 - f T).
-  void A_beyond(int P, double gamma_i, double* out) const;
-
- private:
-  double eta_, cos_theta_, eta_p_;
-  std::vector<double> sigma_a_prime_;
-  Absorption absorption_;
-};
-
-// A quadrature node of (1/2) integral over h in (-1, 1) of g(h) dh, written
-// over gamma_i (h = sin gamma_i; weight includes cos(gamma_i) / 2), with the
-// exit azimuth Phi(p, gamma_i) wrapped to [-pi, pi).
-struct PathNode {
-  double gamma, weight, phi;
-};
-// Nodes split at every crossing of Phi(p, .) with an edge of n_phi uniform
-// bins on [-pi, pi) and at the fold: each node's phi is strictly inside one
-// bin and each piece carries a smooth integrand. `order` points per piece.
-void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNode>& out);
-// Composite Gauss-Legendre over gamma_i in (-pi/2, pi/2), split at the fold,
-// with panels over which Phi changes by at most max_dphi.
-void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out);
-// Bin of a wrapped phi in n uniform bins on [-pi, pi).
-int phi_bin(double phi, int n_phi);
-
-}  // namespace cylinder
 
 // Lobe energies and phi-bin probabilities of the smooth circular fiber at one
 // incidence; usable directly by simulator tests.

@@ -57,6 +57,7 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
       for (hsize_t j = 0; j < np; ++j) omega[i * np + j] = r.grid.solid_angle(i, j);
     f.write("solid_angle", {nt, np}, omega);
     f.write("theta_i", {K}, r.theta_i);
+    f.write("phi_i", {K}, r.phi_i);  // NaN: a randomly rotated fiber
     std::vector<double> p(r.weight_sum.size()), se(r.weight_sum.size()), m;
     m.reserve(r.weight_sum.size());
     for (std::size_t k = 0; k < K; ++k) {

@@ -10,10 +10,10 @@ missing (the caller then reports "plots skipped"), 2 on bad arguments.
 
 Figures have fixed pixel sizes (no tight bounding box), so tests can check
 the PNG headers:
-  compare_k{K}_heatmaps.png   1200 x 1200: per lobe, simulated and predicted
+  compare_theta{T}_phi{P}_heatmaps.png   1200 x 1200: per lobe, simulated and predicted
                               density per solid angle (log10) and the
                               normalised residual (P_sim - P_model) / se
-  compare_k{K}_marginals.png  1200 x 1200: per lobe, theta_r and phi
+  compare_theta{T}_phi{P}_marginals.png  1200 x 1200: per lobe, theta_r and phi
                               marginals, simulation with error bars, model
   energy.png                  1200 x 800: total, R+TT+TRT and per-lobe
                               energy against theta_i for every source
@@ -35,12 +35,25 @@ def lobe_name(lobe, lobes):
     return names[lobe] if lobe < 6 else "p=%d" % lobe
 
 
+def incidence_title(theta_i, phi_i):
+    """theta_i = 30.0 deg, phi_i = 0.0 deg (phi_i uniform for a randomly rotated fiber)."""
+    phi = "uniform" if phi_i != phi_i else "%.1f deg" % phi_i
+    return "theta_i = %.1f deg, phi_i = %s" % (theta_i, phi)
+
+
+def incidence_stem(theta_i, phi_i):
+    """File-name part naming the incident direction: theta30.0_phi0.0 (phiuniform)."""
+    phi = "uniform" if phi_i != phi_i else "%.1f" % phi_i
+    return "theta%.1f_phi%s" % (theta_i, phi)
+
+
 def plot_compare(d, np, plt, h5py):
     with h5py.File(os.path.join(d, "report_data.h5"), "r") as f:
         te = np.degrees(f["theta_edges"][...])
         pe = np.degrees(f["phi_edges"][...])
         omega = f["solid_angle"][...]
         theta_i = np.degrees(f["theta_i"][...])
+        phi_i = np.degrees(f["phi_i"][...]) if "phi_i" in f else np.zeros_like(theta_i)
         sim_p = f["sim_p"][...]
         sim_se = f["sim_se"][...]
         model_p = f["model_p"][...]
@@ -51,9 +64,10 @@ def plot_compare(d, np, plt, h5py):
     tc = 0.5 * (te[:-1] + te[1:])
     pc = 0.5 * (pe[:-1] + pe[1:])
     for k in range(min(K, MAX_CONFIGS)):
+        where = incidence_title(theta_i[k], phi_i[k])
+        stem = incidence_stem(theta_i[k], phi_i[k])
         fig, axes = plt.subplots(L, 3, figsize=(12, 12), dpi=100, squeeze=False)
-        fig.suptitle("theta_i = %.1f deg, channel %d: simulation | %s | (sim - model) / se"
-                     % (theta_i[k], c, model))
+        fig.suptitle("%s, channel %d: simulation | %s | (sim - model) / se" % (where, c, model))
         for l in range(L):
             s = sim_p[k, l, :, :, c]
             m = model_p[k, l, :, :, c]
@@ -77,12 +91,11 @@ def plot_compare(d, np, plt, h5py):
                 ax.tick_params(labelsize=7)
         for ax in axes[-1]:
             ax.set_xlabel("phi (deg)", fontsize=8)
-        fig.savefig(os.path.join(d, "compare_k%d_heatmaps.png" % k), dpi=100)
+        fig.savefig(os.path.join(d, "compare_%s_heatmaps.png" % stem), dpi=100)
         plt.close(fig)
 
         fig, axes = plt.subplots(L, 2, figsize=(12, 12), dpi=100, squeeze=False)
-        fig.suptitle("theta_i = %.1f deg, channel %d: marginals, simulation (points, 1 se) and %s (line)"
-                     % (theta_i[k], c, model))
+        fig.suptitle("%s, channel %d: marginals, simulation (points, 1 se) and %s (line)" % (where, c, model))
         for l in range(L):
             s = sim_p[k, l, :, :, c]
             m = model_p[k, l, :, :, c]
@@ -99,7 +112,7 @@ def plot_compare(d, np, plt, h5py):
                     ax.set_xlabel("%s (deg)" % name, fontsize=8)
                 if l == 0:
                     ax.legend(fontsize=7)
-        fig.savefig(os.path.join(d, "compare_k%d_marginals.png" % k), dpi=100)
+        fig.savefig(os.path.join(d, "compare_%s_marginals.png" % stem), dpi=100)
         plt.close(fig)
 
 

@@ -109,7 +109,7 @@ TEST(Report, CompareAndEnergyFolders) {
   for (const char* name : {"report.md", "metrics.csv", "metrics.json"})
     EXPECT_TRUE(fs::exists(erep / name)) << name;
   if (have_matplotlib()) {
-    for (const char* png : {"compare_k0_heatmaps.png", "compare_k0_marginals.png"}) {
+    for (const char* png : {"compare_theta31.0_phi0.0_heatmaps.png", "compare_theta31.0_phi0.0_marginals.png"}) {
       const auto [w, h] = png_size(rep / png);
       EXPECT_EQ(w, 1200) << png;
       EXPECT_EQ(h, 1200) << png;

@@ -1,0 +1,77 @@
+#pragma once
+// Paths of light through a smooth circular cylinder, in the normal plane
+// (SPEC s7; Marschner et al. 2003 s4 and Appendix B; d'Eon et al. 2011 s4):
+// the one place where eta' (Bravais), Phi(p, h) and its fold (the TRT
+// caustic), the attenuation T and the path weight A(p, h) are written. Used
+// by the exact model (smooth_cylinder.h), d'Eon 2011 and Marschner 2003.
+//   Phi(p, h) = 2 p gamma_t - 2 gamma_i + p pi, sin gamma_i = h,
+//   sin gamma_t = h / eta', eta' = sqrt(eta^2 - sin^2 theta) / cos theta,
+//   A(0, h) = f, A(p, h) = (1 - f)^2 f^(p-1) T^p,
+//   f = F(eta, acos(cos theta cos gamma_i)) (3D Fresnel, common/fresnel.h),
+//   T = exp(-sigma_a' 2 cos gamma_t) (chord) or exp(-4 sigma_a' cos^2 gamma_t)
+//   (published), sigma_a' = sigma_a / cos theta_t, sin theta_t = sin theta / eta.
+#include <vector>
+
+#include "analytic/model.h"
+
+namespace fiberlab::analytic {
+
+namespace cylinder {
+
+// eta' of Bravais's law (Marschner 2003 Appendix B).
+double eta_prime(double eta, double theta);
+// Phi(p, gamma_i) and its derivative for the projected index eta_p.
+double Phi(int p, double gamma_i, double eta_p);
+double dPhi_dgamma(int p, double gamma_i, double eta_p);
+// gamma_c > 0 where dPhi/dgamma = 0 (sin^2 gamma_c = (p^2 - eta'^2)/(p^2 - 1)),
+// for p >= 2 and eta' < p; otherwise -1 (Phi monotonic). For p = 2 this is
+// the TRT caustic, h^2 = (4 - eta'^2)/3 (SPEC s8).
+double fold_gamma(int p, double eta_p);
+
+// Transmittance of one internal segment at projected refraction angle
+// gamma_t: chord exp(-sigma_a' 2 cos gamma_t), or as published
+// exp(-2 sigma_a' (1 + cos 2 gamma_t)) = exp(-4 sigma_a' cos^2 gamma_t).
+double segment_transmittance(double sigma_a_prime, double cos_gamma_t, Absorption absorption);
+
+// The attenuation of paths at inclination theta (theta_i for the smooth
+// fiber, theta_d for d'Eon 2011). Precomputes what does not depend on h.
+class Attenuation {
+ public:
+  Attenuation(double eta, double theta, const std::vector<double>& sigma_a, Absorption absorption);
+  double eta_p() const { return eta_p_; }
+  int channels() const { return static_cast<int>(sigma_a_prime_.size()); }
+  // f = F(eta, acos(cos theta cos gamma_i)).
+  double f(double gamma_i) const;
+  // T of one internal segment, per channel.
+  void T(double gamma_i, double* out) const;
+  // A(p, gamma_i) per channel (out[0..C)).
+  void A(int p, double gamma_i, double* out) const;
+  // Sum of A(p', gamma_i) over every p' > P (P >= 0), per channel, in closed
+  // form: (1 - f)^2 f^P T^(P+1) / (1 - f T).
+  void A_beyond(int P, double gamma_i, double* out) const;
+
+ private:
+  double eta_, cos_theta_, eta_p_;
+  std::vector<double> sigma_a_prime_;
+  Absorption absorption_;
+};
+
+// A quadrature node of (1/2) integral over h in (-1, 1) of g(h) dh, written
+// over gamma_i (h = sin gamma_i; weight includes cos(gamma_i) / 2), with the
+// exit azimuth Phi(p, gamma_i) wrapped to [-pi, pi).
+struct PathNode {
+  double gamma, weight, phi;
+};
+// Nodes split at every crossing of Phi(p, .) with an edge of n_phi uniform
+// bins on [-pi, pi) and at the fold: each node's phi is strictly inside one
+// bin and each piece carries a smooth integrand. `order` points per piece.
+void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNode>& out);
+// Composite Gauss-Legendre over gamma_i in (-pi/2, pi/2), split at the fold,
+// with panels over which Phi changes by at most max_dphi.
+void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out);
+// Bin of a wrapped phi in n uniform bins on [-pi, pi).
+int phi_bin(double phi, int n_phi);
+
+}  // namespace cylinder
+
+}  // namespace fiberlab::analytic
