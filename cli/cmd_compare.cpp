@@ -15,6 +15,7 @@
 #include "common/units.h"
 #include "compare/comparison.h"
 #include "compare/fit.h"
+#include "compare/fit_text.h"
 #include "compare/models.h"
 #include "compare/prediction_file.h"
 #include "compare/verdict.h"
@@ -110,35 +111,17 @@ void compare_command(const CompareOptions& o) {
 
   std::string fit_json = "null", fit_md;
   if (!o.fit.empty()) {
-    const std::vector<std::string> keys = split_commas(o.fit);
-    const compare::FitResult fr = compare::fit_model(result, spec.name, params, keys, copt);
-    fmt::print("\nfit of {} ({} residuals, {} iterations, {} model evaluations{}):\n", o.fit, fr.residuals,
-               fr.iterations, fr.evaluations, fr.converged ? "" : ", NOT converged");
-    fmt::print("  chi2/dof {:.4f} -> {:.4f} (dof {}); errors scaled by sqrt(max(1, chi2/dof)) = {:.3f}\n",
-               fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, std::sqrt(std::max(1.0, fr.per_dof())));
-    fit_md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations).\n\n"
-                         "| key | start | fitted | error | unscaled error |\n|---|---|---|---|---|\n",
-                         fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations);
-    std::string items;
-    for (std::size_t i = 0; i < keys.size(); ++i) {
-      fmt::print("  {:<14} {:12.6g} -> {:12.6g} +- {:.3g} (unscaled {:.3g})\n", keys[i], fr.start[i],
-                 fr.value[i], fr.error[i], fr.error_unscaled[i]);
-      fit_md += fmt::format("| {} | {:.6g} | {:.6g} | {:.3g} | {:.3g} |\n", keys[i], fr.start[i], fr.value[i],
-                            fr.error[i], fr.error_unscaled[i]);
-      items += fmt::format("{}{{\"key\": {}, \"start\": {}, \"value\": {}, \"error\": {}, \"error_unscaled\": {}}}",
-                           i ? ", " : "", compare::json_string(keys[i]), compare::json_number(fr.start[i]),
-                           compare::json_number(fr.value[i]), compare::json_number(fr.error[i]),
-                           compare::json_number(fr.error_unscaled[i]));
-    }
-    fit_json = fmt::format(
-        "{{\"parameters\": [{}], \"chi2_start\": {}, \"chi2\": {}, \"dof\": {}, \"iterations\": {}, "
-        "\"converged\": {}, \"error_scale\": \"sqrt(max(1, chi2/dof))\"}}",
-        items, compare::json_number(fr.chi2_start), compare::json_number(fr.chi2), fr.dof, fr.iterations,
-        fr.converged ? "true" : "false");
+    const compare::FitResult fr = compare::fit_model(
+        result, spec.name, params, split_commas(o.fit), copt, 40,
+        [](const std::string& line) { fmt::print(stderr, "{}\n", line); });
     // The verdict and the report use the fitted model.
     params = fr.params;
     current = predicted_by_model(result, spec, params);
+    const compare::Verdict before = v;
     v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), o.max_chi2);
+    fmt::print("{}", compare::fit_text(fr, before, v, result.lobes));
+    fit_md = compare::fit_markdown(fr, before, v, result.lobes);
+    fit_json = compare::fit_json(fr, before, v);
     fmt::print("\nafter the fit: {}", current.header);
     fmt::print("{}", compare::verdict_table(v, result.lobes));
   }
@@ -188,8 +171,8 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--set", o->settings,
                   "Model parameter KEY=VALUE (angles in degrees; repeatable; `fiberlab models` lists the keys)");
   cmd->add_option("--fit", o->fit,
-                  "Comma-separated parameters to fit: eta, sigma_a, beta_long, beta_azim, alpha, scale_tilt, "
-                  "or NAME[p] for one lobe's entry");
+                  "Comma-separated parameters to fit: the model's numeric keys (eta, beta_long, ...), NAME[p] "
+                  "for one lobe's entry (beta_long[0],alpha[2]), or the physical scale_tilt (shift rule)");
   cmd->add_option("--report", o->report, "Write a report folder (report.md, metrics.csv/json, PNG plots)");
   cmd->add_option("--max-chi2", o->max_chi2,
                   "Accept a lobe when chi2/dof <= X (default: 1 + 5 sqrt(2/dof), five standard deviations)");

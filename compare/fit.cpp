@@ -9,6 +9,8 @@
 
 #include "common/error.h"
 #include "common/units.h"
+#include "analytic/model_registry.h"
+#include "analytic/physical_defaults.h"
 #include "compare/models.h"
 
 namespace fiberlab::compare {
@@ -52,9 +54,23 @@ std::vector<double>* list_of(analytic::ModelParams& p, const std::string& name, 
 
 [[noreturn]] void unknown(const std::string& key) {
   throw Error(fmt::format(
-      "--fit key '{}' is not fittable (allowed: eta, sigma_a, beta_long, beta_azim, alpha, "
-      "scale_tilt, or NAME[INDEX] for the lists)",
+      "--fit key '{}' is not fittable (allowed: eta, sigma_a, beta_long, beta_azim, alpha[p], "
+      "scale_tilt, k_g, w_c, delta_eta, delta_h_m, eccentricity, or NAME[INDEX] for the lists)",
       key));
+}
+
+// Scalar keys of ModelParams that a fit may move (the model's table decides
+// which of them a model has).
+double* scalar_of(analytic::ModelParams& p, const std::string& name, double& scale) {
+  scale = 1.0;
+  if (name == "eta") return &p.eta;
+  if (name == "k_g") return &p.k_g;
+  if (name == "delta_eta") return &p.delta_eta;
+  if (name == "delta_h_m") return &p.delta_h_m;
+  if (name == "eccentricity") return &p.eccentricity;
+  scale = kPi / 180.0;
+  if (name == "w_c") return &p.w_c;
+  return nullptr;
 }
 
 }  // namespace
@@ -62,9 +78,9 @@ std::vector<double>* list_of(analytic::ModelParams& p, const std::string& name, 
 double get_parameter(const analytic::ModelParams& p0, const std::string& key) {
   analytic::ModelParams p = p0;
   const Key k = parse_key(key);
-  if (k.name == "eta" && k.index < 0) return p.eta;
   if (k.name == "scale_tilt" && k.index < 0) return rad_to_deg(analytic::for_lobe(p.alpha, 1));
   double scale = 1.0;
+  if (double* x = scalar_of(p, k.name, scale); x && k.index < 0) return *x / scale;
   std::vector<double>* list = list_of(p, k.name, scale);
   if (!list) unknown(key);
   return analytic::for_lobe(*list, std::max(0, k.index)) / scale;
@@ -72,16 +88,19 @@ double get_parameter(const analytic::ModelParams& p0, const std::string& key) {
 
 void set_parameter(analytic::ModelParams& p, const std::string& key, double value) {
   const Key k = parse_key(key);
-  if (k.name == "eta" && k.index < 0) {
-    p.eta = std::max(value, 1.0 + 1e-9);
-    return;
-  }
   if (k.name == "scale_tilt" && k.index < 0) {
-    const double a = deg_to_rad(value);
-    p.alpha = {-2.0 * a, a, 4.0 * a, 0.0};  // SPEC s7
+    p.alpha = analytic::tilt_shifts(deg_to_rad(value));  // SPEC s7's shift rule
     return;
   }
   double scale = 1.0;
+  if (double* x = scalar_of(p, k.name, scale); x && k.index < 0) {
+    double v = value * scale;
+    if (k.name == "eta") v = std::max(v, 1.0 + 1e-9);
+    else if (k.name == "eccentricity") v = std::clamp(v, 1e-3, 1.0);
+    else v = std::max(v, 0.0);
+    *x = v;
+    return;
+  }
   std::vector<double>* list = list_of(p, k.name, scale);
   if (!list) unknown(key);
   double v = value * scale;
@@ -99,10 +118,32 @@ void set_parameter(analytic::ModelParams& p, const std::string& key, double valu
   (*list)[k.index] = v;
 }
 
+void check_fit_key(const std::string& model_name, const std::string& key) {
+  const Key k = parse_key(key);
+  const analytic::ParamTable& table = analytic::model_info(model_name).params;
+  std::string fittable;
+  for (const analytic::ParamSpec& s : table)
+    if (s.unit != "choice" && s.unit != "integer") fittable += (fittable.empty() ? "" : ", ") + s.key;
+  if (analytic::find_param(table, "alpha")) fittable += ", scale_tilt";
+  const bool is_list = k.name == "beta_long" || k.name == "beta_azim" || k.name == "alpha" || k.name == "sigma_a";
+  const analytic::ParamSpec* spec = analytic::find_param(table, k.name);
+  const bool known = k.name == "scale_tilt" ? analytic::find_param(table, "alpha") != nullptr && k.index < 0
+                                            : spec && spec->unit != "choice" && spec->unit != "integer" &&
+                                                  (k.index < 0 || is_list);
+  if (!known)
+    throw Error(fmt::format("--fit {}: model {} cannot fit '{}'; fittable keys: {} (lists per lobe as NAME[p])",
+                            key, model_name, key, fittable));
+  if (k.name == "alpha" && k.index < 0)
+    throw Error(fmt::format("--fit alpha: one common shift for every lobe moves R the wrong way; fit "
+                            "alpha[p] per lobe (e.g. alpha[0],alpha[1]) or the physical scale_tilt"));
+}
+
 FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
                     const analytic::ModelParams& start, const std::vector<std::string>& keys,
-                    const Options& options, int max_iterations) {
+                    const Options& options, int max_iterations,
+                    const std::function<void(const std::string&)>& progress) {
   if (keys.empty()) throw Error("--fit: no parameters given");
+  for (const std::string& key : keys) check_fit_key(model_name, key);
   const int n = static_cast<int>(keys.size());
   FitResult fr;
   fr.keys = keys;
@@ -116,7 +157,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   };
   auto residuals = [&](const Eigen::VectorXd& x, bool parallel) {
     const analytic::ModelParams p = params_at(x);
-    const auto model = make_model(model_name, p);
+    const auto model = compare::make_model(model_name, p);
     const std::vector<double> r =
         normalised_residuals(result, sel, predict_result(*model, result, parallel), options);
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<long>(r.size())));
@@ -157,6 +198,10 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   fr.dof = static_cast<int>(m) - n;
   if (fr.dof <= 0) throw Error(fmt::format("--fit: {} residuals for {} parameters", m, n));
   fr.chi2_start = r.squaredNorm();
+  if (progress)
+    progress(fmt::format("fit: {} residuals, {} parameters, start chi2/dof {:.4f}; each iteration costs {} "
+                         "model evaluations",
+                         m, n, fr.chi2_start / fr.dof, 2 * n + 1));
   double chi2 = fr.chi2_start, lambda = 1e-3;
   Eigen::MatrixXd J = jacobian(x, m);
   fr.evaluations += 2 * n;
@@ -189,6 +234,12 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
       } else {
         lambda *= 10.0;
       }
+    }
+    if (progress) {
+      std::string values;
+      for (int j = 0; j < n; ++j) values += fmt::format(" {}={:.6g}", keys[j], x[j]);
+      progress(fmt::format("fit: iteration {}, chi2/dof {:.4f}, {} model evaluations,{}", fr.iterations + 1,
+                           chi2 / fr.dof, fr.evaluations, values));
     }
     if (!improved) {
       fr.converged = true;  // no downhill step at any damping: at the minimum

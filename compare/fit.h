@@ -15,13 +15,20 @@
 // problem (the PDG's scale factor); when it does they are the bare ones.
 // Both are reported.
 //
-// Keys (angles in degrees):
-//   eta, sigma_a (one common value for every channel), sigma_a[c];
-//   beta_long, beta_azim, alpha (one common value for every lobe: the list
-//     is replaced by one entry); beta_long[p], beta_azim[p], alpha[p] (entry
-//     p only; the list is extended by its last entry as needed);
-//   scale_tilt: the physical cuticle tilt a, mapped to alpha by SPEC s7
-//     (R -2a, TT +a, TRT +4a, p >= 3: 0).
+// Keys (angles in degrees), each one of the model's own numeric parameters
+// (its table, analytic/model_registry.h; another key is refused naming the
+// model's fittable keys):
+//   eta, k_g, ... (scalars); sigma_a (one common value for every channel),
+//   sigma_a[c];
+//   beta_long, beta_azim (one common value for every lobe: the list is
+//     replaced by one entry); beta_long[p], beta_azim[p], alpha[p] (entry
+//     p only, per lobe; the list is extended by its last entry as needed).
+//     A bare `alpha` is refused: one common shift for every lobe moves R the
+//     wrong way (R shifts by -2a, TT by +a); fit alpha[p] or scale_tilt;
+//   scale_tilt (models with alpha): the physical cuticle tilt a, mapped to
+//     every lobe's alpha by the shift rule of SPEC s7 (analytic::tilt_shifts:
+//     R -2a, TT +a, TRT +4a, p >= 3: 0).
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -35,6 +42,8 @@ namespace fiberlab::compare {
 // angles). Throws fiberlab::Error for an unknown key.
 double get_parameter(const analytic::ModelParams& p, const std::string& key);
 void set_parameter(analytic::ModelParams& p, const std::string& key, double value);
+// Refuses (fiberlab::Error) a key that model `model_name` cannot fit.
+void check_fit_key(const std::string& model_name, const std::string& key);
 
 struct FitResult {
   std::vector<std::string> keys;
@@ -48,8 +57,11 @@ struct FitResult {
   double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
 };
 
+// `progress` (optional) receives one line per iteration (the CLI prints it
+// on stderr: fits take minutes).
 FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
                     const analytic::ModelParams& start, const std::vector<std::string>& keys,
-                    const Options& options = {}, int max_iterations = 40);
+                    const Options& options = {}, int max_iterations = 40,
+                    const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace fiberlab::compare

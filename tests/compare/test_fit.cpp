@@ -7,6 +7,7 @@
 
 #include <cstdio>
 
+#include "common/error.h"
 #include "compare/fit.h"
 #include "tests/compare/compare_test_support.h"
 
@@ -72,6 +73,46 @@ TEST(Fit, MeasuresTiltShiftOfR) {
   EXPECT_GT(f.value[0], -2.2 * 3.0);
   EXPECT_LT(f.value[0], -0.6 * 3.0);
   EXPECT_LT(f.error[0], 0.3);
+}
+
+}  // namespace
+}  // namespace fiberlab::compare
+
+namespace fiberlab::compare {
+namespace {
+
+// Fit keys are the model's own: per-lobe entries and the physical tilt are
+// accepted, another model's key or one common alpha for every lobe refused.
+TEST(Fit, KeysAreTheModelsOwn) {
+  EXPECT_NO_THROW(check_fit_key("deon2011", "beta_long[0]"));
+  EXPECT_NO_THROW(check_fit_key("deon2011", "alpha[2]"));
+  EXPECT_NO_THROW(check_fit_key("deon2011", "scale_tilt"));
+  EXPECT_NO_THROW(check_fit_key("marschner2003", "k_g"));
+  EXPECT_NO_THROW(check_fit_key("exact", "eta"));
+  for (const auto& [model, key] : std::vector<std::pair<std::string, std::string>>{
+           {"exact", "k_g"}, {"exact", "scale_tilt"}, {"deon2011", "alpha"}, {"deon2011", "w_c"},
+           {"marschner2003", "beta_azim"}, {"deon2011", "lobes"}, {"deon2011", "eta[1]"}}) {
+    try {
+      check_fit_key(model, key);
+      ADD_FAILURE() << model << " " << key;
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  }
+}
+
+// scale_tilt moves every lobe by SPEC s7's shift rule.
+TEST(Fit, ScaleTiltIsTheShiftRule) {
+  analytic::ModelParams p;
+  set_parameter(p, "scale_tilt", 3.0);
+  ASSERT_EQ(p.alpha.size(), 4u);
+  EXPECT_NEAR(rad_to_deg(p.alpha[0]), -6.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(p.alpha[1]), 3.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(p.alpha[2]), 12.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(p.alpha[3]), 0.0, 1e-12);
+  EXPECT_NEAR(get_parameter(p, "scale_tilt"), 3.0, 1e-12);
+  set_parameter(p, "beta_long[2]", 7.0);
+  EXPECT_NEAR(rad_to_deg(analytic::for_lobe(p.beta_long, 2)), 7.0, 1e-12);
 }
 
 }  // namespace

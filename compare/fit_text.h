@@ -1,0 +1,18 @@
+#pragma once
+// A fit's outcome as text (terminal, report.md, metrics.json): the fitted
+// values with their uncertainties, and the chi-square before and after the
+// fit for every judged lobe (incident direction, lobe, channel).
+#include <string>
+
+#include "compare/fit.h"
+#include "compare/verdict.h"
+
+namespace fiberlab::compare {
+
+// `before` and `after`: the verdicts with the start and the fitted parameters
+// (same rows, same order).
+std::string fit_text(const FitResult& fit, const Verdict& before, const Verdict& after, int lobes);
+std::string fit_markdown(const FitResult& fit, const Verdict& before, const Verdict& after, int lobes);
+std::string fit_json(const FitResult& fit, const Verdict& before, const Verdict& after);
+
+}  // namespace fiberlab::compare
