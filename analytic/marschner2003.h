@@ -161,6 +161,18 @@ struct CausticParams {
 void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_a,
            const CausticParams& caustic_params, std::vector<double>& out);
 
+// Phi-bin integrals of N_p over n_phi uniform bins on [-pi, pi):
+// out[j * C + c] = integral over bin j of N_p(phi) dphi = (1/2) int A(p, h) dh
+// over the h whose exit angle (the phi function in use, Eq. 10 or Eq. 3)
+// falls in bin j: exact, caustics included, with no root finding (the h
+// range is split where the phi function crosses a bin edge and at its fold;
+// Gauss-Legendre on each piece). For p = 2 with caustic_params->w_c > 0 the
+// procedure of section 5.2.2: the removal factor per h, and the two glint
+// Gaussians' bin masses in closed form. Used by bin_probabilities() for
+// circular fibers (eccentricity makes N depend on phi_h).
+void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
+              const CausticParams* caustic_params, int n_phi, std::vector<double>& out);
+
 // ---- Eccentricity (section 5.2.3) -------------------------------------------
 
 // eta*_1 = 2(eta-1)a^2 - eta + 2, eta*_2 = 2(eta-1)a^-2 - eta + 2,

@@ -637,11 +637,16 @@ TEST(Marschner2003, BinProbabilitiesAgreeWithDefaultWhenSmooth) {
   params.k_g = 1.0;
   params.delta_h_m = 0.5;
   params.delta_eta = 0.3;
-  params.eccentricity = 0.9;
   params.alpha = {deg_to_rad(-6.0), deg_to_rad(3.0), deg_to_rad(12.0)};
-  const auto model = make_marschner2003(params);
-  const BinGrid grid = BinGrid::make(12, 24, ThetaBinning::EqualArea);
-  for (double theta_i : {deg_to_rad(-20.0), deg_to_rad(50.0)}) {
+  // Eccentric (pointwise phi quadrature) and circular (phi-bin integrals
+  // over h, N_p_bins: the caustic removal per h and the glints' closed-form
+  // bin masses), with the published cubic and with exact roots.
+  for (const auto& [ecc, exact] : std::vector<std::pair<double, bool>>{{0.9, false}, {1.0, false}, {1.0, true}})
+  for (double theta_i : {deg_to_rad(-20.0), deg_to_rad(50.0), deg_to_rad(75.0)}) {
+    params.eccentricity = ecc;
+    params.exact_roots = exact;
+    const auto model = make_marschner2003(params);
+    const BinGrid grid = BinGrid::make(12, 24, ThetaBinning::EqualArea);
     const std::vector<double> mine = model->bin_probabilities(grid, theta_i, 0.4);
     const std::vector<double> base = model->Model::bin_probabilities(grid, theta_i, 0.4);
     ASSERT_EQ(mine.size(), base.size());
