@@ -314,6 +314,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
 
   std::vector<cylinder::PathNode> nodes;
   std::vector<double> a(C);
+  std::vector<std::complex<double>> bin_factor;  // [n * np + j], see the Fourier deposit
   // Phi-bin integrals of sum_{p in term} N_p at exit inclination theta_r: [j * C + c].
   auto azimuthal = [&](const Term& t, double theta_r, std::vector<double>& nb) {
     nb.assign(static_cast<std::size_t>(np) * C, 0.0);
@@ -371,16 +372,26 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       // Eq. 11 in Fourier form: the wrapped Gaussian's coefficients are
       // g_n = exp(-n^2 beta^2 / 2), so the bin mass is
       // F_0 dphi / 2pi + (1/pi) Re sum_{n>=1} F_n g_n (e^{i n b} - e^{i n a}) / (i n).
+      // The bin factors (e^{i n b} - e^{i n a}) / (i n) depend on neither
+      // theta_r nor the channel: tabulated once per call (bin_factor).
+      if (static_cast<int>(bin_factor.size()) < (n_fourier + 1) * np) {
+        bin_factor.assign(static_cast<std::size_t>(n_fourier + 1) * np, 0.0);
+        for (int n = 1; n <= n_fourier; ++n)
+          for (int j = 0; j < np; ++j) {
+            const double lo = -kPi + j * dphi, hi = lo + dphi;
+            bin_factor[static_cast<std::size_t>(n) * np + j] =
+                (std::polar(1.0, n * hi) - std::polar(1.0, n * lo)) / std::complex<double>(0.0, n);
+          }
+      }
+      for (int n = 1; n <= n_fourier; ++n) {
+        const double g = std::exp(-0.5 * n * n * t.beta * t.beta) / kPi;
+        for (int c = 0; c < C; ++c) fourier[static_cast<std::size_t>(n) * C + c] *= g;
+      }
       for (int j = 0; j < np; ++j) {
-        const double lo = -kPi + j * dphi, hi = lo + dphi;
         for (int c = 0; c < C; ++c) {
           double v = fourier[c].real() * dphi / kTwoPi;
-          for (int n = 1; n <= n_fourier; ++n) {
-            const double g = std::exp(-0.5 * n * n * t.beta * t.beta);
-            const std::complex<double> d = (std::polar(1.0, n * hi) - std::polar(1.0, n * lo)) /
-                                           std::complex<double>(0.0, n);
-            v += (fourier[static_cast<std::size_t>(n) * C + c] * g * d).real() / kPi;
-          }
+          for (int n = 1; n <= n_fourier; ++n)
+            v += (fourier[static_cast<std::size_t>(n) * C + c] * bin_factor[static_cast<std::size_t>(n) * np + j]).real();
           nb[static_cast<std::size_t>(j) * C + c] += v;
         }
       }
