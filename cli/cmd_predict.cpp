@@ -92,6 +92,7 @@ void add_predict_command(CLI::App& app) {
                   "KEY=VALUE parameter of the model (repeatable; angles in degrees; `fiberlab models` lists "
                   "each model's keys)");
   cmd->add_option("-o,--output", o->output, "Prediction file (.h5)")->required();
+  cmd->footer("\nModel parameters (--set KEY=VALUE):\n\n" + analytic::models_listing());
   cmd->callback([o] { predict(*o); });
 }
 

@@ -57,4 +57,9 @@ grep -q "incident direction 1" "$work/err" || { echo "FAIL: the error does not n
 expect 2 "prediction and model together" -- "$fiberlab" compare "$work/r.h5" --prediction "$work/right.h5" --model exact
 expect 2 "a result as prediction" -- "$fiberlab" compare "$work/r.h5" --prediction "$work/r.h5"
 expect 0 "info reads a prediction" -- "$fiberlab" info "$work/right.h5"
+# fiberlab's own predictions are judged the same way (with a report).
+expect 0 "predict writes" -- "$fiberlab" predict "$work/r.h5" --model exact -o "$work/own.h5"
+expect 0 "predict's file, judged" -- "$fiberlab" compare "$work/r.h5" --prediction "$work/own.h5" --report "$work/rep"
+[ -f "$work/rep/metrics.csv" ] || { echo "FAIL: no report for --prediction"; fail=1; }
+expect 2 "--set with --prediction" -- "$fiberlab" compare "$work/r.h5" --prediction "$work/own.h5" --set eta=1.5
 exit $fail
