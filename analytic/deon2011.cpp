@@ -303,14 +303,26 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
   const double dphi = kTwoPi / np;
   std::vector<double> g0;
   const bool r_special = params_.r_half_angle_fresnel && terms.front().p0 == 0;
+  // cos(phi) at those points, hoisted out of Eq. 12's Fresnel term (which is
+  // evaluated for every theta_r point and phi point: F_half_angle inlined).
+  std::vector<double> cos_ph;
   if (r_special) {
     g0.resize(static_cast<std::size_t>(np) * kPhiOrder);
+    cos_ph.resize(g0.size());
     for (int j = 0; j < np; ++j)
       for (int q = 0; q < kPhiOrder; ++q) {
         const double ph = -kPi + (j + 0.5) * dphi + 0.5 * dphi * glp.x[q];
         g0[j * kPhiOrder + q] = G0(ph, terms.front().beta, refine_);
+        cos_ph[j * kPhiOrder + q] = std::cos(ph);
       }
   }
+  const double sin_i = std::sin(theta_i), cos_i = std::cos(theta_i);
+  // Eq. 12: F(eta, arccos(wi . wr) / 2) at (theta_r, phi point jq), as
+  // deon2011::F_half_angle computes it.
+  auto f_half = [&](double sin_r, double cos_r, int jq) {
+    const double x = sin_i * sin_r + cos_i * cos_r * cos_ph[jq];
+    return fresnel_dielectric(std::sqrt(std::clamp(0.5 * (1.0 + x), 0.0, 1.0)), params_.eta);
+  };
 
   std::vector<cylinder::PathNode> nodes;
   std::vector<double> a(C);
@@ -331,13 +343,11 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     std::vector<std::complex<double>> fourier(static_cast<std::size_t>(n_fourier + 1) * C);
     for (int p = t.p0; p <= t.p1; ++p) {
       if (p == 0 && r_special) {
+        const double sin_r = std::sin(theta_r), cos_r = std::cos(theta_r);
         for (int j = 0; j < np; ++j) {
           double s = 0.0;
-          for (int q = 0; q < kPhiOrder; ++q) {
-            const double ph = -kPi + (j + 0.5) * dphi + 0.5 * dphi * glp.x[q];
-            s += 0.5 * dphi * glp.w[q] * deon2011::F_half_angle(params_.eta, theta_i, theta_r, ph) *
-                 g0[j * kPhiOrder + q];
-          }
+          for (int q = 0; q < kPhiOrder; ++q)
+            s += 0.5 * dphi * glp.w[q] * f_half(sin_r, cos_r, j * kPhiOrder + q) * g0[j * kPhiOrder + q];
           for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += s;
         }
       } else if (t.beta < kSmoothBeta) {
@@ -466,13 +476,11 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       // R with Eq. 12: F depends on (theta_r, phi) itself: direct 2D quadrature.
       std::vector<double> row(np);
       for (const ThetaPoint& pt : tp) {
+        const double sin_r = std::sin(pt.theta), cos_r = std::cos(pt.theta);
         for (int j = 0; j < np; ++j) {
           double s = 0.0;
-          for (int q = 0; q < kPhiOrder; ++q) {
-            const double ph = -kPi + (j + 0.5) * dphi + 0.5 * dphi * glp.x[q];
-            s += 0.5 * dphi * glp.w[q] * deon2011::F_half_angle(params_.eta, theta_i, pt.theta, ph) *
-                 g0[j * kPhiOrder + q];
-          }
+          for (int q = 0; q < kPhiOrder; ++q)
+            s += 0.5 * dphi * glp.w[q] * f_half(sin_r, cos_r, j * kPhiOrder + q) * g0[j * kPhiOrder + q];
           double* o = &lobe_out[(static_cast<std::size_t>(pt.i) * np + j) * C];
           for (int c = 0; c < C; ++c) o[c] += pt.w * s;
         }
