@@ -13,6 +13,7 @@
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/units.h"
+#include "compare/compare_report.h"
 #include "compare/comparison.h"
 #include "compare/fit.h"
 #include "compare/fit_text.h"
@@ -130,29 +131,16 @@ void compare_command(const CompareOptions& o) {
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
 
   if (!o.report.empty()) {
-    compare::write_text(o.report, "metrics.csv", compare::verdict_csv(v, result.lobes));
-    const std::string params_json = from_file ? "null" : compare::params_json(spec.name, params);
-    const std::string json = fmt::format(
-        "{{\n  \"kind\": \"compare\",\n  \"result\": {},\n  \"model\": {},\n  \"params\": {},\n  \"criterion\": {},\n"
-        "  \"accepted\": {},\n  \"fit\": {},\n  \"lobes\": {}\n}}\n",
-        compare::json_string(o.result), compare::json_string(current.label), params_json,
-        compare::json_string(v.criterion), v.all_accepted ? "true" : "false", fit_json,
-        compare::verdict_json_rows(v, result.lobes));
-    compare::write_text(o.report, "metrics.json", json);
-    compare::write_compare_data(o.report, result, current.bins, current.label, o.channel);
-    const compare::PlotOutcome plots = compare::make_plots("compare", o.report);
-    std::string md = fmt::format("# {} against {}\n\n```\n{}```\n\nCriterion per lobe: {}. "
-                                 "Verdict: **{}** ({} of {} judged lobes accepted).\n\n",
-                                 o.result, current.label, current.header, v.criterion,
-                                 v.all_accepted ? "accepted" : "rejected", v.judged - v.rejected, v.judged);
-    md += compare::verdict_markdown(v, result.lobes);
-    md += "\n" + fit_md;
-    md += "\n## Plots\n\n";
-    if (!plots.ran) md += plots.message + "\n\n";
-    for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
-    md += "Numbers: `metrics.csv`, `metrics.json`; arrays: `report_data.h5`.\n";
-    compare::write_text(o.report, "report.md", md);
-    fmt::print("report: {}/report.md{}\n", o.report, plots.ran ? "" : " (" + plots.message + ")");
+    compare::CompareReport rep;
+    rep.dir = o.report;
+    rep.result_path = o.result;
+    rep.label = current.label;
+    rep.header = current.header;
+    if (!from_file) rep.params_json = compare::params_json(spec.name, params);
+    rep.fit_json = fit_json;
+    rep.fit_markdown = fit_md;
+    rep.plot_channel = o.channel;
+    fmt::print("{}", compare::write_compare_report(rep, result, current.bins, v));
   }
   exit_code = v.all_accepted ? 0 : 1;
 }

@@ -1,5 +1,6 @@
 // `--set KEY=VALUE` parsing, the model factory and `fiberlab predict`.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -90,7 +91,7 @@ TEST(ModelParams, KeyOfAnotherModelIsRefused) {
 
 TEST(Predict, WritesAPredictionFileOrNothing) {
   namespace fs = std::filesystem;
-  const fs::path dir = fs::temp_directory_path() / "fiberlab_test_predict";
+  const fs::path dir = fs::temp_directory_path() / ("fiberlab_test_predict_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string cfg = std::string(FIBERLAB_SOURCE_DIR) + "/configs/smooth_circle.yaml";
   const std::string out = (dir / "pred.h5").string();
@@ -124,4 +125,5 @@ TEST(Predict, WritesAPredictionFileOrNothing) {
   rc = std::system((bin + " predict " + cfg + " --model nosuch -o " + bad + " 2>/dev/null").c_str());
   EXPECT_EQ(WEXITSTATUS(rc), 2);
   EXPECT_FALSE(fs::exists(bad));
+  fs::remove_all(dir);
 }

@@ -1,6 +1,7 @@
 // `compare` on designs where the model is exact (accepted) or deliberately
 // wrong (rejected).
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -93,7 +94,7 @@ int run_binary(const std::string& args) {
 TEST(CompareModels, ExitStatus) {
   sim::Settings s = testing::circle(35.0, 400000, sim::RoughnessModel::Smooth);
   s.tally.n_theta = 91;
-  const fs::path dir = fs::temp_directory_path() / "fiberlab_compare_exit_status";
+  const fs::path dir = fs::temp_directory_path() / ("fiberlab_compare_exit_status_" + std::to_string(::getpid()));
   fs::create_directories(dir);
   const std::string path = (dir / "smooth.h5").string();
   sim::write_result(testing::run(s), path);

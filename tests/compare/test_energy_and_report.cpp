@@ -1,5 +1,6 @@
 // `energy` on a white fiber (d'Eon 2011 Figs. 3 and 5) and the report folders.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cstdio>
 #include <cstdlib>
@@ -85,7 +86,7 @@ bool have_matplotlib() {
 }
 
 TEST(Report, CompareAndEnergyFolders) {
-  const fs::path dir = fs::temp_directory_path() / "fiberlab_report_test";
+  const fs::path dir = fs::temp_directory_path() / ("fiberlab_report_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
   sim::Settings s = testing::circle(31.0, 200000, sim::RoughnessModel::ExitBlur);

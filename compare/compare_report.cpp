@@ -1,0 +1,35 @@
+#include "compare/compare_report.h"
+
+#include <fmt/core.h>
+
+#include "compare/report.h"
+#include "compare/verdict_tables.h"
+
+namespace fiberlab::compare {
+
+std::string write_compare_report(const CompareReport& rep, const sim::ResultFile& result,
+                                 const std::vector<std::vector<double>>& bins, const Verdict& v) {
+  write_text(rep.dir, "metrics.csv", verdict_csv(v, result.lobes));
+  const std::string json = fmt::format(
+      "{{\n  \"kind\": \"compare\",\n  \"result\": {},\n  \"model\": {},\n  \"params\": {},\n  \"criterion\": {},\n"
+      "  \"accepted\": {},\n  \"fit\": {},\n  \"lobes\": {}\n}}\n",
+      json_string(rep.result_path), json_string(rep.label), rep.params_json, json_string(v.criterion),
+      v.all_accepted ? "true" : "false", rep.fit_json, verdict_json_rows(v, result.lobes));
+  write_text(rep.dir, "metrics.json", json);
+  write_compare_data(rep.dir, result, bins, rep.label, rep.plot_channel);
+  const PlotOutcome plots = make_plots("compare", rep.dir);
+  std::string md = fmt::format("# {} against {}\n\n```\n{}```\n\nCriterion per lobe: {}. "
+                               "Verdict: **{}** ({} of {} judged lobes accepted).\n\n",
+                               rep.result_path, rep.label, rep.header, v.criterion,
+                               v.all_accepted ? "accepted" : "rejected", v.judged - v.rejected, v.judged);
+  md += verdict_markdown(v, result.lobes);
+  md += "\n" + rep.fit_markdown;
+  md += "\n## Plots\n\n";
+  if (!plots.ran) md += plots.message + "\n\n";
+  for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
+  md += "Numbers: `metrics.csv`, `metrics.json`; arrays: `report_data.h5`.\n";
+  write_text(rep.dir, "report.md", md);
+  return fmt::format("report: {}/report.md{}\n", rep.dir, plots.ran ? "" : " (" + plots.message + ")");
+}
+
+}  // namespace fiberlab::compare
