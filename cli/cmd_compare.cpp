@@ -1,8 +1,10 @@
 // `fiberlab compare RESULT.h5 --model M [--set KEY=VALUE ...] [--fit KEYS]
 //                  [--report DIR] [--max-chi2 X]`
-// Is model M right for the fiber of RESULT, where, and by how much?
-// Exit status 0 when every judged lobe is accepted, 1 when one is not, 2 on
-// bad input. See compare/comparison.h for the statistics.
+// `fiberlab compare RESULT.h5 --prediction PRED.h5 [--report DIR] [--max-chi2 X]`
+// Is model M (or any prediction file) right for the fiber of RESULT, where,
+// and by how much? Exit status 0 when every judged lobe is accepted, 1 when
+// one is not, 2 on bad input. The statistics: compare/comparison.h; the rule:
+// compare/verdict.h; the prediction format: compare/prediction_file.h.
 #include <fmt/core.h>
 
 #include <chrono>
@@ -10,6 +12,7 @@
 #include <memory>
 #include <sstream>
 
+#include "analytic/model_registry.h"
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/units.h"
@@ -20,9 +23,8 @@
 #include "compare/models.h"
 #include "compare/prediction_file.h"
 #include "compare/verdict.h"
-#include "compare/verdict_tables.h"
-#include "analytic/model_registry.h"
 #include "compare/report.h"
+#include "compare/verdict_tables.h"
 #include "sim/result_file.h"
 
 namespace fiberlab::cli {
