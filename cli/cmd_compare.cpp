@@ -96,6 +96,7 @@ void compare_command(const CompareOptions& o) {
     spec = compare::parse_model_spec(o.model);
     params = compare::params_for(result.settings, spec, o.settings);
     analytic::make_model(spec.name, params);  // the model's own checks, before any output
+    for (const std::string& key : split_commas(o.fit)) compare::check_fit_key(spec.name, key);
   }
   compare::Options copt;
   copt.min_effective = o.min_effective;
