@@ -37,6 +37,9 @@ expect 1 "exact, eta 1.45" -- "$fiberlab" compare "$work/r.h5" --model exact --s
 expect 1 "exact, published attenuation" -- "$fiberlab" compare "$work/r.h5" --model exact --set absorption=published
 expect 2 "a key exact does not have" -- "$fiberlab" compare "$work/r.h5" --model exact --set k_g=5
 grep -q "k_g" "$work/err" || { echo "FAIL: the error does not name k_g"; fail=1; }
+expect 2 "a fit key exact does not have" -- "$fiberlab" compare "$work/r.h5" --model exact --fit k_g
+expect 2 "one alpha for every lobe" -- "$fiberlab" compare "$work/r.h5" --model deon2011 --fit alpha
+[ -s "$work/out" ] && { echo "FAIL: output before the --fit error"; fail=1; }
 
 py=/usr/bin/python3
 $py "$source_dir/tests/cli/write_exact_prediction.py" "$work/r.h5" "$work/right.h5" || exit 1
