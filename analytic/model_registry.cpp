@@ -69,12 +69,18 @@ std::string models_listing(bool markdown) {
   std::string s;
   for (const ModelInfo& m : registered_models()) {
     if (markdown) {
-      s += fmt::format("#### `{}`: {}\n\n| key | meaning | unit | default | allowed | from a simulation |\n"
+      s += fmt::format("### `{}`: {}\n\n| key | meaning | unit | default | allowed | from a simulation |\n"
                        "|---|---|---|---|---|---|\n",
                        m.name, m.reference);
+      // A "|" inside a cell (choices "a | b") would end the cell.
+      auto cell = [](std::string text) {
+        for (std::size_t i = text.find('|'); i != std::string::npos; i = text.find('|', i + 2))
+          text.replace(i, 1, "\\|");
+        return text;
+      };
       for (const ParamSpec& p : m.params)
-        s += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", p.key, p.meaning, p.unit, p.default_value,
-                         p.allowed, p.from_fiber.empty() ? "-" : p.from_fiber);
+        s += fmt::format("| `{}` | {} | {} | {} | {} | {} |\n", p.key, cell(p.meaning), p.unit, p.default_value,
+                         cell(p.allowed), p.from_fiber.empty() ? "-" : p.from_fiber);
       s += "\n";
     } else {
       s += fmt::format("{}: {}\n", m.name, m.reference);
