@@ -3,6 +3,7 @@
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <new>
 
 #include "cli/commands.h"
 #include "common/error.h"
@@ -25,6 +26,10 @@ int main(int argc, char** argv) {
     return status == 0 ? 0 : 2;
   } catch (const fiberlab::Error& e) {
     fmt::print(stderr, "fiberlab: error: {}\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "fiberlab: error: out of memory (lower the tally size, the incident "
+                       "angles or --threads); no output written\n");
     return 2;
   } catch (const std::exception& e) {
     fmt::print(stderr, "fiberlab: internal error: {}\n", e.what());

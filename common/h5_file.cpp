@@ -2,11 +2,24 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+
 #include "common/error.h"
 
 namespace fiberlab::h5 {
 
 namespace {
+
+// A fixed-length string attribute longer than this is refused before it is
+// read (a crafted file can declare any length).
+constexpr std::size_t kMaxStringBytes = 64u << 20;
+
+std::string shape_text(const Dims& dims) {
+  if (dims.empty()) return "a scalar";
+  std::string s;
+  for (std::size_t i = 0; i < dims.size(); ++i) s += fmt::format("{}{}", i ? " x " : "", dims[i]);
+  return s;
+}
 
 void check(herr_t status, const std::string& what, const std::string& path) {
   if (status < 0) throw Error(fmt::format("{}: HDF5 error: {}", path, what));
@@ -77,6 +90,35 @@ std::vector<T> read_dataset(hid_t file, const std::string& path, const std::stri
         "cannot read " + name, path);
   if (dims_out) *dims_out = dims;
   return data;
+}
+
+Dims dataset_shape(hid_t file, const std::string& path, const std::string& name) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 0) throw Error(fmt::format("{}: {} has an unreadable dataspace", path, name));
+  Dims dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  return dims;
+}
+
+void check_shape(hid_t file, const std::string& path, const std::string& name,
+                 const Dims& expected, const std::string& meaning) {
+  const Dims dims = dataset_shape(file, path, name);
+  if (dims != expected)
+    throw Error(fmt::format("{}: {} has shape {} (must be {}: {})", path, name, shape_text(dims),
+                            shape_text(expected), meaning));
+}
+
+H5T_class_t dataset_class(hid_t file, const std::string& path, const std::string& name,
+                          H5T_sign_t* sign) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle type = checked(H5Dget_type(set.id()), H5Tclose, "type of " + name, path);
+  const H5T_class_t c = H5Tget_class(type.id());
+  if (sign) *sign = c == H5T_INTEGER ? H5Tget_sign(type.id()) : H5T_SGN_NONE;
+  return c;
 }
 
 void write_attr(hid_t file, const std::string& path, const std::string& obj,
@@ -159,6 +201,104 @@ std::vector<std::uint64_t> File::read_uint64s(const std::string& name, Dims* dim
   return read_dataset<std::uint64_t>(handle_.id(), path_, name, dims, H5T_NATIVE_UINT64);
 }
 
+Dims File::shape(const std::string& name) const { return dataset_shape(handle_.id(), path_, name); }
+
+std::vector<double> File::read_doubles(const std::string& name, const Dims& expected,
+                                       const std::string& meaning) const {
+  check_shape(handle_.id(), path_, name, expected, meaning);
+  const H5T_class_t c = dataset_class(handle_.id(), path_, name, nullptr);
+  if (c != H5T_FLOAT && c != H5T_INTEGER)
+    throw Error(fmt::format("{}: {} does not hold numbers (must be float64)", path_, name));
+  return read_doubles(name);
+}
+
+std::vector<std::uint64_t> File::read_uint64s(const std::string& name, const Dims& expected,
+                                              const std::string& meaning) const {
+  check_shape(handle_.id(), path_, name, expected, meaning);
+  H5T_sign_t sign = H5T_SGN_NONE;
+  if (dataset_class(handle_.id(), path_, name, &sign) != H5T_INTEGER)
+    throw Error(fmt::format("{}: {} does not hold integers (must be uint64)", path_, name));
+  if (sign != H5T_SGN_2) return read_uint64s(name);
+  // A signed dataset (e.g. written by h5py from int64): read it as such and
+  // refuse negative counts rather than let HDF5 clip them.
+  const std::vector<std::int64_t> v =
+      read_dataset<std::int64_t>(handle_.id(), path_, name, nullptr, H5T_NATIVE_INT64);
+  std::vector<std::uint64_t> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] < 0)
+      throw Error(fmt::format("{}: {} holds the negative count {} at flat index {} (must be >= 0)",
+                              path_, name, v[i], i));
+    out[i] = static_cast<std::uint64_t>(v[i]);
+  }
+  return out;
+}
+
+void File::set_attr(const std::string& obj, const std::string& name, std::uint64_t value) {
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "scalar space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_STD_U64LE, space.id(), &value);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name,
+                    const std::vector<std::uint64_t>& value) {
+  hsize_t n = value.size();
+  Handle space = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "array space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_STD_U64LE, space.id(), value.data());
+}
+
+std::uint64_t File::attr_size(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  if (n < 0) throw Error(fmt::format("{}: attribute {}@{} has an unreadable dataspace", path_, obj, name));
+  return static_cast<std::uint64_t>(n);
+}
+
+std::uint64_t File::attr_uint64(const std::string& obj, const std::string& name) const {
+  const std::string what = obj + "@" + name;
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {} is not a single value (must be one uint64)", path_, what));
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle type = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
+  if (H5Tget_class(type.id()) != H5T_INTEGER)
+    throw Error(fmt::format("{}: attribute {} is not an integer (must be uint64)", path_, what));
+  if (H5Tget_sign(type.id()) == H5T_SGN_2) {
+    std::int64_t v = 0;
+    check(H5Aread(a.id(), H5T_NATIVE_INT64, &v), "cannot read " + what, path_);
+    return static_cast<std::uint64_t>(v);  // the bits of fiberlab 0.1's int64 seed
+  }
+  std::uint64_t v = 0;
+  check(H5Aread(a.id(), H5T_NATIVE_UINT64, &v), "cannot read " + what, path_);
+  return v;
+}
+
+std::vector<std::uint64_t> File::attr_uint64s(const std::string& obj, const std::string& name,
+                                              std::size_t max_count) const {
+  const std::string what = obj + "@" + name;
+  const std::uint64_t n = attr_size(obj, name);
+  if (n < 1 || n > max_count)
+    throw Error(fmt::format("{}: attribute {} holds {} values (must hold 1 to {})", path_, what, n,
+                            max_count));
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle type = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
+  const H5T_class_t c = H5Tget_class(type.id());
+  std::vector<std::uint64_t> out(n);
+  if (c == H5T_INTEGER && H5Tget_sign(type.id()) != H5T_SGN_2) {
+    check(H5Aread(a.id(), H5T_NATIVE_UINT64, out.data()), "cannot read " + what, path_);
+    return out;
+  }
+  if (c != H5T_FLOAT && c != H5T_INTEGER)
+    throw Error(fmt::format("{}: attribute {} does not hold integers (must be uint64)", path_, what));
+  std::vector<double> v(n);
+  check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, v.data()), "cannot read " + what, path_);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!(v[i] >= 0.0 && v[i] < 18446744073709551616.0 && v[i] == std::floor(v[i])))
+      throw Error(fmt::format("{}: attribute {} holds {} (must hold integers in [0, 2^64 - 1])",
+                              path_, what, v[i]));
+    out[i] = static_cast<std::uint64_t>(v[i]);
+  }
+  return out;
+}
+
 void File::set_attr(const std::string& obj, const std::string& name, const std::string& value) {
   // Variable-length UTF-8 string: h5py reads it as a Python str.
   Handle type = checked(H5Tcopy(H5T_C_S1), H5Tclose, "string type", path_);
@@ -195,6 +335,8 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
   Handle ftype = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
   if (H5Tget_class(ftype.id()) != H5T_STRING)
     throw Error(fmt::format("{}: attribute {}@{} is not a string", path_, obj, name));
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single string", path_, obj, name));
   if (H5Tis_variable_str(ftype.id()) > 0) {
     Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "string type", path_);
     H5Tset_size(mtype.id(), H5T_VARIABLE);
@@ -207,6 +349,9 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
     return s;
   }
   const std::size_t n = H5Tget_size(ftype.id());
+  if (n > kMaxStringBytes)
+    throw Error(fmt::format("{}: attribute {}@{} is a string longer than {} bytes", path_, obj,
+                            name, kMaxStringBytes));
   std::string s(n, '\0');
   check(H5Aread(a.id(), ftype.id(), s.data()), "cannot read " + name, path_);
   s.resize(s.find('\0') == std::string::npos ? n : s.find('\0'));
@@ -214,6 +359,8 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
 }
 
 double File::attr_double(const std::string& obj, const std::string& name) const {
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single number", path_, obj, name));
   Handle a = open_attr(handle_.id(), obj, name, path_);
   double v = 0;
   check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, &v), "cannot read " + name, path_);
@@ -221,6 +368,8 @@ double File::attr_double(const std::string& obj, const std::string& name) const 
 }
 
 std::int64_t File::attr_int(const std::string& obj, const std::string& name) const {
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single number", path_, obj, name));
   Handle a = open_attr(handle_.id(), obj, name, path_);
   std::int64_t v = 0;
   check(H5Aread(a.id(), H5T_NATIVE_INT64, &v), "cannot read " + name, path_);
@@ -231,6 +380,9 @@ std::vector<double> File::attr_doubles(const std::string& obj, const std::string
   Handle a = open_attr(handle_.id(), obj, name, path_);
   Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
   const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  if (n < 0 || n > (hssize_t{1} << 24))
+    throw Error(fmt::format("{}: attribute {}@{} declares {} values (at most 2^24 are read)", path_,
+                            obj, name, n));
   std::vector<double> v(static_cast<std::size_t>(n));
   check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, v.data()), "cannot read " + name, path_);
   return v;

@@ -45,16 +45,41 @@ class File {
   std::vector<double> read_doubles(const std::string& name, Dims* dims = nullptr) const;
   std::vector<std::uint64_t> read_uint64s(const std::string& name, Dims* dims = nullptr) const;
 
+  // Files from outside are read in two steps: the declared shape first
+  // (nothing allocated), then the data only when the shape is the expected
+  // one. `meaning` says where the expected shape comes from, for the error
+  // ("K x L x C = 1 x 4 x 3, from config_yaml").
+  Dims shape(const std::string& name) const;  // a dataset's dimensions
+  std::vector<double> read_doubles(const std::string& name, const Dims& expected,
+                                   const std::string& meaning) const;
+  // Integer datasets only (a float or a negative signed value is refused).
+  std::vector<std::uint64_t> read_uint64s(const std::string& name, const Dims& expected,
+                                          const std::string& meaning) const;
+
   // Attributes on an object ("/" for the root).
   void set_attr(const std::string& obj, const std::string& name, const std::string& value);
   void set_attr(const std::string& obj, const std::string& name, double value);
   void set_attr(const std::string& obj, const std::string& name, std::int64_t value);
+  void set_attr(const std::string& obj, const std::string& name, std::uint64_t value);
+  void set_attr(const std::string& obj, const std::string& name,
+                const std::vector<std::uint64_t>& value);
   void set_attr(const std::string& obj, const std::string& name, const std::vector<double>& value);
   bool has_attr(const std::string& obj, const std::string& name) const;
   std::string attr_string(const std::string& obj, const std::string& name) const;
   double attr_double(const std::string& obj, const std::string& name) const;
   std::int64_t attr_int(const std::string& obj, const std::string& name) const;
   std::vector<double> attr_doubles(const std::string& obj, const std::string& name) const;
+  // An exact unsigned 64-bit integer. Integer attributes only; a signed one
+  // is read as the two's-complement bits of an int64 (fiberlab 0.1 stored
+  // uint64 seeds as int64, so -1 means 2^64 - 1).
+  std::uint64_t attr_uint64(const std::string& obj, const std::string& name) const;
+  // An array of unsigned 64-bit integers (at most max_count). Unsigned
+  // integers exactly; float64 (fiberlab 0.1's merged_seeds) when every value
+  // is a finite integer in [0, 2^64).
+  std::vector<std::uint64_t> attr_uint64s(const std::string& obj, const std::string& name,
+                                          std::size_t max_count) const;
+  // The number of values an attribute holds (1 for a scalar).
+  std::uint64_t attr_size(const std::string& obj, const std::string& name) const;
 
  private:
   File(Handle h, std::string path) : handle_(std::move(h)), path_(std::move(path)) {}
