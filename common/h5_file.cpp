@@ -2,6 +2,12 @@
 
 #include <fmt/core.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <cmath>
 
 #include "common/error.h"
@@ -148,11 +154,45 @@ Handle::~Handle() {
 
 void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
+namespace {
+
+// Writes a finished file image with POSIX calls, so that a disk error (ENOSPC,
+// EIO) is reported here as one line and never reaches HDF5.
+void write_image(const std::string& path, const std::vector<char>& image) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
+  if (fd < 0) throw Error(fmt::format("{}: cannot create file: {}", path, std::strerror(errno)));
+  std::size_t done = 0;
+  while (done < image.size()) {
+    const ssize_t n = ::write(fd, image.data() + done, image.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      const int err = n < 0 ? errno : EIO;
+      ::close(fd);
+      throw Error(fmt::format("{}: cannot write the file ({} of {} bytes written): {}", path, done,
+                              image.size(), std::strerror(err)));
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  if (::close(fd) != 0)
+    throw Error(fmt::format("{}: cannot write the file: {}", path, std::strerror(errno)));
+}
+
+}  // namespace
+
 File File::create(const std::string& path) {
   quiet_hdf5_errors();
-  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (id < 0) throw Error(fmt::format("{}: cannot create file (is the folder writable?)", path));
-  return File(Handle(id, H5Fclose), path);
+  // The file is built in memory (HDF5's core driver, no backing store) and
+  // written out by close(): HDF5 never meets a disk error. With the sec2
+  // driver a full disk made H5Fclose fail, left the id registered, and
+  // HDF5 crashed at exit trying to close it again.
+  Handle fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "property list", path);
+  check(H5Pset_fapl_core(fapl.id(), std::size_t{1} << 20, false), "core driver", path);
+  H5Pset_fclose_degree(fapl.id(), H5F_CLOSE_STRONG);
+  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id());
+  if (id < 0) throw Error(fmt::format("{}: cannot create file", path));
+  File f(Handle(id, H5Fclose), path);
+  f.in_memory_ = true;
+  return f;
 }
 
 File File::open_read(const std::string& path) {
@@ -163,8 +203,19 @@ File File::open_read(const std::string& path) {
 }
 
 void File::close() {
-  if (handle_.id() >= 0) check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "flush", path_);
-  handle_ = Handle();
+  if (handle_.id() < 0) return;
+  check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "flush", path_);
+  if (!in_memory_) {
+    handle_ = Handle();
+    return;
+  }
+  const ssize_t size = H5Fget_file_image(handle_.id(), nullptr, 0);
+  if (size < 0) throw Error(fmt::format("{}: HDF5 error: cannot get the file image", path_));
+  std::vector<char> image(static_cast<std::size_t>(size));
+  if (H5Fget_file_image(handle_.id(), image.data(), image.size()) != size)
+    throw Error(fmt::format("{}: HDF5 error: cannot get the file image", path_));
+  handle_ = Handle();  // in memory: closing cannot fail on a disk
+  write_image(path_, image);
 }
 
 void File::create_group(const std::string& name) {

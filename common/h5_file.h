@@ -22,6 +22,7 @@ class Handle {
   Handle& operator=(Handle&& o) noexcept;
   ~Handle();
   hid_t id() const { return id_; }
+  void release() { id_ = -1; }  // the caller closes the id
 
  private:
   hid_t id_ = -1;
@@ -32,10 +33,13 @@ using Dims = std::vector<hsize_t>;
 
 class File {
  public:
-  static File create(const std::string& path);  // truncates
+  // Built in memory and written to `path` (truncated) by close(); a file
+  // destroyed without close() (an exception during the write) is never
+  // written. Disk errors are thrown by close() naming the file.
+  static File create(const std::string& path);
   static File open_read(const std::string& path);
   const std::string& path() const { return path_; }
-  void close();
+  void close();  // flush and close; throws naming the file (e.g. disk full)
 
   void create_group(const std::string& name);
   bool exists(const std::string& name) const;  // a link at this path
@@ -85,6 +89,7 @@ class File {
   File(Handle h, std::string path) : handle_(std::move(h)), path_(std::move(path)) {}
   Handle handle_;
   std::string path_;
+  bool in_memory_ = false;  // created: written out by close()
 };
 
 // Silences HDF5's automatic error stack printing; fiberlab reports its own.
