@@ -244,6 +244,14 @@ void File::write(const std::string& name, const Dims& dims,
   write_dataset(handle_.id(), path_, name, dims, data, H5T_NATIVE_UINT64, H5T_STD_U64LE);
 }
 
+void File::write_finite(const std::string& name, const Dims& dims, const std::vector<double>& data) {
+  for (std::size_t i = 0; i < data.size(); ++i)
+    if (!std::isfinite(data[i]))
+      throw Error(fmt::format("{}: {} would hold {} at flat index {} (values must be finite; "
+                              "nothing written)", path_, name, data[i], i));
+  write(name, dims, data);
+}
+
 std::vector<double> File::read_doubles(const std::string& name, Dims* dims) const {
   return read_dataset<double>(handle_.id(), path_, name, dims, H5T_NATIVE_DOUBLE);
 }

@@ -46,6 +46,10 @@ class File {
 
   void write(const std::string& name, const Dims& dims, const std::vector<double>& data);
   void write(const std::string& name, const Dims& dims, const std::vector<std::uint64_t>& data);
+  // As write(), after checking that every value is finite: a NaN or an
+  // infinity (e.g. a model evaluated far outside its domain) is refused with
+  // one line naming the dataset and the first bad value, and nothing is written.
+  void write_finite(const std::string& name, const Dims& dims, const std::vector<double>& data);
   std::vector<double> read_doubles(const std::string& name, Dims* dims = nullptr) const;
   std::vector<std::uint64_t> read_uint64s(const std::string& name, Dims* dims = nullptr) const;
 
