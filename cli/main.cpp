@@ -7,8 +7,10 @@
 
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/h5_file.h"
 
 int main(int argc, char** argv) {
+  fiberlab::h5::prepare_hdf5();
   CLI::App app{"fiberlab " FIBERLAB_VERSION
                ": Monte Carlo ground truth for light scattering by single fibers"};
   app.set_version_flag("--version", std::string(FIBERLAB_VERSION));

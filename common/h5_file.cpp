@@ -27,8 +27,13 @@ std::string shape_text(const Dims& dims) {
   return s;
 }
 
+// A failed write usually comes from the system (errno ENOSPC: disk full,
+// EDQUOT, EIO): say so when errno was set.
 void check(herr_t status, const std::string& what, const std::string& path) {
-  if (status < 0) throw Error(fmt::format("{}: HDF5 error: {}", path, what));
+  if (status >= 0) return;
+  if (errno != 0)
+    throw Error(fmt::format("{}: HDF5 error: {}: {}", path, what, std::strerror(errno)));
+  throw Error(fmt::format("{}: HDF5 error: {}", path, what));
 }
 
 Handle checked(hid_t id, Handle::Closer closer, const std::string& what, const std::string& path) {
@@ -76,6 +81,7 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
   Handle set = checked(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
                                   dcpl.id(), H5P_DEFAULT),
                        H5Dclose, "cannot create " + name, path);
+  errno = 0;
   check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
         "cannot write " + name, path);
 }
@@ -152,47 +158,41 @@ Handle::~Handle() {
   if (id_ >= 0 && closer_) closer_(id_);
 }
 
+void prepare_hdf5() {
+  // Before any other HDF5 call: no library cleanup at exit (see
+  // abandon_written_file); every file fiberlab completes is closed explicitly.
+  H5dont_atexit();
+  quiet_hdf5_errors();
+}
+
 void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
 namespace {
 
-// Writes a finished file image with POSIX calls, so that a disk error (ENOSPC,
-// EIO) is reported here as one line and never reaches HDF5.
-void write_image(const std::string& path, const std::vector<char>& image) {
-  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0666);
-  if (fd < 0) throw Error(fmt::format("{}: cannot create file: {}", path, std::strerror(errno)));
-  std::size_t done = 0;
-  while (done < image.size()) {
-    const ssize_t n = ::write(fd, image.data() + done, image.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const int err = n < 0 ? errno : EIO;
-      ::close(fd);
-      throw Error(fmt::format("{}: cannot write the file ({} of {} bytes written): {}", path, done,
-                              image.size(), std::strerror(err)));
-    }
-    done += static_cast<std::size_t>(n);
-  }
-  if (::close(fd) != 0)
-    throw Error(fmt::format("{}: cannot write the file: {}", path, std::strerror(errno)));
+// Closes a file being written that was not close()d: an error ended the
+// write (e.g. a full disk). Its contents are dropped first (ftruncate frees
+// the space; the file is a temporary that AtomicOutput removes) so that the
+// close has room for the little metadata HDF5 still flushes. Should the close
+// fail anyway, HDF5 keeps the id and would crash retrying at exit:
+// prepare_hdf5() turns that exit-time cleanup off.
+herr_t abandon_written_file(hid_t id) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(id, H5P_DEFAULT, &handle) >= 0 && handle)
+    if (ftruncate(*static_cast<int*>(handle), 0) != 0) { /* H5Fclose below reports */ }
+  return H5Fclose(id);
 }
 
 }  // namespace
 
 File File::create(const std::string& path) {
   quiet_hdf5_errors();
-  // The file is built in memory (HDF5's core driver, no backing store) and
-  // written out by close(): HDF5 never meets a disk error. With the sec2
-  // driver a full disk made H5Fclose fail, left the id registered, and
-  // HDF5 crashed at exit trying to close it again.
+  // H5F_CLOSE_STRONG: closing the file also closes any dataset or group whose
+  // own close failed, so nothing of it is left open.
   Handle fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "property list", path);
-  check(H5Pset_fapl_core(fapl.id(), std::size_t{1} << 20, false), "core driver", path);
   H5Pset_fclose_degree(fapl.id(), H5F_CLOSE_STRONG);
   hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id());
-  if (id < 0) throw Error(fmt::format("{}: cannot create file", path));
-  File f(Handle(id, H5Fclose), path);
-  f.in_memory_ = true;
-  return f;
+  if (id < 0) throw Error(fmt::format("{}: cannot create file (is the folder writable?)", path));
+  return File(Handle(id, abandon_written_file), path);
 }
 
 File File::open_read(const std::string& path) {
@@ -204,18 +204,11 @@ File File::open_read(const std::string& path) {
 
 void File::close() {
   if (handle_.id() < 0) return;
-  check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "flush", path_);
-  if (!in_memory_) {
-    handle_ = Handle();
-    return;
-  }
-  const ssize_t size = H5Fget_file_image(handle_.id(), nullptr, 0);
-  if (size < 0) throw Error(fmt::format("{}: HDF5 error: cannot get the file image", path_));
-  std::vector<char> image(static_cast<std::size_t>(size));
-  if (H5Fget_file_image(handle_.id(), image.data(), image.size()) != size)
-    throw Error(fmt::format("{}: HDF5 error: cannot get the file image", path_));
-  handle_ = Handle();  // in memory: closing cannot fail on a disk
-  write_image(path_, image);
+  errno = 0;
+  check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "cannot write the file", path_);
+  const hid_t id = handle_.id();
+  handle_.release();
+  check(H5Fclose(id), "cannot close the file", path_);
 }
 
 void File::create_group(const std::string& name) {

@@ -33,9 +33,9 @@ using Dims = std::vector<hsize_t>;
 
 class File {
  public:
-  // Built in memory and written to `path` (truncated) by close(); a file
-  // destroyed without close() (an exception during the write) is never
-  // written. Disk errors are thrown by close() naming the file.
+  // Truncates. A created file must be close()d: one destroyed without it
+  // (an exception during the write, e.g. a full disk) is abandoned, its
+  // contents dropped. Disk errors are thrown naming the file and errno.
   static File create(const std::string& path);
   static File open_read(const std::string& path);
   const std::string& path() const { return path_; }
@@ -93,8 +93,11 @@ class File {
   File(Handle h, std::string path) : handle_(std::move(h)), path_(std::move(path)) {}
   Handle handle_;
   std::string path_;
-  bool in_memory_ = false;  // created: written out by close()
 };
+
+// Called first in main(): turns HDF5's exit-time cleanup off (it crashes on a
+// file whose close failed on a full disk) and silences its error printing.
+void prepare_hdf5();
 
 // Silences HDF5's automatic error stack printing; fiberlab reports its own.
 void quiet_hdf5_errors();
