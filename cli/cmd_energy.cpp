@@ -8,7 +8,11 @@
 // in memory, with the config's photons or --photons).
 #include <fmt/core.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <memory>
 #include <sstream>
@@ -21,6 +25,7 @@
 #include "compare/energy.h"
 #include "compare/models.h"
 #include "compare/report.h"
+#include "sim/memory_budget.h"
 #include "sim/result_file.h"
 #include "sim/settings.h"
 #include "sim/simulation.h"
@@ -34,31 +39,78 @@ struct EnergyOptions {
   std::vector<std::string> settings;
   std::string beta_sweep, theta_i, report;
   bool run = false;
-  long long photons = -1;
-  int threads = 0, channel = 0, n_theta = 180, n_phi = 90;
+  std::string photons, threads;  // checked by sim::parse_integer_flag
+  int channel = 0, n_theta = 180, n_phi = 90;
 };
 
-std::vector<double> parse_degrees(const std::string& option, const std::string& text) {
-  std::vector<double> out;
-  const auto colon = text.find(':');
-  try {
-    if (colon != std::string::npos) {  // from:to:step
-      std::vector<double> v;
-      std::string part;
-      std::istringstream in(text);
-      while (std::getline(in, part, ':')) v.push_back(std::stod(part));
-      if (v.size() != 3 || !(v[2] > 0) || v[1] < v[0]) throw std::invalid_argument("range");
-      for (double x = v[0]; x <= v[1] + 1e-9 * v[2]; x += v[2]) out.push_back(deg_to_rad(x));
-    } else {
-      std::string part;
-      std::istringstream in(text);
-      while (std::getline(in, part, ','))
-        if (!part.empty()) out.push_back(deg_to_rad(std::stod(part)));
-    }
-  } catch (const std::exception&) {
-    throw Error(fmt::format("{} '{}': expected degrees A,B,C or FROM:TO:STEP", option, text));
+constexpr std::size_t kMaxSweep = 100000;  // as a config's theta_i range (configs/README.md)
+constexpr int kMaxGridCells = 4000000;    // --grid-theta x --grid-phi
+
+// An allowed interval of degrees, and how it is said in an error.
+struct DegreeRange {
+  double lo, hi;
+  bool lo_open, hi_open;
+  const char* text;
+  bool contains(double x) const {
+    return (lo_open ? x > lo : x >= lo) && (hi_open ? x < hi : x <= hi);
   }
-  if (out.empty()) throw Error(fmt::format("{} '{}': no values", option, text));
+};
+constexpr DegreeRange kThetaIRange{-90, 90, true, true, "each in (-90, 90) degrees"};
+constexpr DegreeRange kBetaRange{0, 90, false, false, "each in [0, 90] degrees"};
+
+// One finite number, the whole text (strtod alone accepts "95abc", "nan", "inf").
+double parse_number(const std::string& option, const std::string& text, const std::string& part,
+                    const char* rule) {
+  char* end = nullptr;
+  const double x = part.empty() ? NAN : std::strtod(part.c_str(), &end);
+  if (part.empty() || end != part.c_str() + part.size() || !std::isfinite(x))
+    throw Error(fmt::format("command line: {} '{}': '{}' is not a finite number (expected degrees "
+                            "A,B,C or FROM:TO:STEP, {})", option, text, part, rule));
+  return x;
+}
+
+std::vector<std::string> split(const std::string& text, char sep) {
+  std::vector<std::string> parts;
+  std::string part;
+  std::istringstream in(text);
+  while (std::getline(in, part, sep)) parts.push_back(part);
+  return parts;
+}
+
+std::vector<double> parse_degrees(const std::string& option, const std::string& text,
+                                  const DegreeRange& range) {
+  const std::string usage = fmt::format("expected degrees A,B,C or FROM:TO:STEP, {}", range.text);
+  std::vector<double> degrees;
+  if (text.find(':') != std::string::npos) {
+    const std::vector<std::string> p = split(text, ':');
+    if (p.size() != 3)
+      throw Error(fmt::format("command line: {} '{}': {}", option, text, usage));
+    const double from = parse_number(option, text, p[0], range.text);
+    const double to = parse_number(option, text, p[1], range.text);
+    const double step = parse_number(option, text, p[2], range.text);
+    if (!(step > 0) || to < from)
+      throw Error(fmt::format("command line: {} '{}': needs FROM <= TO and STEP > 0", option, text));
+    const double count = std::floor((to - from) / step + 1e-9) + 1.0;
+    if (!(count <= static_cast<double>(kMaxSweep)))
+      throw Error(fmt::format("command line: {} '{}' gives {:.3g} angles (at most {})", option, text,
+                              count, kMaxSweep));
+    for (std::size_t i = 0; i < static_cast<std::size_t>(count); ++i)
+      degrees.push_back(std::min(from + static_cast<double>(i) * step, to));
+  } else {
+    for (const std::string& part : split(text, ','))
+      if (!part.empty()) degrees.push_back(parse_number(option, text, part, range.text));
+    if (degrees.size() > kMaxSweep)
+      throw Error(fmt::format("command line: {} gives {} angles (at most {})", option,
+                              degrees.size(), kMaxSweep));
+  }
+  if (degrees.empty()) throw Error(fmt::format("command line: {} '{}': no values ({})", option, text, usage));
+  std::vector<double> out;
+  for (double d : degrees) {
+    if (!range.contains(d))
+      throw Error(fmt::format("command line: {} '{}': {} is out of range ({})", option, text, d,
+                              range.text));
+    out.push_back(deg_to_rad(d));
+  }
   return out;
 }
 
@@ -111,8 +163,10 @@ std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
       errors, arr(total), arr(total_err), arr(three), arr(absorbed), arr(truncated), arr(ledger));
 }
 
-void energy_command(const EnergyOptions& o) {
-  if (o.n_theta < 1 || o.n_phi < 1) throw Error("--grid: both sizes must be >= 1");
+void energy_command(const EnergyOptions& o, bool photons_given) {
+  if (o.n_theta < 1 || o.n_phi < 1 || o.n_theta > kMaxGridCells / o.n_phi)
+    throw Error(fmt::format("command line: --grid-theta = {} x --grid-phi = {} is out of range (each "
+                            ">= 1, product at most {})", o.n_theta, o.n_phi, kMaxGridCells));
   const bool from_result = is_hdf5_file(o.input);
   sim::ResultFile result;
   sim::Settings settings;
@@ -125,15 +179,19 @@ void energy_command(const EnergyOptions& o) {
     simulated = true;
   } else {
     settings = sim::load_settings(o.input);
-    if (o.photons == 0 || o.photons < -1) throw Error(fmt::format("--photons = {} must be >= 1", o.photons));
-    if (o.photons > 0) settings.photons = static_cast<std::uint64_t>(o.photons);
+    if (photons_given)
+      settings.photons = sim::parse_integer_flag("--photons", o.photons, 1, ~std::uint64_t{0});
     if (!o.theta_i.empty()) {
       if (o.run) throw Error("--theta-i cannot be combined with --run (edit the config's theta_i)");
-      settings.source.theta_i = parse_degrees("--theta-i", o.theta_i);
+      settings.source.theta_i = parse_degrees("--theta-i", o.theta_i, kThetaIRange);
     }
     if (o.run) {
+      const int threads =
+          o.threads.empty() ? std::min(omp_get_max_threads(), sim::kMaxThreads)
+                            : static_cast<int>(sim::parse_integer_flag("--threads", o.threads, 1, sim::kMaxThreads));
+      sim::check_memory_budget(settings, threads);
       const sim::Simulation simulation(settings);
-      result = sim::make_result(simulation.settings(), simulation.grid(), simulation.run(o.threads));
+      result = sim::make_result(simulation.settings(), simulation.grid(), simulation.run(threads));
       simulated = true;
     }
   }
@@ -149,7 +207,7 @@ void energy_command(const EnergyOptions& o) {
   std::vector<compare::EnergyCurve> curves;
   if (simulated) curves.push_back(compare::simulation_energy(result));
   std::vector<double> betas;
-  if (!o.beta_sweep.empty()) betas = parse_degrees("--beta-sweep", o.beta_sweep);
+  if (!o.beta_sweep.empty()) betas = parse_degrees("--beta-sweep", o.beta_sweep, kBetaRange);
   for (const std::string& m : split_commas(o.models)) {
     const compare::ModelSpec spec = compare::parse_model_spec(m);
     const analytic::ModelParams base = compare::params_for(settings, spec, o.settings);
@@ -256,13 +314,13 @@ void add_energy_command(CLI::App& app) {
                   "Evaluate each model at these beta_long (degrees, every lobe), as in d'Eon 2011 Fig. 3");
   cmd->add_option("--theta-i", o->theta_i, "Config only: model theta_i, degrees A,B,C or FROM:TO:STEP");
   cmd->add_flag("--run", o->run, "Config only: run the simulation too (in memory)");
-  cmd->add_option("--photons", o->photons, "With --run: photons per incident direction");
+  CLI::Option* photons = cmd->add_option("--photons", o->photons, "With --run: photons per incident direction");
   cmd->add_option("--threads", o->threads, "With --run: OpenMP threads");
   cmd->add_option("--channel", o->channel, "Channel shown in the table and plots (0)");
   cmd->add_option("--grid-theta", o->n_theta, "theta bins of the models' integration grid (180)");
   cmd->add_option("--grid-phi", o->n_phi, "phi bins of the models' integration grid (90)");
   cmd->add_option("--report", o->report, "Write a report folder (report.md, metrics.csv/json, PNG plots)");
-  cmd->callback([o] { energy_command(*o); });
+  cmd->callback([o, photons] { energy_command(*o, photons->count() > 0); });
 }
 
 }  // namespace fiberlab::cli

@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "cli/commands.h"
+#include "common/atomic_output.h"
 #include "common/error.h"
 #include "sim/result_file.h"
 
@@ -19,10 +20,11 @@ struct MergeOptions {
 
 void merge(const MergeOptions& o) {
   if (o.inputs.size() < 2) throw Error("merge: give at least two result files");
+  check_output_target(o.output, o.inputs);  // before reading: not onto an input, a FIFO, ...
   std::vector<sim::ResultFile> parts;
   for (const std::string& p : o.inputs) parts.push_back(sim::read_result(p));
   const sim::ResultFile merged = sim::merge_results(parts, o.inputs);
-  sim::write_result(merged, o.output);
+  sim::write_result(merged, o.output, o.inputs);
   fmt::print("merged {} files ({} photons per incident direction) into {}\n", parts.size(),
              merged.photons.front(), o.output);
 }

@@ -42,7 +42,7 @@ void predict(const PredictOptions& o) {
   const int L = params.lobes, nt = grid.n_theta(), np = grid.n_phi();
   const int C = static_cast<int>(params.sigma_a.size());
   const std::size_t per_k = static_cast<std::size_t>(L) * nt * np * C;
-  AtomicOutput out(o.output);  // checks the folder before the work
+  AtomicOutput out(o.output, {o.input});  // checks the target before the work
 
   std::vector<double> prob(per_k * inc.size(), 0.0);
   std::vector<double> theta_i, phi_i;
@@ -60,7 +60,7 @@ void predict(const PredictOptions& o) {
   write_bins(f, grid);
   write_incidences(f, theta_i, phi_i);
   f.create_group("/prediction");
-  f.write("/prediction/probability",
+  f.write_finite("/prediction/probability",
           {static_cast<hsize_t>(inc.size()), static_cast<hsize_t>(L), static_cast<hsize_t>(nt),
            static_cast<hsize_t>(np), static_cast<hsize_t>(C)},
           prob);

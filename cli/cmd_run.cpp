@@ -1,6 +1,9 @@
 // `fiberlab run CONFIG [-o OUT.h5] [--photons N] [--seed S] [--threads T] [--quiet]`
 #include <fmt/core.h>
 
+#include <omp.h>
+
+#include <algorithm>
 #include <chrono>
 #include <memory>
 
@@ -8,6 +11,7 @@
 #include "cli/summary_table.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "sim/memory_budget.h"
 #include "sim/result_file.h"
 #include "sim/simulation.h"
 
@@ -17,8 +21,8 @@ namespace {
 
 struct RunOptions {
   std::string config, output;
-  long long photons = -1, seed = -1;
-  int threads = 0;
+  std::string photons, seed, threads;  // checked by sim::parse_integer_flag
+  bool output_given = false, photons_given = false, seed_given = false, threads_given = false;
   bool quiet = false;
 };
 
@@ -37,21 +41,42 @@ sim::ProgressCallback progress_printer(bool quiet) {
   };
 }
 
+// --photons, --seed and -o override the config; each is checked like the
+// config's own key (exact integers, no silent clamping, no empty path).
+void apply_run_flags(const RunOptions& o, sim::Settings& settings) {
+  constexpr std::uint64_t kU64Max = ~std::uint64_t{0};
+  if (o.photons_given)
+    settings.photons = sim::parse_integer_flag("--photons", o.photons, 1, kU64Max);
+  if (o.seed_given) settings.seed = sim::parse_integer_flag("--seed", o.seed, 0, kU64Max);
+  if (o.output_given) {
+    if (o.output.empty()) throw Error("command line: -o is empty (must be a file name)");
+    settings.output = o.output;
+  }
+  // photons x incident configurations must fit in uint64 (sim/settings.cpp
+  // checks the config; a flag can raise photons past it).
+  const std::uint64_t k = settings.incidences().size();
+  if (settings.photons > kU64Max / k)
+    throw Error(fmt::format("command line: --photons = {} x {} incident configurations exceeds "
+                            "2^64 - 1 photons in total", settings.photons, k));
+}
+
+// --threads: 1 to sim::kMaxThreads; absent means every core.
+int thread_count(bool given, const std::string& text) {
+  if (!given) return std::min(omp_get_max_threads(), sim::kMaxThreads);
+  return static_cast<int>(sim::parse_integer_flag("--threads", text, 1, sim::kMaxThreads));
+}
+
 void run(const RunOptions& o) {
   sim::Settings settings = sim::load_settings(o.config);
-  if (o.photons == 0 || o.photons < -1)
-    throw Error(fmt::format("--photons = {} is out of range (must be an integer >= 1)", o.photons));
-  if (o.seed < -1) throw Error(fmt::format("--seed = {} is out of range (must be >= 0)", o.seed));
-  if (o.threads < 0) throw Error(fmt::format("--threads = {} is out of range (must be >= 1)", o.threads));
-  if (o.photons > 0) settings.photons = static_cast<std::uint64_t>(o.photons);
-  if (o.seed >= 0) settings.seed = static_cast<std::uint64_t>(o.seed);
-  if (!o.output.empty()) settings.output = o.output;
-  // Check the output path before spending time on photons.
-  { AtomicOutput probe(settings.output); }
+  apply_run_flags(o, settings);
+  const int threads = thread_count(o.threads_given, o.threads);
+  // Check the output path and the memory before spending time on photons.
+  check_output_target(settings.output, {o.config});
+  sim::check_memory_budget(settings, threads);
 
   const sim::Simulation simulation(settings);
   sim::RunStatistics stats;
-  const std::vector<sim::Tally> tallies = simulation.run(o.threads, progress_printer(o.quiet), &stats);
+  const std::vector<sim::Tally> tallies = simulation.run(threads, progress_printer(o.quiet), &stats);
   const sim::ResultFile result = sim::make_result(simulation.settings(), simulation.grid(), tallies);
   sim::write_result(result, settings.output);
   if (!o.quiet) {
@@ -70,12 +95,21 @@ void add_run_command(CLI::App& app) {
   auto o = std::make_shared<RunOptions>();
   CLI::App* cmd = app.add_subcommand("run", "Simulate a fiber config into an HDF5 result file");
   cmd->add_option("config", o->config, "YAML config (see configs/README.md)")->required();
-  cmd->add_option("-o,--output", o->output, "Result file (overrides `output` in the config)");
-  cmd->add_option("--photons", o->photons, "Photons per incident direction (overrides the config)");
-  cmd->add_option("--seed", o->seed, "Random seed (overrides the config)");
-  cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
+  CLI::Option* out =
+      cmd->add_option("-o,--output", o->output, "Result file (overrides `output` in the config)");
+  CLI::Option* photons = cmd->add_option(
+      "--photons", o->photons, "Photons per incident direction, integer >= 1, e.g. 1e6 (overrides the config)");
+  CLI::Option* seed = cmd->add_option("--seed", o->seed, "Random seed in [0, 2^64 - 1] (overrides the config)");
+  CLI::Option* threads = cmd->add_option("--threads", o->threads,
+                  fmt::format("OpenMP threads, 1 to {} (default: all cores)", sim::kMaxThreads));
   cmd->add_flag("--quiet", o->quiet, "No progress and no summary table");
-  cmd->callback([o] { run(*o); });
+  cmd->callback([o, out, photons, seed, threads] {
+    o->threads_given = threads->count() > 0;
+    o->output_given = out->count() > 0;
+    o->photons_given = photons->count() > 0;
+    o->seed_given = seed->count() > 0;
+    run(*o);
+  });
 }
 
 }  // namespace fiberlab::cli

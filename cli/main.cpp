@@ -3,11 +3,14 @@
 
 #include <CLI/CLI.hpp>
 #include <exception>
+#include <new>
 
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/h5_file.h"
 
 int main(int argc, char** argv) {
+  fiberlab::h5::prepare_hdf5();
   CLI::App app{"fiberlab " FIBERLAB_VERSION
                ": Monte Carlo ground truth for light scattering by single fibers"};
   app.set_version_flag("--version", std::string(FIBERLAB_VERSION));
@@ -26,6 +29,10 @@ int main(int argc, char** argv) {
     return status == 0 ? 0 : 2;
   } catch (const fiberlab::Error& e) {
     fmt::print(stderr, "fiberlab: error: {}\n", e.what());
+    return 2;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "fiberlab: error: out of memory (lower the tally size, the incident "
+                       "angles or --threads); no output written\n");
     return 2;
   } catch (const std::exception& e) {
     fmt::print(stderr, "fiberlab: internal error: {}\n", e.what());

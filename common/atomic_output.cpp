@@ -1,9 +1,15 @@
 #include "common/atomic_output.h"
 
+#include <dirent.h>
+#include <fcntl.h>
 #include <fmt/core.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <cerrno>
+#include <csignal>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 
 #include "common/error.h"
@@ -12,18 +18,100 @@ namespace fiberlab {
 
 namespace fs = std::filesystem;
 
-AtomicOutput::AtomicOutput(std::string target) : target_(std::move(target)) {
-  if (target_.empty()) throw Error("output: the output path is empty");
-  const fs::path p(target_);
-  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw Error(fmt::format("output: {}: folder {} does not exist", target_, dir.string()));
-  if (fs::is_directory(p, ec))
-    throw Error(fmt::format("output: {}: is a folder, not a file path", target_));
+namespace {
+
+std::string folder_of(const std::string& target) {
+  const fs::path p(target);
+  return p.has_parent_path() ? p.parent_path().string() : std::string(".");
+}
+
+const char* file_kind(mode_t mode) {
+  if (S_ISDIR(mode)) return "a folder";
+  if (S_ISFIFO(mode)) return "a FIFO (named pipe)";
+  if (S_ISCHR(mode)) return "a character device";
+  if (S_ISBLK(mode)) return "a block device";
+  if (S_ISSOCK(mode)) return "a socket";
+  if (S_ISLNK(mode)) return "a symbolic link";
+  return "not a regular file";
+}
+
+[[noreturn]] void refuse(const std::string& target, const std::string& why) {
+  throw Error(fmt::format("output: {}: {}", target, why));
+}
+
+void check_not_an_input(const std::string& target, const struct stat& out,
+                        const std::vector<std::string>& inputs) {
+  for (const std::string& in : inputs) {
+    struct stat st {};
+    if (stat(in.c_str(), &st) == 0 && st.st_dev == out.st_dev && st.st_ino == out.st_ino)
+      refuse(target, fmt::format("is the input file {} (it would be overwritten; give another "
+                                 "output path)", in));
+  }
+}
+
+// .NAME.tmp-PID files of this target whose process is gone.
+void remove_stale_temporaries(const std::string& dir, const std::string& name) {
+  const std::string prefix = "." + name + ".tmp-";
+  DIR* d = opendir(dir.c_str());
+  if (!d) return;
+  while (const dirent* e = readdir(d)) {
+    const std::string entry = e->d_name;
+    if (entry.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = entry.substr(prefix.size());
+    if (digits.empty() || digits.size() > 9 ||
+        digits.find_first_not_of("0123456789") != std::string::npos)
+      continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == getpid()) continue;
+    if (kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
+    unlink((fs::path(dir) / entry).c_str());
+  }
+  closedir(d);
+}
+
+void fsync_path(const std::string& path, int flags, const std::string& target, const char* what) {
+  const int fd = open(path.c_str(), flags);
+  if (fd < 0) refuse(target, fmt::format("cannot open {} to flush it: {}", what, std::strerror(errno)));
+  const int rc = fsync(fd);
+  const int err = errno;
+  close(fd);
+  // Folders on some file systems do not support fsync (EINVAL): nothing to flush there.
+  if (rc != 0 && !(err == EINVAL && (flags & O_DIRECTORY)))
+    refuse(target, fmt::format("cannot flush {} to disk: {}", what, std::strerror(err)));
+}
+
+}  // namespace
+
+void check_output_target(const std::string& target, const std::vector<std::string>& inputs) {
+  if (target.empty()) throw Error("output: the output path is empty (give a file name)");
+  const std::string dir = folder_of(target);
+  struct stat st {};
+  if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))
+    refuse(target, fmt::format("folder {} does not exist", dir));
   if (access(dir.c_str(), W_OK) != 0)
-    throw Error(fmt::format("output: {}: folder {} is not writable", target_, dir.string()));
-  temp_ = (dir / fmt::format(".{}.tmp-{}", p.filename().string(), getpid())).string();
+    refuse(target, fmt::format("folder {} is not writable", dir));
+  if (lstat(target.c_str(), &st) != 0) {
+    if (errno == ENOENT) return;
+    refuse(target, fmt::format("cannot inspect: {}", std::strerror(errno)));
+  }
+  if (!S_ISREG(st.st_mode))
+    refuse(target, fmt::format("is {}; the output must be a regular file or not exist yet",
+                               file_kind(st.st_mode)));
+  // The mode bits, not access(): root may write anything, but a file made
+  // read-only by its owner is not to be replaced.
+  if ((st.st_mode & (S_IWUSR | S_IWGRP | S_IWOTH)) == 0 || access(target.c_str(), W_OK) != 0)
+    refuse(target, "exists and is read-only (remove it or make it writable to replace it)");
+  check_not_an_input(target, st, inputs);
+}
+
+AtomicOutput::AtomicOutput(std::string target, const std::vector<std::string>& inputs)
+    : target_(std::move(target)) {
+  check_output_target(target_, inputs);
+  dir_ = folder_of(target_);
+  const std::string name = fs::path(target_).filename().string();
+  remove_stale_temporaries(dir_, name);
+  temp_ = (fs::path(dir_) / fmt::format(".{}.tmp-{}", name, getpid())).string();
+  guard_.emplace(temp_);
 }
 
 AtomicOutput::~AtomicOutput() {
@@ -31,11 +119,12 @@ AtomicOutput::~AtomicOutput() {
 }
 
 void AtomicOutput::commit() {
-  std::error_code ec;
-  fs::rename(temp_, target_, ec);
-  if (ec) throw Error(fmt::format("output: {}: cannot rename the finished file: {}", target_,
-                                  ec.message()));
+  fsync_path(temp_, O_RDONLY, target_, "the temporary file");
+  if (std::rename(temp_.c_str(), target_.c_str()) != 0)
+    refuse(target_, fmt::format("cannot rename the finished file: {}", std::strerror(errno)));
   committed_ = true;
+  guard_.reset();
+  fsync_path(dir_, O_RDONLY | O_DIRECTORY, target_, "its folder");
 }
 
 }  // namespace fiberlab

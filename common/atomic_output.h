@@ -1,26 +1,45 @@
 #pragma once
 // A result file is written completely or not at all (SPEC section 9): write
-// to a temporary name in the same folder, then rename over the target.
+// to a temporary name in the same folder (.NAME.tmp-PID), flush it to disk,
+// then rename it over the target.
+//
+// The temporary file is removed on every way out: an exception (destructor),
+// SIGINT/SIGTERM during the write (a TempFileGuard, common/interrupt.h).
+// Temporary files of the same target left by processes that no longer exist
+// (a crash, SIGKILL) are removed when the next AtomicOutput for that target
+// is made.
+#include <optional>
 #include <string>
+#include <vector>
+
+#include "common/interrupt.h"
 
 namespace fiberlab {
 
 class AtomicOutput {
  public:
-  // Checks that the target's folder exists and is writable; throws
-  // fiberlab::Error naming the path otherwise.
-  explicit AtomicOutput(std::string target);
+  // Checks the target before any work: a non-empty path whose folder exists
+  // and is writable; if it exists, a writable regular file (not a folder, a
+  // FIFO, a device, a socket or a symbolic link) that is none of `inputs`
+  // (the files the command reads). Throws fiberlab::Error naming the path.
+  explicit AtomicOutput(std::string target, const std::vector<std::string>& inputs = {});
   ~AtomicOutput();  // removes the temporary file unless commit() ran
   AtomicOutput(const AtomicOutput&) = delete;
   AtomicOutput& operator=(const AtomicOutput&) = delete;
 
   const std::string& temp_path() const { return temp_; }
   const std::string& target() const { return target_; }
-  void commit();  // rename temp -> target
+  // fsync the temporary file, rename it to the target, fsync the folder.
+  // The temporary file must be closed (HDF5 file closed) before.
+  void commit();
 
  private:
-  std::string target_, temp_;
+  std::string target_, temp_, dir_;
+  std::optional<TempFileGuard> guard_;
   bool committed_ = false;
 };
+
+// The same checks as AtomicOutput's constructor, without creating anything.
+void check_output_target(const std::string& target, const std::vector<std::string>& inputs = {});
 
 }  // namespace fiberlab

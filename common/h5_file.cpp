@@ -2,14 +2,38 @@
 
 #include <fmt/core.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
+#include <cmath>
+
 #include "common/error.h"
 
 namespace fiberlab::h5 {
 
 namespace {
 
+// A fixed-length string attribute longer than this is refused before it is
+// read (a crafted file can declare any length).
+constexpr std::size_t kMaxStringBytes = 64u << 20;
+
+std::string shape_text(const Dims& dims) {
+  if (dims.empty()) return "a scalar";
+  std::string s;
+  for (std::size_t i = 0; i < dims.size(); ++i) s += fmt::format("{}{}", i ? " x " : "", dims[i]);
+  return s;
+}
+
+// A failed write usually comes from the system (errno ENOSPC: disk full,
+// EDQUOT, EIO): say so when errno was set.
 void check(herr_t status, const std::string& what, const std::string& path) {
-  if (status < 0) throw Error(fmt::format("{}: HDF5 error: {}", path, what));
+  if (status >= 0) return;
+  if (errno != 0)
+    throw Error(fmt::format("{}: HDF5 error: {}: {}", path, what, std::strerror(errno)));
+  throw Error(fmt::format("{}: HDF5 error: {}", path, what));
 }
 
 Handle checked(hid_t id, Handle::Closer closer, const std::string& what, const std::string& path) {
@@ -57,6 +81,7 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
   Handle set = checked(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
                                   dcpl.id(), H5P_DEFAULT),
                        H5Dclose, "cannot create " + name, path);
+  errno = 0;
   check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
         "cannot write " + name, path);
 }
@@ -77,6 +102,35 @@ std::vector<T> read_dataset(hid_t file, const std::string& path, const std::stri
         "cannot read " + name, path);
   if (dims_out) *dims_out = dims;
   return data;
+}
+
+Dims dataset_shape(hid_t file, const std::string& path, const std::string& name) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 0) throw Error(fmt::format("{}: {} has an unreadable dataspace", path, name));
+  Dims dims(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  return dims;
+}
+
+void check_shape(hid_t file, const std::string& path, const std::string& name,
+                 const Dims& expected, const std::string& meaning) {
+  const Dims dims = dataset_shape(file, path, name);
+  if (dims != expected)
+    throw Error(fmt::format("{}: {} has shape {} (must be {}: {})", path, name, shape_text(dims),
+                            shape_text(expected), meaning));
+}
+
+H5T_class_t dataset_class(hid_t file, const std::string& path, const std::string& name,
+                          H5T_sign_t* sign) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle type = checked(H5Dget_type(set.id()), H5Tclose, "type of " + name, path);
+  const H5T_class_t c = H5Tget_class(type.id());
+  if (sign) *sign = c == H5T_INTEGER ? H5Tget_sign(type.id()) : H5T_SGN_NONE;
+  return c;
 }
 
 void write_attr(hid_t file, const std::string& path, const std::string& obj,
@@ -104,13 +158,41 @@ Handle::~Handle() {
   if (id_ >= 0 && closer_) closer_(id_);
 }
 
+void prepare_hdf5() {
+  // Before any other HDF5 call: no library cleanup at exit (see
+  // abandon_written_file); every file fiberlab completes is closed explicitly.
+  H5dont_atexit();
+  quiet_hdf5_errors();
+}
+
 void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+
+namespace {
+
+// Closes a file being written that was not close()d: an error ended the
+// write (e.g. a full disk). Its contents are dropped first (ftruncate frees
+// the space; the file is a temporary that AtomicOutput removes) so that the
+// close has room for the little metadata HDF5 still flushes. Should the close
+// fail anyway, HDF5 keeps the id and would crash retrying at exit:
+// prepare_hdf5() turns that exit-time cleanup off.
+herr_t abandon_written_file(hid_t id) {
+  void* handle = nullptr;
+  if (H5Fget_vfd_handle(id, H5P_DEFAULT, &handle) >= 0 && handle)
+    if (ftruncate(*static_cast<int*>(handle), 0) != 0) { /* H5Fclose below reports */ }
+  return H5Fclose(id);
+}
+
+}  // namespace
 
 File File::create(const std::string& path) {
   quiet_hdf5_errors();
-  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  // H5F_CLOSE_STRONG: closing the file also closes any dataset or group whose
+  // own close failed, so nothing of it is left open.
+  Handle fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "property list", path);
+  H5Pset_fclose_degree(fapl.id(), H5F_CLOSE_STRONG);
+  hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id());
   if (id < 0) throw Error(fmt::format("{}: cannot create file (is the folder writable?)", path));
-  return File(Handle(id, H5Fclose), path);
+  return File(Handle(id, abandon_written_file), path);
 }
 
 File File::open_read(const std::string& path) {
@@ -121,8 +203,12 @@ File File::open_read(const std::string& path) {
 }
 
 void File::close() {
-  if (handle_.id() >= 0) check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "flush", path_);
-  handle_ = Handle();
+  if (handle_.id() < 0) return;
+  errno = 0;
+  check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "cannot write the file", path_);
+  const hid_t id = handle_.id();
+  handle_.release();
+  check(H5Fclose(id), "cannot close the file", path_);
 }
 
 void File::create_group(const std::string& name) {
@@ -151,12 +237,118 @@ void File::write(const std::string& name, const Dims& dims,
   write_dataset(handle_.id(), path_, name, dims, data, H5T_NATIVE_UINT64, H5T_STD_U64LE);
 }
 
+void File::write_finite(const std::string& name, const Dims& dims, const std::vector<double>& data) {
+  for (std::size_t i = 0; i < data.size(); ++i)
+    if (!std::isfinite(data[i]))
+      throw Error(fmt::format("{}: {} would hold {} at flat index {} (values must be finite; "
+                              "nothing written)", path_, name, data[i], i));
+  write(name, dims, data);
+}
+
 std::vector<double> File::read_doubles(const std::string& name, Dims* dims) const {
   return read_dataset<double>(handle_.id(), path_, name, dims, H5T_NATIVE_DOUBLE);
 }
 
 std::vector<std::uint64_t> File::read_uint64s(const std::string& name, Dims* dims) const {
   return read_dataset<std::uint64_t>(handle_.id(), path_, name, dims, H5T_NATIVE_UINT64);
+}
+
+Dims File::shape(const std::string& name) const { return dataset_shape(handle_.id(), path_, name); }
+
+std::vector<double> File::read_doubles(const std::string& name, const Dims& expected,
+                                       const std::string& meaning) const {
+  check_shape(handle_.id(), path_, name, expected, meaning);
+  const H5T_class_t c = dataset_class(handle_.id(), path_, name, nullptr);
+  if (c != H5T_FLOAT && c != H5T_INTEGER)
+    throw Error(fmt::format("{}: {} does not hold numbers (must be float64)", path_, name));
+  return read_doubles(name);
+}
+
+std::vector<std::uint64_t> File::read_uint64s(const std::string& name, const Dims& expected,
+                                              const std::string& meaning) const {
+  check_shape(handle_.id(), path_, name, expected, meaning);
+  H5T_sign_t sign = H5T_SGN_NONE;
+  if (dataset_class(handle_.id(), path_, name, &sign) != H5T_INTEGER)
+    throw Error(fmt::format("{}: {} does not hold integers (must be uint64)", path_, name));
+  if (sign != H5T_SGN_2) return read_uint64s(name);
+  // A signed dataset (e.g. written by h5py from int64): read it as such and
+  // refuse negative counts rather than let HDF5 clip them.
+  const std::vector<std::int64_t> v =
+      read_dataset<std::int64_t>(handle_.id(), path_, name, nullptr, H5T_NATIVE_INT64);
+  std::vector<std::uint64_t> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (v[i] < 0)
+      throw Error(fmt::format("{}: {} holds the negative count {} at flat index {} (must be >= 0)",
+                              path_, name, v[i], i));
+    out[i] = static_cast<std::uint64_t>(v[i]);
+  }
+  return out;
+}
+
+void File::set_attr(const std::string& obj, const std::string& name, std::uint64_t value) {
+  Handle space = checked(H5Screate(H5S_SCALAR), H5Sclose, "scalar space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_STD_U64LE, space.id(), &value);
+}
+
+void File::set_attr(const std::string& obj, const std::string& name,
+                    const std::vector<std::uint64_t>& value) {
+  hsize_t n = value.size();
+  Handle space = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "array space", path_);
+  write_attr(handle_.id(), path_, obj, name, H5T_STD_U64LE, space.id(), value.data());
+}
+
+std::uint64_t File::attr_size(const std::string& obj, const std::string& name) const {
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
+  const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  if (n < 0) throw Error(fmt::format("{}: attribute {}@{} has an unreadable dataspace", path_, obj, name));
+  return static_cast<std::uint64_t>(n);
+}
+
+std::uint64_t File::attr_uint64(const std::string& obj, const std::string& name) const {
+  const std::string what = obj + "@" + name;
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {} is not a single value (must be one uint64)", path_, what));
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle type = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
+  if (H5Tget_class(type.id()) != H5T_INTEGER)
+    throw Error(fmt::format("{}: attribute {} is not an integer (must be uint64)", path_, what));
+  if (H5Tget_sign(type.id()) == H5T_SGN_2) {
+    std::int64_t v = 0;
+    check(H5Aread(a.id(), H5T_NATIVE_INT64, &v), "cannot read " + what, path_);
+    return static_cast<std::uint64_t>(v);  // the bits of fiberlab 0.1's int64 seed
+  }
+  std::uint64_t v = 0;
+  check(H5Aread(a.id(), H5T_NATIVE_UINT64, &v), "cannot read " + what, path_);
+  return v;
+}
+
+std::vector<std::uint64_t> File::attr_uint64s(const std::string& obj, const std::string& name,
+                                              std::size_t max_count) const {
+  const std::string what = obj + "@" + name;
+  const std::uint64_t n = attr_size(obj, name);
+  if (n < 1 || n > max_count)
+    throw Error(fmt::format("{}: attribute {} holds {} values (must hold 1 to {})", path_, what, n,
+                            max_count));
+  Handle a = open_attr(handle_.id(), obj, name, path_);
+  Handle type = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
+  const H5T_class_t c = H5Tget_class(type.id());
+  std::vector<std::uint64_t> out(n);
+  if (c == H5T_INTEGER && H5Tget_sign(type.id()) != H5T_SGN_2) {
+    check(H5Aread(a.id(), H5T_NATIVE_UINT64, out.data()), "cannot read " + what, path_);
+    return out;
+  }
+  if (c != H5T_FLOAT && c != H5T_INTEGER)
+    throw Error(fmt::format("{}: attribute {} does not hold integers (must be uint64)", path_, what));
+  std::vector<double> v(n);
+  check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, v.data()), "cannot read " + what, path_);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!(v[i] >= 0.0 && v[i] < 18446744073709551616.0 && v[i] == std::floor(v[i])))
+      throw Error(fmt::format("{}: attribute {} holds {} (must hold integers in [0, 2^64 - 1])",
+                              path_, what, v[i]));
+    out[i] = static_cast<std::uint64_t>(v[i]);
+  }
+  return out;
 }
 
 void File::set_attr(const std::string& obj, const std::string& name, const std::string& value) {
@@ -195,6 +387,8 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
   Handle ftype = checked(H5Aget_type(a.id()), H5Tclose, "attribute type", path_);
   if (H5Tget_class(ftype.id()) != H5T_STRING)
     throw Error(fmt::format("{}: attribute {}@{} is not a string", path_, obj, name));
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single string", path_, obj, name));
   if (H5Tis_variable_str(ftype.id()) > 0) {
     Handle mtype = checked(H5Tcopy(H5T_C_S1), H5Tclose, "string type", path_);
     H5Tset_size(mtype.id(), H5T_VARIABLE);
@@ -207,6 +401,9 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
     return s;
   }
   const std::size_t n = H5Tget_size(ftype.id());
+  if (n > kMaxStringBytes)
+    throw Error(fmt::format("{}: attribute {}@{} is a string longer than {} bytes", path_, obj,
+                            name, kMaxStringBytes));
   std::string s(n, '\0');
   check(H5Aread(a.id(), ftype.id(), s.data()), "cannot read " + name, path_);
   s.resize(s.find('\0') == std::string::npos ? n : s.find('\0'));
@@ -214,6 +411,8 @@ std::string File::attr_string(const std::string& obj, const std::string& name) c
 }
 
 double File::attr_double(const std::string& obj, const std::string& name) const {
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single number", path_, obj, name));
   Handle a = open_attr(handle_.id(), obj, name, path_);
   double v = 0;
   check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, &v), "cannot read " + name, path_);
@@ -221,6 +420,8 @@ double File::attr_double(const std::string& obj, const std::string& name) const 
 }
 
 std::int64_t File::attr_int(const std::string& obj, const std::string& name) const {
+  if (attr_size(obj, name) != 1)
+    throw Error(fmt::format("{}: attribute {}@{} is not a single number", path_, obj, name));
   Handle a = open_attr(handle_.id(), obj, name, path_);
   std::int64_t v = 0;
   check(H5Aread(a.id(), H5T_NATIVE_INT64, &v), "cannot read " + name, path_);
@@ -231,6 +432,9 @@ std::vector<double> File::attr_doubles(const std::string& obj, const std::string
   Handle a = open_attr(handle_.id(), obj, name, path_);
   Handle space = checked(H5Aget_space(a.id()), H5Sclose, "space", path_);
   const hssize_t n = H5Sget_simple_extent_npoints(space.id());
+  if (n < 0 || n > (hssize_t{1} << 24))
+    throw Error(fmt::format("{}: attribute {}@{} declares {} values (at most 2^24 are read)", path_,
+                            obj, name, n));
   std::vector<double> v(static_cast<std::size_t>(n));
   check(H5Aread(a.id(), H5T_NATIVE_DOUBLE, v.data()), "cannot read " + name, path_);
   return v;

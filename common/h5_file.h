@@ -22,6 +22,7 @@ class Handle {
   Handle& operator=(Handle&& o) noexcept;
   ~Handle();
   hid_t id() const { return id_; }
+  void release() { id_ = -1; }  // the caller closes the id
 
  private:
   hid_t id_ = -1;
@@ -32,35 +33,71 @@ using Dims = std::vector<hsize_t>;
 
 class File {
  public:
-  static File create(const std::string& path);  // truncates
+  // Truncates. A created file must be close()d: one destroyed without it
+  // (an exception during the write, e.g. a full disk) is abandoned, its
+  // contents dropped. Disk errors are thrown naming the file and errno.
+  static File create(const std::string& path);
   static File open_read(const std::string& path);
   const std::string& path() const { return path_; }
-  void close();
+  void close();  // flush and close; throws naming the file (e.g. disk full)
 
   void create_group(const std::string& name);
   bool exists(const std::string& name) const;  // a link at this path
 
   void write(const std::string& name, const Dims& dims, const std::vector<double>& data);
   void write(const std::string& name, const Dims& dims, const std::vector<std::uint64_t>& data);
+  // As write(), after checking that every value is finite: a NaN or an
+  // infinity (e.g. a model evaluated far outside its domain) is refused with
+  // one line naming the dataset and the first bad value, and nothing is written.
+  void write_finite(const std::string& name, const Dims& dims, const std::vector<double>& data);
   std::vector<double> read_doubles(const std::string& name, Dims* dims = nullptr) const;
   std::vector<std::uint64_t> read_uint64s(const std::string& name, Dims* dims = nullptr) const;
+
+  // Files from outside are read in two steps: the declared shape first
+  // (nothing allocated), then the data only when the shape is the expected
+  // one. `meaning` says where the expected shape comes from, for the error
+  // ("K x L x C = 1 x 4 x 3, from config_yaml").
+  Dims shape(const std::string& name) const;  // a dataset's dimensions
+  std::vector<double> read_doubles(const std::string& name, const Dims& expected,
+                                   const std::string& meaning) const;
+  // Integer datasets only (a float or a negative signed value is refused).
+  std::vector<std::uint64_t> read_uint64s(const std::string& name, const Dims& expected,
+                                          const std::string& meaning) const;
 
   // Attributes on an object ("/" for the root).
   void set_attr(const std::string& obj, const std::string& name, const std::string& value);
   void set_attr(const std::string& obj, const std::string& name, double value);
   void set_attr(const std::string& obj, const std::string& name, std::int64_t value);
+  void set_attr(const std::string& obj, const std::string& name, std::uint64_t value);
+  void set_attr(const std::string& obj, const std::string& name,
+                const std::vector<std::uint64_t>& value);
   void set_attr(const std::string& obj, const std::string& name, const std::vector<double>& value);
   bool has_attr(const std::string& obj, const std::string& name) const;
   std::string attr_string(const std::string& obj, const std::string& name) const;
   double attr_double(const std::string& obj, const std::string& name) const;
   std::int64_t attr_int(const std::string& obj, const std::string& name) const;
   std::vector<double> attr_doubles(const std::string& obj, const std::string& name) const;
+  // An exact unsigned 64-bit integer. Integer attributes only; a signed one
+  // is read as the two's-complement bits of an int64 (fiberlab 0.1 stored
+  // uint64 seeds as int64, so -1 means 2^64 - 1).
+  std::uint64_t attr_uint64(const std::string& obj, const std::string& name) const;
+  // An array of unsigned 64-bit integers (at most max_count). Unsigned
+  // integers exactly; float64 (fiberlab 0.1's merged_seeds) when every value
+  // is a finite integer in [0, 2^64).
+  std::vector<std::uint64_t> attr_uint64s(const std::string& obj, const std::string& name,
+                                          std::size_t max_count) const;
+  // The number of values an attribute holds (1 for a scalar).
+  std::uint64_t attr_size(const std::string& obj, const std::string& name) const;
 
  private:
   File(Handle h, std::string path) : handle_(std::move(h)), path_(std::move(path)) {}
   Handle handle_;
   std::string path_;
 };
+
+// Called first in main(): turns HDF5's exit-time cleanup off (it crashes on a
+// file whose close failed on a full disk) and silences its error printing.
+void prepare_hdf5();
 
 // Silences HDF5's automatic error stack printing; fiberlab reports its own.
 void quiet_hdf5_errors();

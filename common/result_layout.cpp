@@ -47,16 +47,58 @@ void write_bins(h5::File& f, const BinGrid& grid) {
   f.set_attr("/bins", "theta_bins", to_string(grid.theta_binning));
 }
 
-BinGrid read_bins(const h5::File& f) {
+namespace {
+
+constexpr hsize_t kMaxEdges = (hsize_t{1} << 24) + 1;
+
+void check_edges(const h5::File& f, const std::string& name, const std::vector<double>& edges,
+                 double lo, double hi, const char* range) {
+  for (std::size_t i = 0; i < edges.size(); ++i) {
+    const double e = edges[i];
+    if (!std::isfinite(e) || e < lo - 1e-12 || e > hi + 1e-12)
+      throw Error(fmt::format("{}: {}[{}] = {} (edges must be finite and in {} radians)", f.path(),
+                              name, i, e, range));
+    if (i > 0 && !(e > edges[i - 1]))
+      throw Error(fmt::format("{}: {}[{}] = {} is not above the previous edge {} (edges must "
+                              "increase strictly)", f.path(), name, i, e, edges[i - 1]));
+  }
+}
+
+std::vector<double> read_edges(const h5::File& f, const std::string& name, hsize_t expected,
+                               const std::string& meaning) {
+  if (expected > 0) return f.read_doubles(name, {expected}, meaning);
+  const h5::Dims dims = f.shape(name);
+  if (dims.size() != 1 || dims[0] < 2 || dims[0] > kMaxEdges)
+    throw Error(fmt::format("{}: {} must be a one-dimensional array of 2 to {} edges", f.path(),
+                            name, kMaxEdges));
+  return f.read_doubles(name, dims, "");
+}
+
+BinGrid read_checked_bins(const h5::File& f, hsize_t theta_edges, hsize_t phi_edges,
+                          const std::string& meaning) {
   BinGrid g;
-  g.theta_edges = f.read_doubles("/bins/theta_edges");
-  g.phi_edges = f.read_doubles("/bins/phi_edges");
-  if (g.theta_edges.size() < 2 || g.phi_edges.size() < 2)
-    throw Error(f.path() + ": /bins holds fewer than two edges");
+  g.theta_edges = read_edges(f, "/bins/theta_edges", theta_edges, meaning);
+  g.phi_edges = read_edges(f, "/bins/phi_edges", phi_edges, meaning);
+  check_edges(f, "/bins/theta_edges", g.theta_edges, -M_PI / 2, M_PI / 2, "[-pi/2, pi/2]");
+  check_edges(f, "/bins/phi_edges", g.phi_edges, -M_PI, M_PI, "[-pi, pi]");
   g.theta_binning = ThetaBinning::Uniform;
-  if (f.has_attr("/bins", "theta_bins") && f.attr_string("/bins", "theta_bins") == "equal_area")
-    g.theta_binning = ThetaBinning::EqualArea;
+  if (f.has_attr("/bins", "theta_bins")) {
+    const std::string b = f.attr_string("/bins", "theta_bins");
+    if (b == "equal_area") g.theta_binning = ThetaBinning::EqualArea;
+    else if (b != "uniform")
+      throw Error(fmt::format("{}: /bins@theta_bins = \"{}\" (must be uniform or equal_area)",
+                              f.path(), b));
+  }
   return g;
+}
+
+}  // namespace
+
+BinGrid read_bins(const h5::File& f) { return read_checked_bins(f, 0, 0, ""); }
+
+BinGrid read_bins(const h5::File& f, int n_theta, int n_phi, const std::string& meaning) {
+  return read_checked_bins(f, static_cast<hsize_t>(n_theta) + 1, static_cast<hsize_t>(n_phi) + 1,
+                           meaning);
 }
 
 void write_incidences(h5::File& f, const std::vector<double>& theta_i,

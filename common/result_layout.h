@@ -26,7 +26,13 @@ bool is_hdf5_file(const std::string& path);
 // /bins/theta_edges, /bins/phi_edges, /bins/solid_angle, and the attribute
 // /bins@theta_bins ("uniform" | "equal_area").
 void write_bins(h5::File& f, const BinGrid& grid);
+// Checked before use: each edge array one-dimensional with 2 to 2^24 + 1
+// values (shape read before the data), finite, strictly increasing, theta
+// within [-pi/2, pi/2] and phi within [-pi, pi]; theta_bins, when present,
+// "uniform" or "equal_area". Errors name the file and the dataset.
 BinGrid read_bins(const h5::File& f);
+// The same, with the edge counts required to be n_theta + 1 and n_phi + 1.
+BinGrid read_bins(const h5::File& f, int n_theta, int n_phi, const std::string& meaning);
 
 // /source/theta_i and /source/phi_i (radians; phi_i NaN where uniform).
 void write_incidences(h5::File& f, const std::vector<double>& theta_i,

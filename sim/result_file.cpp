@@ -65,14 +65,16 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
   return r;
 }
 
-void write_result(const ResultFile& r, const std::string& path) {
-  AtomicOutput out(path);
+void write_result(const ResultFile& r, const std::string& path,
+                  const std::vector<std::string>& inputs) {
+  AtomicOutput out(path, inputs);
   {
     h5::File f = h5::File::create(out.temp_path());
     write_file_identity(f, "fiber-histogram", r.created_utc);
-    f.set_attr("/", "seed", static_cast<std::int64_t>(r.seeds.front()));
-    std::vector<double> seeds(r.seeds.begin(), r.seeds.end());
-    f.set_attr("/", "merged_seeds", seeds);
+    // Exact uint64: every seed in [0, 2^64 - 1] round-trips, and merge tells
+    // any two distinct seeds apart.
+    f.set_attr("/", "seed", r.seeds.front());
+    f.set_attr("/", "merged_seeds", r.seeds);
     f.set_attr("/", "config_yaml", r.config_yaml);
     write_bins(f, r.grid);
     write_incidences(f, r.theta_i, r.phi_i);
@@ -92,41 +94,6 @@ void write_result(const ResultFile& r, const std::string& path) {
     f.close();
   }
   out.commit();
-}
-
-ResultFile read_result(const std::string& path) {
-  h5::File f = h5::File::open_read(path);
-  if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-histogram")
-    throw Error(fmt::format("{}: not a fiberlab result file (root attribute format is not "
-                            "\"fiber-histogram\")", path));
-  ResultFile r;
-  r.config_yaml = f.attr_string("/", "config_yaml");
-  r.settings = parse_settings_yaml(r.config_yaml, path + ":/config_yaml");
-  r.software_version = f.attr_string("/", "software_version");
-  r.created_utc = f.attr_string("/", "created_utc");
-  if (f.has_attr("/", "merged_seeds")) {
-    for (double s : f.attr_doubles("/", "merged_seeds")) r.seeds.push_back(static_cast<std::uint64_t>(s));
-  } else {
-    r.seeds = {static_cast<std::uint64_t>(f.attr_int("/", "seed"))};
-  }
-  r.grid = read_bins(f);
-  r.theta_i = f.read_doubles("/source/theta_i");
-  r.phi_i = f.read_doubles("/source/phi_i");
-  r.photons = f.read_uint64s("/tally/photons");
-  h5::Dims dims;
-  r.weight_sum = f.read_doubles("/tally/weight_sum", &dims);
-  if (dims.size() != 5) throw Error(path + ": /tally/weight_sum is not 5-dimensional");
-  r.lobes = static_cast<int>(dims[1]);
-  r.channels = static_cast<int>(dims[4]);
-  r.weight_sq_sum = f.read_doubles("/tally/weight_sq_sum");
-  r.count = f.read_uint64s("/tally/count");
-  r.exited = f.read_doubles("/ledger/exited");
-  r.absorbed = f.read_doubles("/ledger/absorbed");
-  r.truncated = f.read_doubles("/ledger/truncated");
-  if (r.weight_sum.size() != r.configs() * r.bin_cells() ||
-      r.weight_sq_sum.size() != r.weight_sum.size() || r.theta_i.size() != r.configs())
-    throw Error(path + ": dataset shapes do not agree with /bins and /source");
-  return r;
 }
 
 ResultFile merge_results(const std::vector<ResultFile>& parts,

@@ -41,7 +41,15 @@ struct ResultFile {
 ResultFile make_result(const Settings& settings, const BinGrid& grid,
                        const std::vector<Tally>& tallies);
 
-void write_result(const ResultFile& result, const std::string& path);  // atomic
+// Atomic (common/atomic_output.h); `inputs` are files the output must not replace.
+void write_result(const ResultFile& result, const std::string& path,
+                  const std::vector<std::string>& inputs = {});
+// Reads and validates a result file (sim/result_reader.cpp): format and
+// format_version, every dataset's shape against K x L x n_theta x n_phi x C
+// from the stored config_yaml (checked before anything is allocated), /bins
+// and /source against the config, finite non-negative sums, photons >= 1,
+// counts and the energy ledger against photons. Throws fiberlab::Error with
+// one line naming the file, the dataset or attribute and what is allowed.
 ResultFile read_result(const std::string& path);
 
 // Adds runs of the same fiber, bins and incident directions; throws

@@ -35,6 +35,7 @@ constexpr std::size_t kMaxRangeAngles = 100000;  // theta_i {from, to, step}
 constexpr double kMaxTallyBytes = 8.0 * 1024 * 1024 * 1024;
 constexpr std::uint64_t kIntMax = std::numeric_limits<int>::max();
 constexpr std::uint64_t kU64Max = std::numeric_limits<std::uint64_t>::max();
+constexpr std::size_t kMaxConfigBytes = std::size_t{16} << 20;  // 16 MiB
 
 const char* const kModels[] = {"smooth", "gaussian", "exit_blur"};
 const char* const kPolarizations[] = {"scalar", "stokes"};
@@ -210,7 +211,9 @@ class Reader {
   // An integer in [lo, hi]; "1e6" is accepted when exactly integral, "1.5" is not.
   std::uint64_t integer(const YAML::Node& n, const std::string& path, std::uint64_t lo,
                         std::uint64_t hi) const {
-    const std::string rule = fmt::format("must be an integer >= {}", lo);
+    // Bounds below int's maximum are stated (e.g. --threads' cap); int's own is not.
+    const std::string rule = hi < kIntMax ? fmt::format("must be an integer in [{}, {}]", lo, hi)
+                                          : fmt::format("must be an integer >= {}", lo);
     if (!n.IsScalar()) bad(path, n, kind(n) + ", expected an integer", rule);
     if (is_quoted(n)) bad(path, n, "is not an integer", rule);
     const std::string& s = n.Scalar();
@@ -454,6 +457,14 @@ void check_tally_size(const Reader& r, const Settings& s) {
         s.fiber.sigma_a.size()));
 }
 
+// photons x incident configurations is counted in uint64 (progress, totals).
+void check_photon_total(const Reader& r, const Settings& s) {
+  const std::uint64_t k = s.incidences().size();
+  if (k > 0 && s.photons > kU64Max / k)
+    r.fail(fmt::format("photons = {} x {} incident configurations exceeds 2^64 - 1 photons in "
+                       "total (lower photons or the incident angles)", s.photons, k));
+}
+
 std::string default_output(const std::string& origin) {
   const std::string stem = std::filesystem::path(origin).stem().string();
   return stem.empty() ? "out.h5" : stem + ".h5";
@@ -470,8 +481,14 @@ std::string betas_text(const std::vector<double>& betas) {
 
 Settings parse_settings_yaml(const std::string& yaml_text, const std::string& origin) {
   const Reader r(origin);
+  const YAML::Node doc = r.load(yaml_text);
+  // A 0-byte file or one holding only comments is most likely a mistake (a
+  // truncated copy, the wrong file): refused rather than run with every default.
+  if (!doc.IsDefined() || doc.IsNull())
+    r.fail("the config is empty (holds no settings; write at least one key, or {} for every "
+           "default)");
   const YAML::Node root =
-      r.section(r.load(yaml_text), "",
+      r.section(doc, "",
                 {"photons", "seed", "output", "fiber", "roughness", "source", "tally",
                  "max_segments", "max_events_per_point", "polarization"});
   Settings s;
@@ -482,6 +499,7 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   read_source(r, root, s.source);
   read_tally(r, root, s.tally);
   check_tally_size(r, s);
+  check_photon_total(r, s);
   return s;
 }
 
@@ -491,10 +509,22 @@ Settings load_settings(const std::string& path) {
     throw Error(path + ": cannot read config file: it is a directory");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(path + ": cannot read config file: " + std::strerror(errno));
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most kMaxConfigBytes + 1: a stream that never ends (/dev/zero, a
+  // FIFO) is refused instead of filling memory.
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
   if (in.bad()) throw Error(path + ": cannot read config file: read error");
-  return parse_settings_yaml(text.str(), path);
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes)
+    throw Error(fmt::format("{}: config file is larger than {} MiB (a config is a few hundred "
+                            "bytes; is this the right file?)", path, kMaxConfigBytes >> 20));
+  return parse_settings_yaml(text, path);
+}
+
+std::uint64_t parse_integer_flag(const std::string& flag, const std::string& text,
+                                 std::uint64_t lo, std::uint64_t hi) {
+  const Reader r("command line");
+  return r.integer(YAML::Node(text), flag, lo, hi);
 }
 
 std::string to_yaml(const Settings& s) {

@@ -87,6 +87,13 @@ struct Settings {
 Settings parse_settings_yaml(const std::string& yaml_text, const std::string& origin);
 Settings load_settings(const std::string& path);
 
+// A command-line integer (--photons, --seed, --threads) read by the config's
+// rules: 100000 or an exactly integral 1e5; not -1, 1.5, nan or anything
+// outside [lo, hi]. Throws fiberlab::Error: "command line: --photons = -1 is
+// out of range (must be an integer >= 1)".
+std::uint64_t parse_integer_flag(const std::string& flag, const std::string& text,
+                                 std::uint64_t lo, std::uint64_t hi);
+
 // The resolved configuration as YAML (degrees, every key explicit): stored in
 // result files as `config_yaml` and parseable again by parse_settings_yaml.
 std::string to_yaml(const Settings& s);

@@ -6,6 +6,8 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <exception>
+#include <optional>
 
 #include "common/units.h"
 #include "sim/source.h"
@@ -64,7 +66,8 @@ std::vector<Tally> Simulation::run(int threads, const ProgressCallback& progress
   const TallySettings& ts = settings_.tally;
   const int channels = static_cast<int>(settings_.fiber.sigma_a.size());
   const std::uint64_t photons = settings_.photons;
-  const std::uint64_t chunks = (photons + kChunk - 1) / kChunk;
+  // (photons + kChunk - 1) / kChunk would wrap for photons near 2^64.
+  const std::uint64_t chunks = photons / kChunk + (photons % kChunk != 0);
   const std::uint64_t total = photons * incidences_.size();
   std::atomic<std::uint64_t> done{0};
   TracerCounters all_counters;
@@ -72,30 +75,51 @@ std::vector<Tally> Simulation::run(int threads, const ProgressCallback& progress
   std::vector<Tally> results;
   for (std::size_t k = 0; k < incidences_.size(); ++k) {
     Tally result(ts.lobes, ts.n_theta, ts.n_phi, channels);
+    // An exception must not leave an OpenMP region (std::terminate, SIGABRT):
+    // the first one (e.g. std::bad_alloc) is kept, the other threads skip
+    // their remaining chunks, and it is rethrown after the region.
+    std::exception_ptr failure;
+    std::atomic<bool> failed{false};
+    auto keep_failure = [&] {
+#pragma omp critical(fiberlab_run_failure)
+      if (!failure) failure = std::current_exception();
+      failed = true;
+    };
 #pragma omp parallel num_threads(threads)
     {
-      Tally local(ts.lobes, ts.n_theta, ts.n_phi, channels);
+      std::optional<Tally> local;
+      try {
+        local.emplace(ts.lobes, ts.n_theta, ts.n_phi, channels);
+      } catch (...) {
+        keep_failure();
+      }
       TracerCounters counters;
       auto last_report = Clock::now();
 #pragma omp for schedule(dynamic, 1)
       for (std::uint64_t c = 0; c < chunks; ++c) {
-        const std::uint64_t first = c * kChunk;
-        const std::uint64_t n = std::min(kChunk, photons - first);
-        trace_photons(k, first, n, local, counters);
-        const std::uint64_t now_done = done.fetch_add(n) + n;
-        if (progress && omp_get_thread_num() == 0 &&
-            Clock::now() - last_report > std::chrono::milliseconds(250)) {
-          last_report = Clock::now();
-          progress(now_done, total);
+        if (failed) continue;
+        try {
+          const std::uint64_t first = c * kChunk;
+          const std::uint64_t n = std::min(kChunk, photons - first);
+          trace_photons(k, first, n, *local, counters);
+          const std::uint64_t now_done = done.fetch_add(n) + n;
+          if (progress && omp_get_thread_num() == 0 &&
+              Clock::now() - last_report > std::chrono::milliseconds(250)) {
+            last_report = Clock::now();
+            progress(now_done, total);
+          }
+        } catch (...) {
+          keep_failure();
         }
       }
 #pragma omp critical
-      {
-        result.add(local);  // integer sums: the order does not matter
+      if (local && !failed) {
+        result.add(*local);  // integer sums: the order does not matter
         all_counters.events += counters.events;
         all_counters.normal_draws += counters.normal_draws;
       }
     }
+    if (failure) std::rethrow_exception(failure);
     results.push_back(std::move(result));
   }
   if (progress) progress(total, total);

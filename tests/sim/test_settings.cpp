@@ -87,8 +87,8 @@ TEST(Settings, ShippedConfigsHaveTheDocumentedContents) {
 
 // ---------------------------------------------------------------- values
 
-TEST(Settings, EmptyConfigGivesTheDefaults) {
-  const Settings s = parse("");
+TEST(Settings, EmptyMappingGivesTheDefaults) {
+  const Settings s = parse("{}\n");
   EXPECT_EQ(s.photons, 1000000u);
   EXPECT_EQ(s.seed, 1u);
   EXPECT_EQ(s.output, "x.h5");  // the config file's stem
