@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "sim/exit_blur.h"
+#include "sim/microfacet_normal.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
@@ -60,7 +61,8 @@ struct BatchTracer::Lanes {
   alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
   alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
   alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
-  LaneCounter events, normal_draws;  // for TracerCounters
+  long far_tail_draws = 0;
+  LaneCounter events, normal_draws, sampler_caps;  // for TracerCounters
 
   void move(int to, int from) {
     px[to] = px[from]; py[to] = py[from];
@@ -291,10 +293,40 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   return m;
 }
 
+// gaussian_normal for the lanes of `which` (their streams stored in `l`),
+// one at a time, drawing until accepted as in Tracer.
+void far_tail_normals(BatchTracer::Lanes& l, int o, const Mask& which, const Vec3B& d,
+                      const Vec3B& facing, double beta_long, double beta_azim, Vec3B& m,
+                      Mask& failed) {
+  alignas(64) double dx[W], dy[W], dz[W], fx[W], fy[W], fz[W];
+  alignas(64) double mx[W] = {}, my[W] = {}, mz[W] = {}, fail[W] = {};
+  d.x.store_aligned(dx); d.y.store_aligned(dy); d.z.store_aligned(dz);
+  facing.x.store_aligned(fx); facing.y.store_aligned(fy); facing.z.store_aligned(fz);
+  alignas(64) double use[W];
+  xsimd::select(which, Batch(1.0), Batch(0.0)).store_aligned(use);
+  long draws = 0;
+  for (int i = 0; i < W; ++i) {
+    if (use[i] == 0.0) continue;
+    PhotonRandom rng(l.rng_state(o + i));
+    const auto drawn = gaussian_normal(Vec3(dx[i], dy[i], dz[i]), Vec3(fx[i], fy[i], fz[i]),
+                                       beta_long, beta_azim, rng, Tracer::kMaxNormalTries, draws);
+    if (drawn) {
+      mx[i] = drawn->x(); my[i] = drawn->y(); mz[i] = drawn->z();
+    } else {
+      fail[i] = 1.0;
+    }
+    l.set_rng_state(o + i, rng.state());
+  }
+  l.far_tail_draws += draws;
+  m = {Batch::load_aligned(mx), Batch::load_aligned(my), Batch::load_aligned(mz)};
+  failed = Batch::load_aligned(fail) != Batch(0.0);
+}
+
 }  // namespace
 
 BatchTracer::BatchTracer(const Settings& s)
     : settings_(s),
+      model_(Tracer::effective_model(s.roughness)),
       ellipse_(s.fiber.eccentricity),
       cos_tilt_(std::cos(s.fiber.scale_tilt)),
       sin_tilt_(std::sin(s.fiber.scale_tilt)) {}
@@ -358,9 +390,10 @@ void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, st
 // vectorised ScalarLight::interact with the normal models of Tracer.
 void BatchTracer::interface_events(Lanes& l, int n_active) const {
   const double eta = settings_.fiber.eta;
-  const RoughnessModel model = settings_.roughness.model;
+  const RoughnessModel model = model_;
   const double beta_long = settings_.roughness.beta_long.front();
   const double beta_azim = settings_.roughness.beta_azim.front();
+  const double far_tail_threshold = sim::far_tail_threshold(std::max(beta_long, beta_azim));
   const Batch iota = lane_index();
   for (int o = 0; o < n_active; o += W) {
     const Mask live = (iota + Batch(o)) < Batch(n_active);
@@ -380,10 +413,24 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
     Mask failed = live & Mask(false), ready = live;
     Vec3B m;
     if (model == RoughnessModel::Gaussian) {
+      // Lanes whose tilted normal faces away by several beta: the far-tail
+      // sampler, rare, one photon at a time with the reference code.
+      const Mask far_tail = live & (d.dot(facing) >= Batch(far_tail_threshold));
+      Vec3B m_tail{Batch(0.0), Batch(0.0), Batch(0.0)};
+      Mask tail_failed = live & Mask(false);
+      if (xsimd::any(far_tail)) {
+        rng.store(l, o);
+        far_tail_normals(l, o, far_tail, d, facing, beta_long, beta_azim, m_tail, tail_failed);
+        rng = LaneRandom(l, o);
+      }
       Batch tries = Batch::load_aligned(l.tries + o);
-      m = gaussian_normals(d, facing, beta_long, beta_azim, live, rng, tries, ready, failed,
-                           l.normal_draws);
+      m = gaussian_normals(d, facing, beta_long, beta_azim, live & !far_tail, rng, tries, ready,
+                           failed, l.normal_draws);
       tries.store_aligned(l.tries + o);
+      m = select(far_tail, m_tail, m);
+      ready = ready | (far_tail & !tail_failed);
+      failed = failed | tail_failed;
+      l.sampler_caps.add(failed);
     } else {
       m = select(d.dot(facing) < Batch(0.0), facing, side * n0);
     }
@@ -478,7 +525,7 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
   const std::uint64_t end = first + n;
   std::uint64_t next = first;
   int n_active = 0;
-  const bool blur = settings_.roughness.model == RoughnessModel::ExitBlur;
+  const bool blur = model_ == RoughnessModel::ExitBlur;
   const ExitBlur exit_blur(settings_.roughness);
 
   auto finish = [&](int i, PhotonFate fate) {
@@ -531,6 +578,8 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
   }
   counters.events += l.events.total();
   counters.normal_draws += l.normal_draws.total();
+  counters.sampler_caps += l.sampler_caps.total();
+  counters.normal_draws += l.far_tail_draws;
 }
 
 }  // namespace fiberlab::sim

@@ -44,6 +44,7 @@ class BatchTracer {
   void travel(Lanes& lanes, int n_active) const;
 
   const Settings settings_;
+  RoughnessModel model_;  // Tracer::effective_model
   EllipseCrossSection ellipse_;
   double cos_tilt_, sin_tilt_;
 };

@@ -92,8 +92,7 @@ std::vector<Tally> Simulation::run(int threads, const ProgressCallback& progress
 #pragma omp critical
       {
         result.add(local);  // integer sums: the order does not matter
-        all_counters.events += counters.events;
-        all_counters.normal_draws += counters.normal_draws;
+        all_counters.add(counters);
       }
     }
     results.push_back(std::move(result));

@@ -66,6 +66,14 @@ TEST(BatchTracer, RoughTiltedAbsorbingEllipseMatchesReference) {
   expect_same_photons(s, "rough ellipse, uniform phi_i, beta 25/4");
 }
 
+// Small beta on a tilted fiber at oblique incidence: the far-tail sampler
+// (SPEC section 3), which the batch tracer runs lane by lane.
+TEST(BatchTracer, FarTailNormalsMatchReference) {
+  Settings s = testing::smooth_circle(60.0, 1);
+  testing::make_rough(s, 0.5, 3.0);
+  expect_same_photons(s, "beta 0.5, tilt 3, theta_i 60");
+}
+
 TEST(BatchTracer, ExitBlurMatchesReference) {
   Settings s = testing::smooth_circle(-41.0, 1);
   s.fiber.scale_tilt = deg_to_rad(-2.0);
