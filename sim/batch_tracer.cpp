@@ -96,7 +96,7 @@ class LaneRandom {
         spare_(Batch::load_aligned(l.spare + o)),
         has_spare_(Batch::load_aligned(l.has_spare + o) != Batch(0.0)) {}
 
-  // Fresh streams: PhotonRandom(seed, config, photon) for W photons at once.
+  // Fresh streams: PhotonRandom(key, photon) for W photons at once.
   LaneRandom(std::uint64_t key, const UBatch& photon) : spare_(0.0), has_spare_(Batch(0.0) != Batch(0.0)) {
     UBatch x = splitmix(UBatch(key) ^ photon);
     s0_ = x = splitmix(x);
@@ -518,8 +518,8 @@ void BatchTracer::travel(Lanes& l, int n_active) const {
   }
 }
 
-void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std::uint64_t first,
-                        std::uint64_t n, const Sink& sink, TracerCounters& counters) const {
+void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
+                        const Sink& sink, TracerCounters& counters) const {
   auto lanes = std::make_unique<Lanes>();
   Lanes& l = *lanes;
   const std::uint64_t end = first + n;
@@ -547,10 +547,10 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
     sink(l.photon[i], l.phi_i[i], out);
   };
 
-  const Source source(settings_.seed, config, theta_i, phi_i, settings_.source.phi_i_uniform);
+  const Source source(settings_.seed, theta_i, phi_i, settings_.source.phi_i_uniform);
   const Vec3 d0 = -direction_from_angles(theta_i, phi_i);
   const Eigen::Vector2d beam = ellipse_.beam_direction(d0);
-  const std::uint64_t key = PhotonRandom::stream_key(settings_.seed, config);
+  const std::uint64_t key = source.stream_key();
   while (true) {
     if (source.fixed_direction()) {
       while (n_active < kPoolLanes && next < end) {

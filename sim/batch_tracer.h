@@ -27,10 +27,10 @@ class BatchTracer {
   // Receives each finished photon: its index, its incident azimuth and its fate.
   using Sink = std::function<void(std::uint64_t photon, double phi_i, const PhotonOutcome&)>;
 
-  // Traces photons [first, first + n) of incident configuration `config`
-  // (seed and incidence as in launch_photon), in no particular order.
-  void trace(std::uint64_t config, double theta_i, double phi_i, std::uint64_t first,
-             std::uint64_t n, const Sink& sink, TracerCounters& counters) const;
+  // Traces photons [first, first + n) of the incident direction (theta_i,
+  // phi_i) (seed and streams as in launch_photon), in no particular order.
+  void trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
+             const Sink& sink, TracerCounters& counters) const;
 
   struct Lanes;  // the photons in flight (defined in batch_tracer.cpp)
 

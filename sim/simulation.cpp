@@ -45,9 +45,9 @@ void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t
     tally.score_exit(lobe, it, ip, weight.data());
   };
   if (use_batch_tracer_) {
-    batch_tracer_.trace(k, inc.theta_i, inc.phi_i, first, n, score, counters);
+    batch_tracer_.trace(inc.theta_i, inc.phi_i, first, n, score, counters);
   } else {
-    const Source source(settings_.seed, k, inc.theta_i, inc.phi_i, settings_.source.phi_i_uniform);
+    const Source source(settings_.seed, inc.theta_i, inc.phi_i, settings_.source.phi_i_uniform);
     for (std::uint64_t i = first; i < first + n; ++i) {
       LaunchedPhoton p = source.launch(i);
       score(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));

@@ -24,7 +24,7 @@ void expect_same_photons(const Settings& s, const char* what) {
   std::vector<double> batched_phi(n);
   std::vector<int> seen(n, 0);
   TracerCounters counters;
-  batch.trace(0, inc.theta_i, inc.phi_i, 0, n,
+  batch.trace(inc.theta_i, inc.phi_i, 0, n,
               [&](std::uint64_t i, double phi_i, const PhotonOutcome& o) {
                 batched[i] = o;
                 batched_phi[i] = phi_i;
@@ -34,7 +34,7 @@ void expect_same_photons(const Settings& s, const char* what) {
   int differ = 0;
   for (std::uint64_t i = 0; i < n; ++i) {
     ASSERT_EQ(seen[i], 1) << "photon " << i << " reported " << seen[i] << " times";
-    LaunchedPhoton p = launch_photon(s.seed, 0, i, inc.theta_i, inc.phi_i, s.source.phi_i_uniform);
+    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, s.source.phi_i_uniform);
     const PhotonOutcome r = reference.trace(p.wi, p.h, p.rng);
     ASSERT_EQ(batched_phi[i], p.phi_i);
     const PhotonOutcome& b = batched[i];

@@ -53,7 +53,7 @@ std::pair<double, double> central_range(std::vector<double> x) {
 
 void compare_samplers(const Vec3& d, const Vec3& nf, double bl, double ba, const char* what,
                       int n = 200000) {
-  PhotonRandom ra(1, 2, 3), rb(4, 5, 6);
+  PhotonRandom ra(1, 2.0, 0.0, 3), rb(4, 5.0, 0.0, 6);
   long tries = 0;
   std::vector<Vec3> sa, sb;
   for (int k = 0; k < n; ++k) {
@@ -152,7 +152,7 @@ TEST(GaussianNormal, SameDistributionInTheFarTail) {
 TEST(GaussianNormal, FarTailNeverReachesTheCap) {
   const Vec3 nf = Vec3(-std::sin(0.05), std::cos(0.05), 0.0);
   const double beta = deg_to_rad(0.5);
-  PhotonRandom rng(7, 8, 9);
+  PhotonRandom rng(7, 8.0, 0.0, 9);
   for (double eps_deg : {0.6, 3.0, 10.0}) {
     const Vec3 d = facing_away_direction(nf, deg_to_rad(eps_deg));
     long tries = 0;
