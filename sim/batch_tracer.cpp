@@ -61,7 +61,6 @@ struct BatchTracer::Lanes {
   alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
   alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
   alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
-  long far_tail_draws = 0;
   LaneCounter events, normal_draws, sampler_caps;  // for TracerCounters
 
   void move(int to, int from) {
@@ -248,15 +247,20 @@ Vec3B select(const Mask& m, const Vec3B& a, const Vec3B& b) {
 constexpr int kRoundsPerCall = 2;
 
 Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double beta_azim,
-                       const Mask& live, LaneRandom& rng, Batch& tries, Mask& ready,
-                       Mask& failed, LaneCounter& draws) {
+                       double far_tail_threshold, const Mask& live, LaneRandom& rng,
+                       Batch& tries, Mask& ready, Mask& failed, LaneCounter& draws) {
   constexpr double kSqrt2OverPi = 0.7978845608028654;
   const Batch sin_n = f.x, cos_n = xsimd::sqrt(f.y * f.y + f.z * f.z);
   const Batch inv = Batch(1.0) / cos_n;
   const Batch pv = f.y * inv, pw = f.z * inv;
-  const Batch c = xsimd::max(Batch(0.0), -d.dot(f));
+  const Batch d_dot_n = d.dot(f);
+  const Batch c = xsimd::max(Batch(0.0), -d_dot_n);
   const Batch w_long(beta_long * kSqrt2OverPi), w_azim(beta_azim * kSqrt2OverPi);
-  const Mask envelope = c < Batch(0.5);
+  // Sampler (c), the far tail, where n_f faces away by eps >= kFarTailSigmas b.
+  const Mask far = d_dot_n >= Batch(far_tail_threshold);
+  const double b = std::max(beta_long, beta_azim);
+  const Batch rho0 = xsimd::asin(xsimd::min(Batch(1.0), d_dot_n)) / Batch(b);
+  const Mask envelope = (c < Batch(0.5)) & !far;
   const Batch w_total = c + w_long + w_azim;
   failed = live & envelope & (w_total <= Batch(0.0));
   ready = live & Mask(false);
@@ -265,23 +269,37 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   for (int k = 0; k < kRoundsPerCall && xsimd::any(pending); ++k) {
     draws.add(pending);
     tries = tries + xsimd::select(pending, Batch(1.0), Batch(0.0));
-    const Batch pick = w_total * rng.uniform(pending & envelope);
+    const Mask near = pending & !far, far_p = pending & far;
+    const Batch pick = w_total * rng.uniform(near & envelope);
     const Mask first = envelope & (pick < c);
     const Mask second = envelope & !first & (pick < c + w_long);
     const Mask third = envelope & !first & !second;
     // Per lane: dl then da, each a normal or (envelope) a signed Rayleigh.
-    const Batch dl_rayleigh = rng.signed_rayleigh(beta_long, pending & second);
-    const auto [n_long, n_azim] = rng.normal_pair(pending & !second, pending & !third);
-    const Batch da_rayleigh = rng.signed_rayleigh(beta_azim, pending & third);
-    const Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
-    const Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
-    const Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
+    const Batch dl_rayleigh = rng.signed_rayleigh(beta_long, near & second);
+    const auto [n_long, n_azim] = rng.normal_pair(near & !second, near & !third);
+    const Batch da_rayleigh = rng.signed_rayleigh(beta_azim, near & third);
+    Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
+    Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
+    Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
+    Mask radial_ok = far_p;
+    if (xsimd::any(far_p)) {  // far_tail_normal in microfacet_normal.cpp, lane by lane
+      const Batch u1 = rng.uniform_open0(far_p), u2 = rng.uniform_open0(far_p);
+      const Batch w = -xsimd::log(u1 * u2);  // Gamma(2, 1)
+      const Batch y = Batch(2.0) * w / (xsimd::sqrt(rho0 * rho0 + Batch(2.0) * w) + rho0);
+      radial_ok = far_p & (rng.uniform(far_p) * w < rho0 * y);
+      const Batch psi = Batch(6.283185307179586) * rng.uniform(radial_ok);
+      const auto [sp, cp] = xsimd::sincos(psi);
+      const Batch rho = rho0 + y;
+      dl = xsimd::select(far, Batch(beta_long) * rho * cp, dl);
+      da = xsimd::select(far, Batch(beta_azim) * rho * sp, da);
+      bound = xsimd::select(far, Batch(b) * y, bound);
+    }
     const auto [sl, cl] = xsimd::sincos(dl);
     const Batch st = sin_n * cl + cos_n * sl, ct = cos_n * cl - sin_n * sl;
     const auto [sa, ca] = xsimd::sincos(da);
     const Vec3B candidate{st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
     const Batch visible = -d.dot(candidate);
-    const Mask facing = pending & (visible > Batch(0.0));
+    const Mask facing = (near | radial_ok) & (visible > Batch(0.0));
     const Mask accepted = facing & (rng.uniform(facing) * bound < visible);
     m = select(accepted, candidate, m);
     ready = ready | accepted;
@@ -291,35 +309,6 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   }
   tries = xsimd::select(ready | failed, Batch(0.0), tries);
   return m;
-}
-
-// gaussian_normal for the lanes of `which` (their streams stored in `l`),
-// one at a time, drawing until accepted as in Tracer.
-void far_tail_normals(BatchTracer::Lanes& l, int o, const Mask& which, const Vec3B& d,
-                      const Vec3B& facing, double beta_long, double beta_azim, Vec3B& m,
-                      Mask& failed) {
-  alignas(64) double dx[W], dy[W], dz[W], fx[W], fy[W], fz[W];
-  alignas(64) double mx[W] = {}, my[W] = {}, mz[W] = {}, fail[W] = {};
-  d.x.store_aligned(dx); d.y.store_aligned(dy); d.z.store_aligned(dz);
-  facing.x.store_aligned(fx); facing.y.store_aligned(fy); facing.z.store_aligned(fz);
-  alignas(64) double use[W];
-  xsimd::select(which, Batch(1.0), Batch(0.0)).store_aligned(use);
-  long draws = 0;
-  for (int i = 0; i < W; ++i) {
-    if (use[i] == 0.0) continue;
-    PhotonRandom rng(l.rng_state(o + i));
-    const auto drawn = gaussian_normal(Vec3(dx[i], dy[i], dz[i]), Vec3(fx[i], fy[i], fz[i]),
-                                       beta_long, beta_azim, rng, Tracer::kMaxNormalTries, draws);
-    if (drawn) {
-      mx[i] = drawn->x(); my[i] = drawn->y(); mz[i] = drawn->z();
-    } else {
-      fail[i] = 1.0;
-    }
-    l.set_rng_state(o + i, rng.state());
-  }
-  l.far_tail_draws += draws;
-  m = {Batch::load_aligned(mx), Batch::load_aligned(my), Batch::load_aligned(mz)};
-  failed = Batch::load_aligned(fail) != Batch(0.0);
 }
 
 }  // namespace
@@ -413,23 +402,10 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
     Mask failed = live & Mask(false), ready = live;
     Vec3B m;
     if (model == RoughnessModel::Gaussian) {
-      // Lanes whose tilted normal faces away by several beta: the far-tail
-      // sampler, rare, one photon at a time with the reference code.
-      const Mask far_tail = live & (d.dot(facing) >= Batch(far_tail_threshold));
-      Vec3B m_tail{Batch(0.0), Batch(0.0), Batch(0.0)};
-      Mask tail_failed = live & Mask(false);
-      if (xsimd::any(far_tail)) {
-        rng.store(l, o);
-        far_tail_normals(l, o, far_tail, d, facing, beta_long, beta_azim, m_tail, tail_failed);
-        rng = LaneRandom(l, o);
-      }
       Batch tries = Batch::load_aligned(l.tries + o);
-      m = gaussian_normals(d, facing, beta_long, beta_azim, live & !far_tail, rng, tries, ready,
-                           failed, l.normal_draws);
+      m = gaussian_normals(d, facing, beta_long, beta_azim, far_tail_threshold, live, rng, tries,
+                           ready, failed, l.normal_draws);
       tries.store_aligned(l.tries + o);
-      m = select(far_tail, m_tail, m);
-      ready = ready | (far_tail & !tail_failed);
-      failed = failed | tail_failed;
       l.sampler_caps.add(failed);
     } else {
       m = select(d.dot(facing) < Batch(0.0), facing, side * n0);
@@ -579,7 +555,6 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
   counters.events += l.events.total();
   counters.normal_draws += l.normal_draws.total();
   counters.sampler_caps += l.sampler_caps.total();
-  counters.normal_draws += l.far_tail_draws;
 }
 
 }  // namespace fiberlab::sim

@@ -74,6 +74,15 @@ TEST(BatchTracer, FarTailNormalsMatchReference) {
   expect_same_photons(s, "beta 0.5, tilt 3, theta_i 60");
 }
 
+// Steep tilt: light-guided photons meet the tilted normal from behind at
+// most events (issue 8's slow case), so the far-tail sampler runs often.
+TEST(BatchTracer, SteepTiltMatchesReference) {
+  Settings s = testing::smooth_circle(30.0, 1);
+  testing::make_rough(s, 5.0, 20.0);
+  s.max_segments = 30;
+  expect_same_photons(s, "tilt 20, beta 5, max_segments 30");
+}
+
 TEST(BatchTracer, ExitBlurMatchesReference) {
   Settings s = testing::smooth_circle(-41.0, 1);
   s.fiber.scale_tilt = deg_to_rad(-2.0);
