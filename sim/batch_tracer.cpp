@@ -504,6 +504,7 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
   const bool blur = model_ == RoughnessModel::ExitBlur;
   const ExitBlur exit_blur(settings_.roughness);
 
+  auto done = std::make_unique<FinishedPhotons>();
   auto finish = [&](int i, PhotonFate fate) {
     PhotonOutcome out;
     out.fate = fate;
@@ -520,7 +521,11 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
         out.phi = azimuth(out.direction);
       }
     }
-    sink(l.photon[i], l.phi_i[i], out);
+    done->add(l.photon[i], l.phi_i[i], out);
+    if (done->full()) {
+      sink(*done);
+      done->n = 0;
+    }
   };
 
   const Source source(settings_.seed, theta_i, phi_i, settings_.source.phi_i_uniform);
@@ -552,6 +557,7 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
       }
     }
   }
+  if (done->n > 0) sink(*done);
   counters.events += l.events.total();
   counters.normal_draws += l.normal_draws.total();
   counters.sampler_caps += l.sampler_caps.total();

@@ -14,6 +14,7 @@
 #include <functional>
 #include <vector>
 
+#include "sim/finished_photons.h"
 #include "sim/settings.h"
 #include "sim/source.h"
 #include "sim/tracer.h"
@@ -24,8 +25,9 @@ class BatchTracer {
  public:
   explicit BatchTracer(const Settings& settings);
 
-  // Receives each finished photon: its index, its incident azimuth and its fate.
-  using Sink = std::function<void(std::uint64_t photon, double phi_i, const PhotonOutcome&)>;
+  // Receives the finished photons a block at a time (each with its index,
+  // incident azimuth and fate).
+  using Sink = std::function<void(const FinishedPhotons&)>;
 
   // Traces photons [first, first + n) of the incident direction (theta_i,
   // phi_i) (seed and streams as in launch_photon), in no particular order.

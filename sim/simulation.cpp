@@ -6,8 +6,10 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "common/units.h"
+#include "sim/exit_scoring.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
@@ -28,29 +30,20 @@ Simulation::Simulation(Settings settings)
 void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n,
                                Tally& tally, TracerCounters& counters) const {
   const Settings::Incidence inc = incidences_[k];
-  const std::vector<double>& sigma_a = settings_.fiber.sigma_a;
-  const int channels = static_cast<int>(sigma_a.size());
-  const int last_lobe = tally.lobes() - 1;
-  std::vector<double> weight(channels);
-  auto score = [&](std::uint64_t, double phi_i, const PhotonOutcome& out) {
-    // Beer-Lambert per channel along the whole internal path (SPEC section 4).
-    for (int c = 0; c < channels; ++c) weight[c] = std::exp(-sigma_a[c] * out.path_length);
-    if (out.fate == PhotonFate::Truncated) {
-      tally.score_truncated(weight.data());
-      return;
-    }
-    const int lobe = std::min(out.segments, last_lobe);
-    const int it = grid_.theta_bin(out.theta);
-    const int ip = grid_.phi_bin(wrap_angle(out.phi - phi_i));
-    tally.score_exit(lobe, it, ip, weight.data());
-  };
+  ExitScorer scorer(grid_, settings_.fiber.sigma_a, tally.lobes());
+  auto score = [&](const FinishedPhotons& f) { scorer.score(f, tally); };
   if (use_batch_tracer_) {
     batch_tracer_.trace(inc.theta_i, inc.phi_i, first, n, score, counters);
   } else {
     const Source source(settings_.seed, inc.theta_i, inc.phi_i, settings_.source.phi_i_uniform);
+    auto done = std::make_unique<FinishedPhotons>();
     for (std::uint64_t i = first; i < first + n; ++i) {
       LaunchedPhoton p = source.launch(i);
-      score(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));
+      done->add(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));
+      if (done->full() || i + 1 == first + n) {
+        score(*done);
+        done->n = 0;
+      }
     }
   }
   tally.add_launched(n);

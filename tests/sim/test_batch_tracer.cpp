@@ -25,10 +25,13 @@ void expect_same_photons(const Settings& s, const char* what) {
   std::vector<int> seen(n, 0);
   TracerCounters counters;
   batch.trace(inc.theta_i, inc.phi_i, 0, n,
-              [&](std::uint64_t i, double phi_i, const PhotonOutcome& o) {
-                batched[i] = o;
-                batched_phi[i] = phi_i;
-                ++seen[i];
+              [&](const FinishedPhotons& f) {
+                for (int j = 0; j < f.n; ++j) {
+                  const std::uint64_t i = f.photon[j];
+                  batched[i] = f.outcome(j);
+                  batched_phi[i] = f.phi_i[j];
+                  ++seen[i];
+                }
               },
               counters);
   int differ = 0;
