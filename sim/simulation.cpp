@@ -15,7 +15,14 @@
 namespace fiberlab::sim {
 
 namespace {
-constexpr std::uint64_t kChunk = 4096;  // photons handed to a thread at a time
+// Photons handed to a thread at a time: large, because a chunk ends with its
+// few light-guided photons alone in the batch tracer's lanes (-4% CPU on case
+// b from 4096 to 32768), but at least 8 chunks per thread when there are
+// photons enough, for the load balance. Results do not depend on it.
+std::uint64_t chunk_size(std::uint64_t photons, int threads) {
+  return std::clamp<std::uint64_t>(photons / (8 * static_cast<std::uint64_t>(threads)), 4096,
+                                   32768);
+}
 }
 
 Simulation::Simulation(Settings settings)
@@ -57,6 +64,7 @@ std::vector<Tally> Simulation::run(int threads, const ProgressCallback& progress
   const TallySettings& ts = settings_.tally;
   const int channels = static_cast<int>(settings_.fiber.sigma_a.size());
   const std::uint64_t photons = settings_.photons;
+  const std::uint64_t kChunk = chunk_size(photons, threads);
   const std::uint64_t chunks = (photons + kChunk - 1) / kChunk;
   const std::uint64_t total = photons * incidences_.size();
   std::atomic<std::uint64_t> done{0};
