@@ -60,7 +60,6 @@ struct BatchTracer::Lanes {
   alignas(64) std::uint64_t s0[kPoolLanes], s1[kPoolLanes], s2[kPoolLanes], s3[kPoolLanes];
   alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
   alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
-  alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
   LaneCounter events, normal_draws, sampler_caps;  // for TracerCounters
 
   void move(int to, int from) {
@@ -71,7 +70,7 @@ struct BatchTracer::Lanes {
     photon[to] = photon[from];
     s0[to] = s0[from]; s1[to] = s1[from]; s2[to] = s2[from]; s3[to] = s3[from];
     spare[to] = spare[from]; has_spare[to] = has_spare[from];
-    tries[to] = tries[from]; theta_out[to] = theta_out[from]; phi_out[to] = phi_out[from];
+    tries[to] = tries[from];
   }
   RandomState rng_state(int i) const {
     return {{s0[i], s1[i], s2[i], s3[i]}, spare[i], has_spare[i] != 0.0};
@@ -311,6 +310,17 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   return m;
 }
 
+// inclination() and azimuth() of the exit directions of a block, vectorised
+// (truncated photons get angles too; they are not used).
+void exit_angles(FinishedPhotons& f) {
+  for (int i = 0; i < f.n; i += W) {
+    const Batch x = Batch::load_aligned(f.dx + i), y = Batch::load_aligned(f.dy + i),
+                z = Batch::load_aligned(f.dz + i);
+    xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), x))).store_aligned(f.theta + i);
+    xsimd::atan2(z, y).store_aligned(f.phi + i);
+  }
+}
+
 }  // namespace
 
 BatchTracer::BatchTracer(const Settings& s)
@@ -423,9 +433,11 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
     const Batch r_p = (eta_rel * cos_i - cos_t) / (eta_rel * cos_i + cos_t);
     const Batch F = Batch(0.5) * (r_s * r_s + r_p * r_p);
     const Mask reflect = tir | (rng.uniform(act & !tir) < F);
-    const Vec3B reflected = (d + (Batch(2.0) * cos_i) * m).normalized();
-    const Vec3B refracted = (ratio * d + (ratio * cos_i - cos_t) * m).normalized();
-    d = select(act, select(reflect, reflected, refracted), d);
+    // reflect() or refract() of interface_event.h, only the chosen one normalised:
+    // d' = a d + b m with (a, b) = (1, 2 cos_i) or (ratio, ratio cos_i - cos_t).
+    const Batch a = xsimd::select(reflect, Batch(1.0), ratio);
+    const Batch b = xsimd::select(reflect, Batch(2.0) * cos_i, ratio * cos_i - cos_t);
+    d = select(act, (a * d + b * m).normalized(), d);
     const Mask flip = act & !reflect;
     const Mask now_inside = (flip & (!inside)) | ((!flip) & inside);
     // Consistency rule, judged with the untilted normal.
@@ -435,11 +447,6 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
                                Batch(kAtBoundary));
     code = xsimd::select(failed, Batch(kTruncated), code);
     code = xsimd::select(act | failed, code, Batch::load_aligned(l.code + o));
-    const Mask exited = act & (code == Batch(kExited));
-    if (xsimd::any(exited)) {  // the exit angles, for the tally
-      xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), d.x))).store_aligned(l.theta_out + o);
-      xsimd::atan2(d.z, d.y).store_aligned(l.phi_out + o);
-    }
     d.x.store_aligned(l.dx + o);
     d.y.store_aligned(l.dy + o);
     d.z.store_aligned(l.dz + o);
@@ -512,17 +519,14 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
     out.path_length = l.path[i];
     if (fate == PhotonFate::Exited) {
       out.direction = Vec3(l.dx[i], l.dy[i], l.dz[i]);
-      out.theta = l.theta_out[i];
-      out.phi = l.phi_out[i];
       if (blur) {
         PhotonRandom rng(l.rng_state(i));
         out.direction = exit_blur.apply(out.direction, out.segments, rng);
-        out.theta = inclination(out.direction);
-        out.phi = azimuth(out.direction);
       }
     }
-    done->add(l.photon[i], l.phi_i[i], out);
+    done->add(l.photon[i], l.phi_i[i], out);  // theta, phi follow for the whole block
     if (done->full()) {
+      exit_angles(*done);
       sink(*done);
       done->n = 0;
     }
@@ -557,7 +561,10 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
       }
     }
   }
-  if (done->n > 0) sink(*done);
+  if (done->n > 0) {
+    exit_angles(*done);
+    sink(*done);
+  }
   counters.events += l.events.total();
   counters.normal_draws += l.normal_draws.total();
   counters.sampler_caps += l.sampler_caps.total();

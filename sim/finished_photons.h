@@ -13,7 +13,7 @@ struct FinishedPhotons {
   int n = 0;
   alignas(64) double path[kCapacity] = {};  // internal 3D path length
   alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
-  alignas(64) double dx[kCapacity], dy[kCapacity], dz[kCapacity];  // exit direction
+  alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
   std::uint64_t photon[kCapacity];
   int segments[kCapacity];
   bool exited[kCapacity];
