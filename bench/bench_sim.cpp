@@ -1,7 +1,9 @@
 // Photons per second per core for the three cases of issue 2:
 //  (a) smooth circle, sigma_a 0;
 //  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
-//  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg.
+//  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg;
+//  (d) steep tilt: circle, beta 5 deg, tilt 20 deg, sigma_a 0, theta_i 30 deg (issue 8: light
+//      guided along the fiber runs to max_segments).
 // One thread, so the rate is per core. Counters: photons/s, interface events
 // and candidate normals per photon. `trace` is the batched SIMD tracer that
 // `fiberlab run` uses for unpolarised light (binning and tally included);
@@ -33,18 +35,22 @@ Settings bench_case(char which) {
   s.fiber.sigma_a = {0.2, 0.4, 0.8};
   s.fiber.scale_tilt = deg_to_rad(3.0);
   s.roughness.model = RoughnessModel::Gaussian;
-  const double beta = deg_to_rad(which == 'b' ? 5.0 : 7.5);
+  const double beta = deg_to_rad(which == 'c' ? 7.5 : 5.0);
   s.roughness.beta_long = {beta};
   s.roughness.beta_azim = {beta};
-  s.source.theta_i = {deg_to_rad(which == 'b' ? 30.0 : 17.0)};
-  s.source.phi_i = {deg_to_rad(which == 'b' ? 0.0 : 11.0)};
+  s.source.theta_i = {deg_to_rad(which == 'c' ? 17.0 : 30.0)};
+  s.source.phi_i = {deg_to_rad(which == 'c' ? 11.0 : 0.0)};
   if (which == 'c') s.fiber.eccentricity = 0.8;
+  if (which == 'd') {
+    s.fiber.sigma_a = {0.0};
+    s.fiber.scale_tilt = deg_to_rad(20.0);
+  }
   return s;
 }
 
 void trace(benchmark::State& state, char which) {
   const Simulation sim(bench_case(which));
-  const std::uint64_t batch = 65536;
+  const std::uint64_t batch = which == 'd' ? 2048 : 65536;
   Tally tally(4, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
   TracerCounters counters;
   std::uint64_t first = 0;
@@ -56,6 +62,7 @@ void trace(benchmark::State& state, char which) {
   state.counters["photons_per_s"] = benchmark::Counter(photons, benchmark::Counter::kIsRate);
   state.counters["events_per_photon"] = counters.events / photons;
   state.counters["normals_per_photon"] = counters.normal_draws / photons;
+  state.counters["truncated_fraction"] = tally.truncated()[0] / photons;
 }
 
 // The reference (scalar, one photon at a time) tracer on the same cases, for
@@ -63,12 +70,12 @@ void trace(benchmark::State& state, char which) {
 void trace_reference(benchmark::State& state, char which) {
   const Settings s = bench_case(which);
   const Tracer tracer(s);
-  const Source source(s.seed, 0, s.source.theta_i[0], s.source.phi_i[0], false);
+  const Source source(s.seed, s.source.theta_i[0], s.source.phi_i[0], false);
   TracerCounters counters;
   std::uint64_t photon = 0;
   double sink = 0.0;
   for (auto _ : state) {
-    for (int k = 0; k < 4096; ++k) {
+    for (int k = 0; k < (which == 'd' ? 256 : 4096); ++k) {
       LaunchedPhoton p = source.launch(photon++);
       sink += tracer.trace(p.wi, p.h, p.rng, &counters).path_length;
     }
@@ -81,10 +88,12 @@ void trace_reference(benchmark::State& state, char which) {
 BENCHMARK_CAPTURE(trace, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 BENCHMARK_CAPTURE(trace_reference, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_CAPTURE(trace_reference, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 }  // namespace
 

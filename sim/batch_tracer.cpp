@@ -7,6 +7,7 @@
 #include <memory>
 
 #include "sim/exit_blur.h"
+#include "sim/microfacet_normal.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
@@ -59,8 +60,7 @@ struct BatchTracer::Lanes {
   alignas(64) std::uint64_t s0[kPoolLanes], s1[kPoolLanes], s2[kPoolLanes], s3[kPoolLanes];
   alignas(64) double spare[kPoolLanes], has_spare[kPoolLanes];
   alignas(64) double tries[kPoolLanes];   // candidate normals drawn for the pending event
-  alignas(64) double theta_out[kPoolLanes], phi_out[kPoolLanes];  // exit inclination, azimuth
-  LaneCounter events, normal_draws;  // for TracerCounters
+  LaneCounter events, normal_draws, sampler_caps;  // for TracerCounters
 
   void move(int to, int from) {
     px[to] = px[from]; py[to] = py[from];
@@ -70,7 +70,7 @@ struct BatchTracer::Lanes {
     photon[to] = photon[from];
     s0[to] = s0[from]; s1[to] = s1[from]; s2[to] = s2[from]; s3[to] = s3[from];
     spare[to] = spare[from]; has_spare[to] = has_spare[from];
-    tries[to] = tries[from]; theta_out[to] = theta_out[from]; phi_out[to] = phi_out[from];
+    tries[to] = tries[from];
   }
   RandomState rng_state(int i) const {
     return {{s0[i], s1[i], s2[i], s3[i]}, spare[i], has_spare[i] != 0.0};
@@ -94,7 +94,7 @@ class LaneRandom {
         spare_(Batch::load_aligned(l.spare + o)),
         has_spare_(Batch::load_aligned(l.has_spare + o) != Batch(0.0)) {}
 
-  // Fresh streams: PhotonRandom(seed, config, photon) for W photons at once.
+  // Fresh streams: PhotonRandom(key, photon) for W photons at once.
   LaneRandom(std::uint64_t key, const UBatch& photon) : spare_(0.0), has_spare_(Batch(0.0) != Batch(0.0)) {
     UBatch x = splitmix(UBatch(key) ^ photon);
     s0_ = x = splitmix(x);
@@ -246,15 +246,20 @@ Vec3B select(const Mask& m, const Vec3B& a, const Vec3B& b) {
 constexpr int kRoundsPerCall = 2;
 
 Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double beta_azim,
-                       const Mask& live, LaneRandom& rng, Batch& tries, Mask& ready,
-                       Mask& failed, LaneCounter& draws) {
+                       double far_tail_threshold, const Mask& live, LaneRandom& rng,
+                       Batch& tries, Mask& ready, Mask& failed, LaneCounter& draws) {
   constexpr double kSqrt2OverPi = 0.7978845608028654;
   const Batch sin_n = f.x, cos_n = xsimd::sqrt(f.y * f.y + f.z * f.z);
   const Batch inv = Batch(1.0) / cos_n;
   const Batch pv = f.y * inv, pw = f.z * inv;
-  const Batch c = xsimd::max(Batch(0.0), -d.dot(f));
+  const Batch d_dot_n = d.dot(f);
+  const Batch c = xsimd::max(Batch(0.0), -d_dot_n);
   const Batch w_long(beta_long * kSqrt2OverPi), w_azim(beta_azim * kSqrt2OverPi);
-  const Mask envelope = c < Batch(0.5);
+  // Sampler (c), the far tail, where n_f faces away by eps >= kFarTailSigmas b.
+  const Mask far = d_dot_n >= Batch(far_tail_threshold);
+  const double b = std::max(beta_long, beta_azim);
+  const Batch rho0 = xsimd::asin(xsimd::min(Batch(1.0), d_dot_n)) / Batch(b);
+  const Mask envelope = (c < Batch(0.5)) & !far;
   const Batch w_total = c + w_long + w_azim;
   failed = live & envelope & (w_total <= Batch(0.0));
   ready = live & Mask(false);
@@ -263,23 +268,37 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   for (int k = 0; k < kRoundsPerCall && xsimd::any(pending); ++k) {
     draws.add(pending);
     tries = tries + xsimd::select(pending, Batch(1.0), Batch(0.0));
-    const Batch pick = w_total * rng.uniform(pending & envelope);
+    const Mask near = pending & !far, far_p = pending & far;
+    const Batch pick = w_total * rng.uniform(near & envelope);
     const Mask first = envelope & (pick < c);
     const Mask second = envelope & !first & (pick < c + w_long);
     const Mask third = envelope & !first & !second;
     // Per lane: dl then da, each a normal or (envelope) a signed Rayleigh.
-    const Batch dl_rayleigh = rng.signed_rayleigh(beta_long, pending & second);
-    const auto [n_long, n_azim] = rng.normal_pair(pending & !second, pending & !third);
-    const Batch da_rayleigh = rng.signed_rayleigh(beta_azim, pending & third);
-    const Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
-    const Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
-    const Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
+    const Batch dl_rayleigh = rng.signed_rayleigh(beta_long, near & second);
+    const auto [n_long, n_azim] = rng.normal_pair(near & !second, near & !third);
+    const Batch da_rayleigh = rng.signed_rayleigh(beta_azim, near & third);
+    Batch dl = xsimd::select(second, dl_rayleigh, Batch(beta_long) * n_long);
+    Batch da = xsimd::select(third, da_rayleigh, Batch(beta_azim) * n_azim);
+    Batch bound = xsimd::select(envelope, c + xsimd::abs(dl) + xsimd::abs(da), Batch(1.0));
+    Mask radial_ok = far_p;
+    if (xsimd::any(far_p)) {  // far_tail_normal in microfacet_normal.cpp, lane by lane
+      const Batch u1 = rng.uniform_open0(far_p), u2 = rng.uniform_open0(far_p);
+      const Batch w = -xsimd::log(u1 * u2);  // Gamma(2, 1)
+      const Batch y = Batch(2.0) * w / (xsimd::sqrt(rho0 * rho0 + Batch(2.0) * w) + rho0);
+      radial_ok = far_p & (rng.uniform(far_p) * w < rho0 * y);
+      const Batch psi = Batch(6.283185307179586) * rng.uniform(radial_ok);
+      const auto [sp, cp] = xsimd::sincos(psi);
+      const Batch rho = rho0 + y;
+      dl = xsimd::select(far, Batch(beta_long) * rho * cp, dl);
+      da = xsimd::select(far, Batch(beta_azim) * rho * sp, da);
+      bound = xsimd::select(far, Batch(b) * y, bound);
+    }
     const auto [sl, cl] = xsimd::sincos(dl);
     const Batch st = sin_n * cl + cos_n * sl, ct = cos_n * cl - sin_n * sl;
     const auto [sa, ca] = xsimd::sincos(da);
     const Vec3B candidate{st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
     const Batch visible = -d.dot(candidate);
-    const Mask facing = pending & (visible > Batch(0.0));
+    const Mask facing = (near | radial_ok) & (visible > Batch(0.0));
     const Mask accepted = facing & (rng.uniform(facing) * bound < visible);
     m = select(accepted, candidate, m);
     ready = ready | accepted;
@@ -291,10 +310,22 @@ Vec3B gaussian_normals(const Vec3B& d, const Vec3B& f, double beta_long, double 
   return m;
 }
 
+// inclination() and azimuth() of the exit directions of a block, vectorised
+// (truncated photons get angles too; they are not used).
+void exit_angles(FinishedPhotons& f) {
+  for (int i = 0; i < f.n; i += W) {
+    const Batch x = Batch::load_aligned(f.dx + i), y = Batch::load_aligned(f.dy + i),
+                z = Batch::load_aligned(f.dz + i);
+    xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), x))).store_aligned(f.theta + i);
+    xsimd::atan2(z, y).store_aligned(f.phi + i);
+  }
+}
+
 }  // namespace
 
 BatchTracer::BatchTracer(const Settings& s)
     : settings_(s),
+      model_(Tracer::effective_model(s.roughness)),
       ellipse_(s.fiber.eccentricity),
       cos_tilt_(std::cos(s.fiber.scale_tilt)),
       sin_tilt_(std::sin(s.fiber.scale_tilt)) {}
@@ -358,9 +389,10 @@ void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, st
 // vectorised ScalarLight::interact with the normal models of Tracer.
 void BatchTracer::interface_events(Lanes& l, int n_active) const {
   const double eta = settings_.fiber.eta;
-  const RoughnessModel model = settings_.roughness.model;
+  const RoughnessModel model = model_;
   const double beta_long = settings_.roughness.beta_long.front();
   const double beta_azim = settings_.roughness.beta_azim.front();
+  const double far_tail_threshold = sim::far_tail_threshold(std::max(beta_long, beta_azim));
   const Batch iota = lane_index();
   for (int o = 0; o < n_active; o += W) {
     const Mask live = (iota + Batch(o)) < Batch(n_active);
@@ -381,9 +413,10 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
     Vec3B m;
     if (model == RoughnessModel::Gaussian) {
       Batch tries = Batch::load_aligned(l.tries + o);
-      m = gaussian_normals(d, facing, beta_long, beta_azim, live, rng, tries, ready, failed,
-                           l.normal_draws);
+      m = gaussian_normals(d, facing, beta_long, beta_azim, far_tail_threshold, live, rng, tries,
+                           ready, failed, l.normal_draws);
       tries.store_aligned(l.tries + o);
+      l.sampler_caps.add(failed);
     } else {
       m = select(d.dot(facing) < Batch(0.0), facing, side * n0);
     }
@@ -400,9 +433,11 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
     const Batch r_p = (eta_rel * cos_i - cos_t) / (eta_rel * cos_i + cos_t);
     const Batch F = Batch(0.5) * (r_s * r_s + r_p * r_p);
     const Mask reflect = tir | (rng.uniform(act & !tir) < F);
-    const Vec3B reflected = (d + (Batch(2.0) * cos_i) * m).normalized();
-    const Vec3B refracted = (ratio * d + (ratio * cos_i - cos_t) * m).normalized();
-    d = select(act, select(reflect, reflected, refracted), d);
+    // reflect() or refract() of interface_event.h, only the chosen one normalised:
+    // d' = a d + b m with (a, b) = (1, 2 cos_i) or (ratio, ratio cos_i - cos_t).
+    const Batch a = xsimd::select(reflect, Batch(1.0), ratio);
+    const Batch b = xsimd::select(reflect, Batch(2.0) * cos_i, ratio * cos_i - cos_t);
+    d = select(act, (a * d + b * m).normalized(), d);
     const Mask flip = act & !reflect;
     const Mask now_inside = (flip & (!inside)) | ((!flip) & inside);
     // Consistency rule, judged with the untilted normal.
@@ -412,11 +447,6 @@ void BatchTracer::interface_events(Lanes& l, int n_active) const {
                                Batch(kAtBoundary));
     code = xsimd::select(failed, Batch(kTruncated), code);
     code = xsimd::select(act | failed, code, Batch::load_aligned(l.code + o));
-    const Mask exited = act & (code == Batch(kExited));
-    if (xsimd::any(exited)) {  // the exit angles, for the tally
-      xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), d.x))).store_aligned(l.theta_out + o);
-      xsimd::atan2(d.z, d.y).store_aligned(l.phi_out + o);
-    }
     d.x.store_aligned(l.dx + o);
     d.y.store_aligned(l.dy + o);
     d.z.store_aligned(l.dz + o);
@@ -471,16 +501,17 @@ void BatchTracer::travel(Lanes& l, int n_active) const {
   }
 }
 
-void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std::uint64_t first,
-                        std::uint64_t n, const Sink& sink, TracerCounters& counters) const {
+void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
+                        const Sink& sink, TracerCounters& counters) const {
   auto lanes = std::make_unique<Lanes>();
   Lanes& l = *lanes;
   const std::uint64_t end = first + n;
   std::uint64_t next = first;
   int n_active = 0;
-  const bool blur = settings_.roughness.model == RoughnessModel::ExitBlur;
+  const bool blur = model_ == RoughnessModel::ExitBlur;
   const ExitBlur exit_blur(settings_.roughness);
 
+  auto done = std::make_unique<FinishedPhotons>();
   auto finish = [&](int i, PhotonFate fate) {
     PhotonOutcome out;
     out.fate = fate;
@@ -488,22 +519,23 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
     out.path_length = l.path[i];
     if (fate == PhotonFate::Exited) {
       out.direction = Vec3(l.dx[i], l.dy[i], l.dz[i]);
-      out.theta = l.theta_out[i];
-      out.phi = l.phi_out[i];
       if (blur) {
         PhotonRandom rng(l.rng_state(i));
         out.direction = exit_blur.apply(out.direction, out.segments, rng);
-        out.theta = inclination(out.direction);
-        out.phi = azimuth(out.direction);
       }
     }
-    sink(l.photon[i], l.phi_i[i], out);
+    done->add(l.photon[i], l.phi_i[i], out);  // theta, phi follow for the whole block
+    if (done->full()) {
+      exit_angles(*done);
+      sink(*done);
+      done->n = 0;
+    }
   };
 
-  const Source source(settings_.seed, config, theta_i, phi_i, settings_.source.phi_i_uniform);
+  const Source source(settings_.seed, theta_i, phi_i, settings_.source.phi_i_uniform);
   const Vec3 d0 = -direction_from_angles(theta_i, phi_i);
   const Eigen::Vector2d beam = ellipse_.beam_direction(d0);
-  const std::uint64_t key = PhotonRandom::stream_key(settings_.seed, config);
+  const std::uint64_t key = source.stream_key();
   while (true) {
     if (source.fixed_direction()) {
       while (n_active < kPoolLanes && next < end) {
@@ -529,8 +561,13 @@ void BatchTracer::trace(std::uint64_t config, double theta_i, double phi_i, std:
       }
     }
   }
+  if (done->n > 0) {
+    exit_angles(*done);
+    sink(*done);
+  }
   counters.events += l.events.total();
   counters.normal_draws += l.normal_draws.total();
+  counters.sampler_caps += l.sampler_caps.total();
 }
 
 }  // namespace fiberlab::sim

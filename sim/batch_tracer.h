@@ -14,6 +14,7 @@
 #include <functional>
 #include <vector>
 
+#include "sim/finished_photons.h"
 #include "sim/settings.h"
 #include "sim/source.h"
 #include "sim/tracer.h"
@@ -24,13 +25,14 @@ class BatchTracer {
  public:
   explicit BatchTracer(const Settings& settings);
 
-  // Receives each finished photon: its index, its incident azimuth and its fate.
-  using Sink = std::function<void(std::uint64_t photon, double phi_i, const PhotonOutcome&)>;
+  // Receives the finished photons a block at a time (each with its index,
+  // incident azimuth and fate).
+  using Sink = std::function<void(const FinishedPhotons&)>;
 
-  // Traces photons [first, first + n) of incident configuration `config`
-  // (seed and incidence as in launch_photon), in no particular order.
-  void trace(std::uint64_t config, double theta_i, double phi_i, std::uint64_t first,
-             std::uint64_t n, const Sink& sink, TracerCounters& counters) const;
+  // Traces photons [first, first + n) of the incident direction (theta_i,
+  // phi_i) (seed and streams as in launch_photon), in no particular order.
+  void trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
+             const Sink& sink, TracerCounters& counters) const;
 
   struct Lanes;  // the photons in flight (defined in batch_tracer.cpp)
 
@@ -44,6 +46,7 @@ class BatchTracer {
   void travel(Lanes& lanes, int n_active) const;
 
   const Settings settings_;
+  RoughnessModel model_;  // Tracer::effective_model
   EllipseCrossSection ellipse_;
   double cos_tilt_, sin_tilt_;
 };

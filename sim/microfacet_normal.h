@@ -23,8 +23,19 @@ Vec3 smooth_normal(const Vec3& d, const BoundaryNormals& n);
 // with probability max(0, -d.m) (visible normals), drawing until accepted.
 // Returns nothing when `max_tries` candidates were all rejected (the caller
 // tallies the photon as truncated). `tries` counts the candidates drawn.
+// beta_long = beta_azim = 0 is not handled here: it is the `smooth` model
+// (SPEC section 3), which the tracers use instead.
 std::optional<Vec3> gaussian_normal(const Vec3& d, const Vec3& n_facing, double beta_long,
                                     double beta_azim, PhotonRandom& rng, int max_tries,
                                     long& tries);
+
+// When the tilted normal faces away from the photon by an angle eps =
+// asin(d.n_f) of at least kFarTailSigmas times the larger beta, every visible
+// normal lies in the far tail of the Gaussian and gaussian_normal switches to
+// a sampler of that tail (see microfacet_normal.cpp). far_tail_threshold(b)
+// is the d.n_f from which it does: sin(kFarTailSigmas b), or 2 (never) when
+// that angle reaches pi/2.
+inline constexpr double kFarTailSigmas = 1.0;
+double far_tail_threshold(double beta_max);
 
 }  // namespace fiberlab::sim

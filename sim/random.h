@@ -1,9 +1,11 @@
 #pragma once
 // Random numbers for one photon. Each photon's stream is derived only from
-// (seed, incident configuration, photon index), so a photon's path does not
-// depend on which thread traces it or in which order (OpenMC's scheme; SPEC
-// section 6, reproducibility). Generator: xoshiro256** (Blackman & Vigna
-// 2018) seeded through SplitMix64.
+// (seed, the incident direction's value (theta_i, phi_i), photon index), so a
+// photon's path depends neither on which thread traces it, in which order,
+// nor on where its direction sits in a sweep: a sweep split into jobs and
+// merged equals one run (OpenMC's scheme; SPEC section 6, reproducibility).
+// Generator: xoshiro256** (Blackman & Vigna 2018) seeded through SplitMix64.
+#include <bit>
 #include <cmath>
 #include <cstdint>
 
@@ -24,15 +26,27 @@ class PhotonRandom {
   }
   RandomState state() const { return {{s_[0], s_[1], s_[2], s_[3]}, spare_, has_spare_}; }
 
-  PhotonRandom(std::uint64_t seed, std::uint64_t config, std::uint64_t photon) {
-    std::uint64_t x = splitmix(stream_key(seed, config) ^ photon);
+  // The stream of photon `photon` of the incident direction (theta_i,
+  // phi_i) (radians as configured; phi_i NaN for a randomly rotated fiber).
+  PhotonRandom(std::uint64_t seed, double theta_i, double phi_i, std::uint64_t photon)
+      : PhotonRandom(stream_key(seed, theta_i, phi_i), photon) {}
+  // The same from a precomputed stream_key.
+  PhotonRandom(std::uint64_t key, std::uint64_t photon) {
+    std::uint64_t x = splitmix(key ^ photon);
     for (auto& s : s_) s = x = splitmix(x);
   }
 
-  // What the streams of one incident configuration share; a photon's state is
-  // SplitMix64 applied to (key ^ photon), then four more times.
-  static std::uint64_t stream_key(std::uint64_t seed, std::uint64_t config) {
-    return splitmix(splitmix(seed ^ 0x6a09e667f3bcc909ULL) ^ config);
+  // What the streams of one incident direction share: SplitMix64 over the
+  // seed and the bit patterns of theta_i and phi_i (-0 counted as +0, every
+  // NaN as one value). A photon's state is SplitMix64 applied to
+  // (key ^ photon), then four more times.
+  static std::uint64_t stream_key(std::uint64_t seed, double theta_i, double phi_i) {
+    const std::uint64_t k = splitmix(splitmix(seed ^ 0x6a09e667f3bcc909ULL) ^ angle_bits(theta_i));
+    return splitmix(k ^ angle_bits(phi_i));
+  }
+  static std::uint64_t angle_bits(double a) {
+    if (std::isnan(a)) return 0x7ff8000000000000ULL;
+    return std::bit_cast<std::uint64_t>(a + 0.0);  // -0 + 0 = +0
   }
   static std::uint64_t splitmix(std::uint64_t z) {
     z += 0x9e3779b97f4a7c15ULL;

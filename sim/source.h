@@ -22,15 +22,17 @@ struct LaunchedPhoton {
 // each photon draws its own azimuth first.
 class Source {
  public:
-  Source(std::uint64_t seed, std::uint64_t config, double theta_i, double phi_i,
-         bool phi_i_uniform)
-      : seed_(seed), config_(config), theta_i_(theta_i), phi_i_(phi_i),
-        uniform_(phi_i_uniform), wi_(direction_from_angles(theta_i, phi_i)) {}
+  // phi_i is ignored (and may be NaN) when phi_i_uniform.
+  Source(std::uint64_t seed, double theta_i, double phi_i, bool phi_i_uniform)
+      : key_(PhotonRandom::stream_key(seed, theta_i, phi_i_uniform ? NAN : phi_i)),
+        theta_i_(theta_i), phi_i_(phi_i_uniform ? 0.0 : phi_i), uniform_(phi_i_uniform),
+        wi_(direction_from_angles(theta_i_, phi_i_)) {}
 
   bool fixed_direction() const { return !uniform_; }
+  std::uint64_t stream_key() const { return key_; }
 
   LaunchedPhoton launch(std::uint64_t photon) const {
-    PhotonRandom rng(seed_, config_, photon);
+    PhotonRandom rng(key_, photon);
     double phi_i = phi_i_;
     Vec3 wi = wi_;
     if (uniform_) {
@@ -42,16 +44,15 @@ class Source {
   }
 
  private:
-  std::uint64_t seed_, config_;
+  std::uint64_t key_;
   double theta_i_, phi_i_;
   bool uniform_;
   Vec3 wi_;
 };
 
-inline LaunchedPhoton launch_photon(std::uint64_t seed, std::uint64_t config,
-                                    std::uint64_t photon, double theta_i, double phi_i,
-                                    bool phi_i_uniform) {
-  return Source(seed, config, theta_i, phi_i, phi_i_uniform).launch(photon);
+inline LaunchedPhoton launch_photon(std::uint64_t seed, std::uint64_t photon, double theta_i,
+                                    double phi_i, bool phi_i_uniform) {
+  return Source(seed, theta_i, phi_i, phi_i_uniform).launch(photon);
 }
 
 }  // namespace fiberlab::sim

@@ -6,42 +6,28 @@ Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
     : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels) {
   const std::size_t bins = static_cast<std::size_t>(lobes) * n_theta * n_phi;
   bins_.assign(bins * block(), 0);
-  exited_.assign(static_cast<std::size_t>(lobes) * channels, 0);
-  absorbed_.assign(channels, 0);
   truncated_.assign(channels, 0);
 }
 
-void Tally::score_exit(int lobe, int i_theta, int i_phi, const double* weight) {
-  Fixed* cell = &bins_[bin_index(lobe, i_theta, i_phi) * block()];
+void Tally::score_exit(std::size_t bin, const double* weight) {
+  Fixed* cell = &bins_[bin * block()];
   ++cell[0];
   Fixed* s1 = cell + 1;
   Fixed* s2 = cell + 1 + channels_;
   for (int c = 0; c < channels_; ++c) {
-    const Fixed w = to_fixed(weight[c]);
-    s1[c] += w;
+    s1[c] += to_fixed(weight[c]);
     s2[c] += to_fixed(weight[c] * weight[c]);
-    exited_[static_cast<std::size_t>(lobe) * channels_ + c] += w;
-    absorbed_[c] += static_cast<Fixed>(1) << 60;
-    absorbed_[c] -= w;
   }
 }
 
 void Tally::score_truncated(const double* weight) {
-  for (int c = 0; c < channels_; ++c) {
-    const Fixed w = to_fixed(weight[c]);
-    truncated_[c] += w;
-    absorbed_[c] += (static_cast<Fixed>(1) << 60) - w;
-  }
+  for (int c = 0; c < channels_; ++c) truncated_[c] += to_fixed(weight[c]);
 }
 
 void Tally::add(const Tally& o) {
   photons_ += o.photons_;
   for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] += o.bins_[i];
-  for (std::size_t i = 0; i < exited_.size(); ++i) exited_[i] += o.exited_[i];
-  for (int c = 0; c < channels_; ++c) {
-    absorbed_[c] += o.absorbed_[c];
-    truncated_[c] += o.truncated_[c];
-  }
+  for (int c = 0; c < channels_; ++c) truncated_[c] += o.truncated_[c];
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
@@ -68,8 +54,32 @@ std::vector<std::uint64_t> Tally::count() const {
   for (std::size_t b = 0; b < bins; ++b) out[b] = static_cast<std::uint64_t>(bins_[b * block()]);
   return out;
 }
-std::vector<double> Tally::exited() const { return to_double(exited_); }
-std::vector<double> Tally::absorbed() const { return to_double(absorbed_); }
+// The ledger (SPEC section 4) from the bins: exited is the sum of S1 over a
+// lobe's bins, and every photon launched left a weight w that exited or was
+// truncated and 1 - w absorbed. Integer sums: exactly what per-photon
+// counters would hold.
+std::vector<Tally::Fixed> Tally::exited_fixed() const {
+  std::vector<Fixed> out(static_cast<std::size_t>(lobes_) * channels_, 0);
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;
+  for (int l = 0; l < lobes_; ++l)
+    for (std::size_t b = 0; b < per_lobe; ++b) {
+      const Fixed* s1 = &bins_[(l * per_lobe + b) * block() + 1];
+      for (int c = 0; c < channels_; ++c) out[static_cast<std::size_t>(l) * channels_ + c] += s1[c];
+    }
+  return out;
+}
+
+std::vector<double> Tally::exited() const { return to_double(exited_fixed()); }
+
+std::vector<double> Tally::absorbed() const {
+  const std::vector<Fixed> exited = exited_fixed();
+  std::vector<Fixed> absorbed(channels_, static_cast<Fixed>(photons_) << 60);
+  for (int c = 0; c < channels_; ++c) {
+    for (int l = 0; l < lobes_; ++l) absorbed[c] -= exited[static_cast<std::size_t>(l) * channels_ + c];
+    absorbed[c] -= truncated_[c];
+  }
+  return to_double(absorbed);
+}
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
 
 }  // namespace fiberlab::sim

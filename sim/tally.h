@@ -28,9 +28,23 @@ class Tally {
 
   // A photon that left in bin (i_theta, i_phi) of `lobe`, with weight[c] per
   // channel; 1 - weight[c] was absorbed.
-  void score_exit(int lobe, int i_theta, int i_phi, const double* weight);
+  void score_exit(int lobe, int i_theta, int i_phi, const double* weight) {
+    score_exit(bin_index(lobe, i_theta, i_phi), weight);
+  }
+  void score_exit(std::size_t bin, const double* weight);
+  std::size_t bin_index(int lobe, int i_theta, int i_phi) const {
+    return (static_cast<std::size_t>(lobe) * n_theta_ + i_theta) * n_phi_ + i_phi;
+  }
+  // Asks for a bin's cells ahead of score_exit (they are far apart in memory).
+  void prefetch(std::size_t bin) const {
+    const Fixed* cell = &bins_[bin * block()];
+    __builtin_prefetch(cell, 1);
+    __builtin_prefetch(reinterpret_cast<const char*>(cell + block()) - 1, 1);
+  }
   // A photon still inside when it was stopped, with weight[c] left.
   void score_truncated(const double* weight);
+  // Every launched photon must have been scored (exited or truncated): what
+  // is absorbed is derived from that (launched - exited - truncated, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
   void add(const Tally& other);  // exact: integer sums
 
@@ -44,9 +58,6 @@ class Tally {
   std::vector<double> truncated() const;  // [channel]
 
  private:
-  std::size_t bin_index(int lobe, int i_theta, int i_phi) const {
-    return (static_cast<std::size_t>(lobe) * n_theta_ + i_theta) * n_phi_ + i_phi;
-  }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
@@ -56,8 +67,9 @@ class Tally {
 
   int lobes_, n_theta_, n_phi_, channels_;
   std::uint64_t photons_ = 0;
+  std::vector<Fixed> exited_fixed() const;  // [lobe][channel]: sums of S1
   std::vector<Fixed> bins_;  // [bin][count, S1[C], S2[C]]
-  std::vector<Fixed> exited_, absorbed_, truncated_;
+  std::vector<Fixed> truncated_;
 };
 
 }  // namespace fiberlab::sim

@@ -18,7 +18,7 @@ Light make_light(const Vec3& d) {
 
 Tracer::Tracer(const Settings& s)
     : ellipse_(s.fiber.eccentricity),
-      model_(s.roughness.model),
+      model_(effective_model(s.roughness)),
       polarization_(s.polarization),
       eta_(s.fiber.eta),
       cos_tilt_(std::cos(s.fiber.scale_tilt)),
@@ -28,6 +28,13 @@ Tracer::Tracer(const Settings& s)
       exit_blur_(s.roughness),
       max_segments_(s.max_segments),
       max_events_(s.max_events_per_point) {}
+
+RoughnessModel Tracer::effective_model(const RoughnessSettings& r) {
+  if (r.model == RoughnessModel::Gaussian && r.beta_long.front() == 0.0 &&
+      r.beta_azim.front() == 0.0)
+    return RoughnessModel::Smooth;
+  return r.model;
+}
 
 // Returns false when the photon must be truncated (too many events at this
 // point, or no visible normal found). On return d is the new direction and
@@ -45,7 +52,10 @@ bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& 
     if (model_ == RoughnessModel::Gaussian) {
       auto drawn = gaussian_normal(d, normals.facing, beta_long_, beta_azim_, rng,
                                    kMaxNormalTries, counters.normal_draws);
-      if (!drawn) return false;
+      if (!drawn) {
+        ++counters.sampler_caps;
+        return false;
+      }
       m = *drawn;
     } else {
       m = smooth_normal(d, normals);
@@ -68,10 +78,7 @@ PhotonOutcome Tracer::trace(const Vec3& wi, double h, PhotonRandom& rng,
   const PhotonOutcome out = polarization_ == Polarization::Stokes
                                 ? trace_with<StokesLight>(wi, h, rng, counters)
                                 : trace_with<ScalarLight>(wi, h, rng, counters);
-  if (counters_out) {
-    counters_out->events += counters.events;
-    counters_out->normal_draws += counters.normal_draws;
-  }
+  if (counters_out) counters_out->add(counters);
   return out;
 }
 

@@ -26,11 +26,22 @@ struct PhotonOutcome {
 struct TracerCounters {
   long events = 0;          // interface events
   long normal_draws = 0;    // candidate microfacet normals drawn
+  long sampler_caps = 0;    // photons truncated because no visible normal was drawn in
+                            // kMaxNormalTries candidates (SPEC section 3: should be none)
+  void add(const TracerCounters& o) {
+    events += o.events;
+    normal_draws += o.normal_draws;
+    sampler_caps += o.sampler_caps;
+  }
 };
 
 class Tracer {
  public:
   explicit Tracer(const Settings& settings);
+
+  // The roughness model the tracers apply: gaussian with beta_long = beta_azim
+  // = 0 is the smooth model, fallback included (SPEC section 3).
+  static RoughnessModel effective_model(const RoughnessSettings& r);
 
   // Traces one photon arriving along -wi. h in (-1, 1) is its impact
   // parameter across the projected width.

@@ -4,7 +4,9 @@
 // the accepted distribution must be the same.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <tuple>
 #include <cstdio>
 #include <vector>
 
@@ -33,40 +35,56 @@ Vec3 reference_normal(const Vec3& d, const Vec3& nf, double bl, double ba, Photo
 struct Histogram2D {
   std::vector<double> counts = std::vector<double>(400, 0.0);
   double lo_u, hi_u, lo_a, hi_a;
+  static double azimuth_offset(const Vec3& m, const Vec3& nf) {
+    return wrap_angle(std::atan2(m.z(), m.y()) - std::atan2(nf.z(), nf.y()));
+  }
   void add(const Vec3& m, const Vec3& nf) {
-    const double a = std::atan2(m.z(), m.y()) - std::atan2(nf.z(), nf.y());
     const int i = static_cast<int>((m.x() - lo_u) / (hi_u - lo_u) * 20);
-    const int j = static_cast<int>((wrap_angle(a) - lo_a) / (hi_a - lo_a) * 20);
+    const int j = static_cast<int>((azimuth_offset(m, nf) - lo_a) / (hi_a - lo_a) * 20);
     if (i >= 0 && i < 20 && j >= 0 && j < 20) counts[i * 20 + j] += 1.0;
   }
 };
 
-void compare_samplers(const Vec3& d, const Vec3& nf, double bl, double ba, const char* what) {
-  const int n = 200000;
-  const double spread = 4.0 * std::max(bl, ba);
-  Histogram2D a;
-  a.lo_u = nf.x() - spread;
-  a.hi_u = nf.x() + spread;
-  a.lo_a = -1.5 * spread;
-  a.hi_a = 1.5 * spread;
-  Histogram2D b = a;
-  PhotonRandom ra(1, 2, 3), rb(4, 5, 6);
+// The 1st and 99th percentiles of x: the histogram range.
+std::pair<double, double> central_range(std::vector<double> x) {
+  std::sort(x.begin(), x.end());
+  return {x[x.size() / 100], x[x.size() - 1 - x.size() / 100]};
+}
+
+void compare_samplers(const Vec3& d, const Vec3& nf, double bl, double ba, const char* what,
+                      int n = 200000) {
+  PhotonRandom ra(1, 2.0, 0.0, 3), rb(4, 5.0, 0.0, 6);
   long tries = 0;
+  std::vector<Vec3> sa, sb;
   for (int k = 0; k < n; ++k) {
     auto m = gaussian_normal(d, nf, bl, ba, ra, 100000, tries);
-    ASSERT_TRUE(m.has_value());
-    EXPECT_LT(d.dot(*m), 0.0);
-    EXPECT_NEAR(m->norm(), 1.0, 1e-12);
-    a.add(*m, nf);
-    b.add(reference_normal(d, nf, bl, ba, rb), nf);
+    ASSERT_TRUE(m.has_value()) << what;
+    ASSERT_LT(d.dot(*m), 0.0);
+    ASSERT_NEAR(m->norm(), 1.0, 1e-12);
+    sa.push_back(*m);
+    sb.push_back(reference_normal(d, nf, bl, ba, rb));
   }
-  // Two-sample chi-square over bins with >= 30 expected counts in both.
+  // Bins over the range the reference samples cover.
+  std::vector<double> u, a;
+  for (const Vec3& m : sb) {
+    u.push_back(m.x());
+    a.push_back(Histogram2D::azimuth_offset(m, nf));
+  }
+  Histogram2D ha;
+  std::tie(ha.lo_u, ha.hi_u) = central_range(u);
+  std::tie(ha.lo_a, ha.hi_a) = central_range(a);
+  Histogram2D hb = ha;
+  for (int k = 0; k < n; ++k) {
+    ha.add(sa[k], nf);
+    hb.add(sb[k], nf);
+  }
+  // Two-sample chi-square over bins with >= 30 counts in both.
   double chi2 = 0.0;
   int dof = 0;
   for (int k = 0; k < 400; ++k) {
-    if (a.counts[k] < 30 || b.counts[k] < 30) continue;
-    const double diff = a.counts[k] - b.counts[k];
-    chi2 += diff * diff / (a.counts[k] + b.counts[k]);
+    if (ha.counts[k] < 30 || hb.counts[k] < 30) continue;
+    const double diff = ha.counts[k] - hb.counts[k];
+    chi2 += diff * diff / (ha.counts[k] + hb.counts[k]);
     ++dof;
   }
   // chi2 ~ chi-square(dof) (mean dof, sd sqrt(2 dof)); 5 sd above the mean.
@@ -96,6 +114,58 @@ TEST(GaussianNormal, SameDistributionWhenTheTiltedNormalFacesAway) {
   const Vec3 d = Vec3(-0.9, 0.03, 0.4).normalized();  // d.n_f > 0: c = 0
   ASSERT_GT(d.dot(nf), 0.0);
   compare_samplers(d, nf, deg_to_rad(10.0), deg_to_rad(10.0), "n_f facing away");
+}
+
+}  // namespace
+}  // namespace fiberlab::sim
+
+namespace fiberlab::sim {
+namespace {
+
+// A photon direction d that sees the facet normal nf from behind: d.nf =
+// sin(eps), eps the angle by which the tilted normal faces away (SPEC
+// section 3, small beta on a tilted fiber at oblique incidence). d is
+// nf's "grazing" partner turned by eps, with some inclination.
+Vec3 facing_away_direction(const Vec3& nf, double eps) {
+  const Vec3 t = nf.cross(Vec3(0.3, 0.2, 0.9)).normalized();  // tangent at nf
+  return (std::sin(eps) * nf + std::cos(eps) * t).normalized();
+}
+
+// The far-tail sampler: the tilted normal faces away by eps = 1.5 beta (and
+// 1.4 beta_long for unequal betas), so every visible normal is 1.5 or more
+// standard deviations out. The reference rejection sampler needs ~400
+// candidates per normal here (the samples are smaller to keep it fast).
+TEST(GaussianNormal, SameDistributionInTheFarTail) {
+  const Vec3 nf = Vec3(-std::sin(0.05), std::cos(0.05), 0.0);
+  const double beta = deg_to_rad(5.0);
+  const Vec3 d = facing_away_direction(nf, 1.5 * beta);
+  ASSERT_GE(d.dot(nf), far_tail_threshold(beta));  // the far-tail sampler is the one used
+  compare_samplers(d, nf, beta, beta, "far tail, eps = 1.5 beta", 40000);
+  const Vec3 d2 = facing_away_direction(nf, deg_to_rad(7.0));
+  compare_samplers(d2, nf, deg_to_rad(5.0), deg_to_rad(3.0), "far tail, beta 5/3, eps 7 deg",
+                   40000);
+}
+
+// Issue 8's case: beta 0.5 deg with the normal 3 deg away (eps / beta = 6):
+// plain rejection (probability ~1e-9 a candidate) hit any cap; the tail
+// sampler must find every normal in a few dozen candidates.
+TEST(GaussianNormal, FarTailNeverReachesTheCap) {
+  const Vec3 nf = Vec3(-std::sin(0.05), std::cos(0.05), 0.0);
+  const double beta = deg_to_rad(0.5);
+  PhotonRandom rng(7, 8.0, 0.0, 9);
+  for (double eps_deg : {0.6, 3.0, 10.0}) {
+    const Vec3 d = facing_away_direction(nf, deg_to_rad(eps_deg));
+    long tries = 0;
+    const int n = 20000;
+    for (int k = 0; k < n; ++k) {
+      const auto m = gaussian_normal(d, nf, beta, beta, rng, 100000, tries);
+      ASSERT_TRUE(m.has_value()) << "eps " << eps_deg << " deg";
+      ASSERT_LT(d.dot(*m), 0.0);
+    }
+    std::printf("beta 0.5 deg, eps %.1f deg: %.1f candidates per normal\n", eps_deg,
+                static_cast<double>(tries) / n);
+    EXPECT_LT(static_cast<double>(tries) / n, 200.0);
+  }
 }
 
 }  // namespace

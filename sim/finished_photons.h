@@ -1,0 +1,47 @@
+#pragma once
+// Photons that a tracer has finished, handed to the scorer a block at a time
+// (structure of arrays), so that weights are computed vectorised and the
+// tally's cells fetched ahead, instead of one call per photon.
+#include <cstdint>
+
+#include "sim/tracer.h"
+
+namespace fiberlab::sim {
+
+struct FinishedPhotons {
+  static constexpr int kCapacity = 256;  // a multiple of every SIMD width
+  int n = 0;
+  alignas(64) double path[kCapacity] = {};  // internal 3D path length
+  alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
+  alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
+  std::uint64_t photon[kCapacity];
+  int segments[kCapacity];
+  bool exited[kCapacity];
+
+  bool full() const { return n == kCapacity; }
+  void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
+    photon[n] = index;
+    phi_i[n] = incident_phi;
+    path[n] = o.path_length;
+    segments[n] = o.segments;
+    exited[n] = o.fate == PhotonFate::Exited;
+    theta[n] = o.theta;
+    phi[n] = o.phi;
+    dx[n] = o.direction.x();
+    dy[n] = o.direction.y();
+    dz[n] = o.direction.z();
+    ++n;
+  }
+  PhotonOutcome outcome(int i) const {
+    PhotonOutcome o;
+    o.fate = exited[i] ? PhotonFate::Exited : PhotonFate::Truncated;
+    o.direction = Vec3(dx[i], dy[i], dz[i]);
+    o.segments = segments[i];
+    o.path_length = path[i];
+    o.theta = theta[i];
+    o.phi = phi[i];
+    return o;
+  }
+};
+
+}  // namespace fiberlab::sim
