@@ -6,6 +6,9 @@
 #include <cmath>
 
 #include "analytic/deon2011.h"
+#include "analytic/model_params.h"
+#include "analytic/model_registry.h"
+#include "analytic/physical_defaults.h"
 #include "analytic/quadrature.h"
 #include "analytic/smooth_cylinder.h"
 #include "common/error.h"
@@ -46,6 +49,24 @@ double trimmed_logistic_cumulative(double x, double s) {
   const double r = x - kTwoPi * k;  // [-pi, pi)
   return k + (sigmoid(r / s) - sigmoid(-kPi / s)) / trimmed_mass(s);
 }
+
+namespace {
+double invert_increasing(double (*f)(double), double y, const char* what) {
+  if (!(y >= 0.0) || !(y <= f(1.0)))
+    throw Error(fmt::format("chiang2016: {} = {} lies beyond beta = 1 (at most {})", what, y, f(1.0)));
+  if (y == 0.0) return 0.0;  // f(0) = 0: the exact smooth limit
+  double lo = 0.0, hi = 1.0;
+  for (int it = 0; it < 100; ++it) {
+    const double m = 0.5 * (lo + hi);
+    if (f(m) < y) lo = m; else hi = m;
+  }
+  return 0.5 * (lo + hi);
+}
+double r_width(double beta_m) { return std::sqrt(longitudinal_variance(beta_m)); }
+}  // namespace
+
+double beta_m_for_width(double width) { return invert_increasing(r_width, width, "R lobe width"); }
+double beta_n_for_scale(double s) { return invert_increasing(logistic_scale, s, "logistic scale"); }
 
 }  // namespace chiang2016
 
@@ -356,6 +377,66 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
 
 std::unique_ptr<Model> make_chiang2016(const Chiang2016Params& params) {
   return std::make_unique<Chiang2016>(params);
+}
+
+std::unique_ptr<Model> make_chiang2016(const ModelParams& mp) {
+  Chiang2016Params p;
+  p.eta = mp.eta;
+  p.sigma_a = mp.sigma_a;
+  p.beta_m = mp.beta_m;
+  p.beta_n = mp.beta_n;
+  p.alpha = mp.scale_tilt;
+  p.lobes = mp.lobes;
+  return std::make_unique<Chiang2016>(p);
+}
+
+namespace {
+
+std::vector<std::string> chiang_approximations(const ModelParams&) {
+  return {"far field: pbrt's BCSDF averaged over h, with pbrt's wo read as our wi (A_p at theta_i)",
+          "M_p: d'Eon's von Mises-Fisher lobe; tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha",
+          "N_p: trimmed logistic about Phi(p, h) (not a physical detector)",
+          "every order p >= 3 in one lobe, uniform in phi (p_max = 3)",
+          "absorption: the chord (SPEC s7)"};
+}
+
+}  // namespace
+
+ModelInfo chiang2016_info() {
+  ModelInfo m;
+  m.name = "chiang2016";
+  m.reference =
+      "Chiang, Bitterli, Tappan, Burley 2016, A Practical and Controllable Hair and Fur Model for "
+      "Production Path Tracing (pbrt-v4 HairBxDF), far field";
+  auto unit_interval = [](double x) { return x >= 0.0 && x <= 1.0; };
+  ParamSpec beta_m = number_param("beta_m", "longitudinal roughness: v = (0.726 b + 0.812 b^2 + 3.7 b^20)^2 (R; TT v/4, TRT 4v)",
+                                  "", "0.3", "a number in [0, 1]", &ModelParams::beta_m, unit_interval);
+  beta_m.from_fiber = "roughness: R's sqrt(v) = the R lobe's calibrated theta_r width";
+  ParamSpec beta_n = number_param("beta_n", "azimuthal roughness: logistic s = sqrt(pi/8)(0.265 b + 1.194 b^2 + 5.372 b^22)",
+                                  "", "0.3", "a number in [0, 1]", &ModelParams::beta_n, unit_interval);
+  beta_n.from_fiber = "roughness: s pi / sqrt(3) = the R lobe's azimuthal width";
+  ParamSpec alpha = number_param("alpha",
+                                 "cuticle scale tilt, > 0 towards the root (R at theta_r = -theta_i - 2 alpha); "
+                                 "pbrt-v4's alpha is its negative",
+                                 "deg", "2", "degrees in (-45, 45)", &ModelParams::scale_tilt,
+                                 [](double x) { return std::abs(x) < 45.0; });
+  alpha.from_fiber = "fiber.scale_tilt";
+  m.params = {eta_param(), sigma_a_param(), beta_m, beta_n, alpha, lobes_param()};
+  m.make = [](const ModelParams& p) { return make_chiang2016(p); };
+  m.approximations = chiang_approximations;
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+    if (f.eccentricity != 1.0)
+      throw Error(fmt::format("model chiang2016: circular fibers only; this fiber has eccentricity {:g}",
+                              f.eccentricity));
+    apply_fiber_basics(f, p);
+    p.scale_tilt = f.scale_tilt;
+    // Widths as for d'Eon's M_p (the same function), then through the
+    // inverse mappings: an approximate width match; smooth gives 0 exactly.
+    apply_fiber_roughness(f, p, deon2011_width_calibration());
+    p.beta_m = chiang2016::beta_m_for_width(for_lobe(p.beta_long, 0));
+    p.beta_n = chiang2016::beta_n_for_scale(for_lobe(p.beta_azim, 0) * std::sqrt(3.0) / kPi);
+  };
+  return m;
 }
 
 }  // namespace fiberlab::analytic

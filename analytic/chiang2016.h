@@ -75,6 +75,12 @@ double trimmed_logistic(double x, double s);
 // a <= b (closed form: logistic CDF 1 / (1 + exp(-x / s))).
 double trimmed_logistic_cumulative(double x, double s);
 
+// Inverses of the two mappings on [0, 1] (bisection; both are increasing):
+// beta_m whose R lobe has sqrt(v) = width, beta_n whose logistic has scale s.
+// fiberlab::Error when the value lies beyond beta = 1.
+double beta_m_for_width(double width);
+double beta_n_for_scale(double s);
+
 }  // namespace chiang2016
 
 struct Chiang2016Params {
@@ -121,5 +127,9 @@ class Chiang2016 : public Model {
 };
 
 std::unique_ptr<Model> make_chiang2016(const Chiang2016Params& params);
+// From ModelParams: eta, sigma_a, lobes, beta_m, beta_n, scale_tilt (its
+// parameter table, chiang2016_info() in the .cpp, names the last `alpha`).
+// Chord absorption always (the model's own).
+std::unique_ptr<Model> make_chiang2016(const ModelParams& params);
 
 }  // namespace fiberlab::analytic
