@@ -344,6 +344,16 @@ TEST(Chiang2016, FewerLobesSumTheHigherOrders) {
   EXPECT_NEAR(two[1], four[1] + four[2] + four[3], 1e-15);
 }
 
+// The inverses used for defaults from a simulation round-trip the mappings.
+TEST(Chiang2016, InverseMappingsRoundTrip) {
+  for (double b : {0.0, 0.01, 0.2, 0.5, 0.93, 1.0}) {
+    EXPECT_NEAR(chiang2016::beta_m_for_width(std::sqrt(chiang2016::longitudinal_variance(b))), b, 1e-12);
+    EXPECT_NEAR(chiang2016::beta_n_for_scale(chiang2016::logistic_scale(b)), b, 1e-12);
+  }
+  EXPECT_THROW(chiang2016::beta_m_for_width(6.0), Error);
+  EXPECT_THROW(chiang2016::beta_n_for_scale(-1.0), Error);
+}
+
 TEST(Chiang2016, RejectsParametersOutOfRange) {
   auto make = [](auto edit) {
     Chiang2016Params p;
