@@ -53,7 +53,7 @@ double integrate(F f, double a, double b, int n) {
 
 // Oracle: the paper's formulas evaluated by hand at beta = 0.3 and 1:
 // v = (0.726 b + 0.812 b^2 + 3.7 b^20)^2, s = sqrt(pi/8)(0.265 b + 1.194 b^2 + 5.372 b^22).
-// Mutation caught: any coefficient or exponent changed (e.g. b^20 -> b^2).
+// (Values at 0.3 and 1 pin every coefficient and exponent.)
 TEST(Chiang2016, RoughnessMappingsAreThePapers) {
   EXPECT_NEAR(chiang2016::longitudinal_variance(0.3), 0.08461117, 1e-8);
   EXPECT_NEAR(chiang2016::longitudinal_variance(1.0), 27.436644, 1e-9);
@@ -66,8 +66,7 @@ TEST(Chiang2016, RoughnessMappingsAreThePapers) {
 // The trimmed logistic integrates to 1 over [-pi, pi] for every scale the
 // mapping produces, and its closed-form cumulative agrees with quadrature
 // and is periodic with unit step.
-// Mutation caught: dropping the trimming normalisation (fails at s = 4.28
-// by 37%); a cumulative of the untrimmed logistic (fails the periodicity).
+// Mutation tried and caught: dropping the trimming normalisation.
 TEST(Chiang2016, TrimmedLogisticIsNormalised) {
   for (double beta_n : {0.01, 0.1, 0.3, 0.5, 0.7, 0.9, 1.0}) {
     const double s = chiang2016::logistic_scale(beta_n);
@@ -89,10 +88,9 @@ TEST(Chiang2016, TrimmedLogisticIsNormalised) {
 // and N_p carry unit mass, sum_p A_p = 1, so the sum over the sphere is 1 to
 // quadrature accuracy for beta_m, beta_n in {0.1 .. 0.9}, with and without tilt,
 // including incidences where the tilt rotation passes the pole.
-// Mutations caught: TT variance v instead of v/4 does not (the furnace holds
-// for any v; see LobeCentres), but a missing |cos| past the pole (theta_i 85,
-// alpha 10 deg: R's M_p then integrates to less than 1) and a residual lobe of
-// f T / (1 - f T) without (1 - f)^2 f^2 T^2 do.
+// Mutation tried and caught: the residual summing p > 3 instead of p >= 3
+// (A_beyond(3) for A_beyond(2)). (Not a mutation: dropping |cos| past the
+// pole; M_p depends on cos theta_i only through the even I0.)
 TEST(Chiang2016, WhiteFurnaceOfBinProbabilities) {
   const BinGrid grid = BinGrid::make(36, 72, ThetaBinning::Uniform);
   const double kBetas[] = {0.1, 0.3, 0.5, 0.7, 0.9};
@@ -117,10 +115,8 @@ TEST(Chiang2016, WhiteFurnaceOfBinProbabilities) {
 // and then integrates the two 1D factors by Gauss-Legendre.
 // Oracle: 1 within 1e-6 (the issue asks 1e-3; measured <= 7e-8, from the
 // kink of the wrapped logistic at beta_n = 0.9).
-// Mutations caught: N_p's eta' or A_p taken at the exit inclination instead
-// of theta_i (separability breaks); Phi with -2 p gamma_t (furnace holds, see
-// SmallRoughnessIsTheSmoothCylinder); the TRT variance 4v replaced by v / 4
-// together with dropping |cos| (the furnace drops at theta_i = 85).
+// Mutation tried and caught: density() building A_p and eta' from theta_r
+// instead of theta_i (pbrt's frame the other way round).
 TEST(Chiang2016, WhiteFurnaceOfDensity) {
   const double kBetas[] = {0.1, 0.5, 0.9};
   std::vector<double> d;
@@ -157,8 +153,7 @@ TEST(Chiang2016, WhiteFurnaceOfDensity) {
 // M_p normalisation: each lobe's mass over the theta bins equals its energy
 // (1/2) int A_p dh for every roughness, every tilt rotation (up to 50 deg,
 // past the pole at theta_i = 80 deg) and absorbing fibers.
-// Mutation caught: panels of sqrt(v) instead of sqrt(v)/3 over a window of
-// 3 sqrt(v) instead of 12 (mass lost 3e-3).
+// Mutation tried and caught: a window of 3 sqrt(v) instead of 12 about the peak.
 TEST(Chiang2016, LongitudinalMassIsOne) {
   const BinGrid grid = BinGrid::make(45, 8, ThetaBinning::EqualArea);
   for (double bm : {0.02, 0.1, 0.4, 1.0})
@@ -182,8 +177,7 @@ TEST(Chiang2016, LongitudinalMassIsOne) {
 // SPEC s8, smooth circular fiber, eta = 1.55, sigma_a = 0, scalar Fresnel:
 // lobe energies R, TT, TRT, p >= 3 at theta_i = 0 and 60 deg. Chiang's A_p
 // are the smooth cylinder's, so these hold at every roughness.
-// Mutation caught: Fresnel at cos(gamma_i) instead of cos(theta) cos(gamma_i)
-// (R at 60 deg 0.086 instead of 0.173); residual without the 1/(1 - f T) sum.
+// Mutation tried and caught: the residual off by one order (as above).
 TEST(Chiang2016, LobeEnergiesAreSpecSection8) {
   struct Row { double theta_deg, R, TT, TRT, rest; };
   const Row rows[] = {{0.0, 0.07496, 0.86179, 0.05567, 0.00758},
@@ -202,8 +196,7 @@ TEST(Chiang2016, LobeEnergiesAreSpecSection8) {
 
 // Absorbing fiber: lobe energies equal the exact smooth cylinder's with chord
 // absorption (SPEC s7, independent code path: analytic/smooth_cylinder).
-// Mutation caught: T with the published 4 cos^2(gamma_t) length, or without
-// the 1 / cos(theta_t) (errors of 1e-2 .. 1e-1 in TT).
+// Mutation tried and caught: Absorption::Published (4 cos^2 gamma_t) for the chord.
 TEST(Chiang2016, AbsorbingLobeEnergiesAreTheSmoothCylinders) {
   const std::vector<double> sigma_a{0.2, 0.8, 2.0};
   for (double ti_deg : {0.0, 35.0, 70.0}) {
@@ -229,8 +222,7 @@ TEST(Chiang2016, AbsorbingLobeEnergiesAreTheSmoothCylinders) {
 
 // Zero roughness is the exact smooth cylinder, bin for bin (the delta
 // limits of M_p and of the logistic), with absorption, for R, TT and TRT.
-// Mutation caught: any change of the phi bookkeeping in the delta branch, or
-// an untilted-lobe theta bin off by one.
+// Mutation tried and caught: the residual off by one order (its total).
 TEST(Chiang2016, ZeroRoughnessIsTheSmoothCylinder) {
   const BinGrid grid = BinGrid::make(18, 72, ThetaBinning::Uniform);
   ModelParams mp;
@@ -259,8 +251,9 @@ TEST(Chiang2016, ZeroRoughnessIsTheSmoothCylinder) {
 // within 1e-3 per bin and the theta mass in the specular bin above 0.999.
 // At this s the fine zones (40 s about each bin edge) leave coarse panels
 // between them, so both node kinds are exercised.
-// Mutations caught: the logistic's mass deposited one bin off, the coarse
-// panels dropped (mass lost), or the fine zones dropped (edges smeared).
+// Mutations tried and caught: the logistic's mass deposited one bin off; the
+// far (coarse) pieces dropped. (Not a mutation: depositing about -Phi, the
+// h -> -h mirror image, which the average over h makes identical.)
 TEST(Chiang2016, SmallRoughnessIsTheSmoothCylinder) {
   const BinGrid grid = BinGrid::make(6, 36, ThetaBinning::Uniform);  // centres +-15, 45, 75 deg
   ModelParams mp;
@@ -291,8 +284,8 @@ TEST(Chiang2016, SmallRoughnessIsTheSmoothCylinder) {
 // SPEC s7's shifts for scale_tilt alpha: the lobes' theta_r centres move to
 // -theta_i - 2 alpha (R), + alpha (TT), + 4 alpha (TRT); the residual stays.
 // Measured as each lobe's mean theta_r over 1-degree bins at small beta_m.
-// Mutation caught: pbrt-v4's sign (R at -theta_i + 2 alpha) or rotating TT
-// by 2 alpha.
+// Mutations tried and caught: pbrt-v4's sign (R at -theta_i + 2 alpha); TT
+// rotated by 2 alpha.
 TEST(Chiang2016, TiltMovesLobeCentresAsSpecSection7) {
   const BinGrid grid = BinGrid::make(180, 4, ThetaBinning::Uniform);
   Chiang2016Params p = white(0.05, 0.3);
@@ -316,6 +309,8 @@ TEST(Chiang2016, TiltMovesLobeCentresAsSpecSection7) {
 // Quadrature convergence: doubling every node density changes no bin by more
 // than 1e-12 (far below any Monte Carlo standard error), at the sharpest
 // roughness users set and at the default.
+// Mutation tried and caught: every piece over h with coarse pi/64 panels
+// (the 2 s panels in the logistic's zones dropped).
 TEST(Chiang2016, BinProbabilitiesConverged) {
   const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
   for (double beta : {0.05, 0.3}) {
@@ -331,6 +326,68 @@ TEST(Chiang2016, BinProbabilitiesConverged) {
     double worst = 0.0;
     for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(a[k] - b[k]));
     EXPECT_LT(worst, 1e-12) << "beta " << beta;
+  }
+}
+
+// The two evaluation paths agree: bin probabilities equal the integral of
+// density() over the bin (2D Gauss-Legendre, 32 x 32 points per bin), at a
+// roughness where the density is smooth on the bin scale, with absorption
+// and tilt.
+// Mutation tried and caught: density() using the R variance v for every lobe
+// (TT's v/4 and TRT's 4v then differ between the two paths).
+TEST(Chiang2016, BinsAreTheIntegralOfTheDensity) {
+  Chiang2016Params p;
+  p.sigma_a = {0.3, 1.2};
+  p.beta_m = 0.5;
+  p.beta_n = 0.5;
+  p.alpha = deg_to_rad(4.0);
+  const Chiang2016 model(p);
+  const BinGrid grid = BinGrid::make(12, 12, ThetaBinning::Uniform);
+  const double ti = deg_to_rad(25.0);
+  const std::vector<double> b = model.bin_probabilities(grid, ti, 0.0);
+  std::vector<double> d;
+  const GaussLegendre& gl = gauss_legendre(8);
+  for (int lobe = 0; lobe < 4; ++lobe)
+    for (int i : {3, 6, 9})
+      for (int j : {0, 7}) {
+        const double t0 = grid.theta_edges[i], t1 = grid.theta_edges[i + 1];
+        const double f0 = grid.phi_edges[j], f1 = grid.phi_edges[j + 1];
+        double v[2] = {0.0, 0.0};
+        constexpr int kPanels = 4;
+        for (int a = 0; a < kPanels * 8; ++a)
+          for (int e = 0; e < kPanels * 8; ++e) {
+            const double ht = (t1 - t0) / kPanels, hf = (f1 - f0) / kPanels;
+            const double tr = t0 + (a / 8 + 0.5 + 0.5 * gl.x[a % 8]) * ht;
+            const double ph = f0 + (e / 8 + 0.5 + 0.5 * gl.x[e % 8]) * hf;
+            model.density(lobe, ti, 0.0, tr, ph, d);
+            for (int c = 0; c < 2; ++c) v[c] += 0.25 * ht * hf * gl.w[a % 8] * gl.w[e % 8] * d[c];
+          }
+        for (int c = 0; c < 2; ++c)
+          EXPECT_NEAR(b[((lobe * 12 + i) * 12 + j) * 2 + c], v[c], 1e-7 * std::max(v[c], 1e-3))
+              << "lobe " << lobe << " bin " << i << "," << j << " channel " << c;
+      }
+}
+
+// The paper's per-lobe variances: the theta_r spread of R, TT, TRT and the
+// residual is sqrt(v), sqrt(v)/2, 2 sqrt(v), 2 sqrt(v) (M_p is a Gaussian of
+// variance v_p in theta_r for small v), measured on 0.5-degree bins with
+// Sheppard's correction, within 3%.
+// Mutation tried and caught: TT with v instead of v / 4.
+TEST(Chiang2016, LobeWidthsAreThePapers) {
+  const BinGrid grid = BinGrid::make(360, 2, ThetaBinning::Uniform);
+  const Chiang2016 model(white(0.1, 0.3));
+  const std::vector<double> b = model.bin_probabilities(grid, 0.0, 0.0);
+  const double sv = rad_to_deg(std::sqrt(chiang2016::longitudinal_variance(0.1)));
+  const double want[4] = {sv, 0.5 * sv, 2.0 * sv, 2.0 * sv};
+  for (int l = 0; l < 4; ++l) {
+    double m0 = 0.0, m1 = 0.0, m2 = 0.0;
+    for (int i = 0; i < 360; ++i) {
+      const double t = rad_to_deg(0.5 * (grid.theta_edges[i] + grid.theta_edges[i + 1]));
+      const double x = b[(l * 360 + i) * 2] + b[(l * 360 + i) * 2 + 1];
+      m0 += x, m1 += x * t, m2 += x * t * t;
+    }
+    const double var = m2 / m0 - (m1 / m0) * (m1 / m0) - 0.25 / 12.0;
+    EXPECT_NEAR(std::sqrt(var), want[l], 0.03 * want[l]) << "lobe " << l;
   }
 }
 
