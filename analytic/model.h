@@ -52,6 +52,11 @@ struct ModelParams {
   // product: exactly the simulator's `exit_blur` (SPEC s3)
   // (`n_theta_d=exit|specular`).
   bool specular_theta_d = false;
+  // Chiang et al. 2016 only: roughness in [0, 1] (their beta_m -> v and
+  // beta_n -> s mappings) and the cuticle scale tilt (radians, > 0 towards
+  // the root as SPEC's scale_tilt; the model rotates by 2^k of it).
+  double beta_m = 0.3, beta_n = 0.3;
+  double scale_tilt = 0.0;
 };
 
 // Value of a per-lobe list for lobe p: the last entry applies to every larger p.

@@ -11,10 +11,12 @@ namespace fiberlab::analytic {
 ModelInfo exact_info();          // smooth_cylinder.cpp
 ModelInfo deon2011_info();       // deon2011.cpp
 ModelInfo marschner2003_info();  // marschner2003.cpp
+ModelInfo chiang2016_info();     // chiang2016.cpp
 
 const std::vector<ModelInfo>& registered_models() {
   // To add a model: declare its info function above and list it here.
-  static const std::vector<ModelInfo> models{exact_info(), deon2011_info(), marschner2003_info()};
+  static const std::vector<ModelInfo> models{exact_info(), deon2011_info(), marschner2003_info(),
+                                             chiang2016_info()};
   return models;
 }
 
