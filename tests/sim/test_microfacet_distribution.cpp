@@ -112,7 +112,7 @@ ChiSquare chi_square(const MicrofacetDistribution& dist, const Vec3& w, double a
   const double scale = 3.0 * alpha_max;
   auto theta_edge = [&](int i) { return i >= kU - 1 ? 0.5 * kPi : std::atan(scale * i / (kU - 1.0)); };
   std::vector<double> observed(kU * kPhi, 0.0), expected(kU * kPhi, 0.0);
-  PhotonRandom rng(20260101, 7, 0);
+  PhotonRandom rng(/*key=*/20260101, /*photon=*/7);
   for (int k = 0; k < n; ++k) {
     const Vec3 m = sample(rng);
     const double theta = std::acos(std::clamp(m.z(), -1.0, 1.0));
