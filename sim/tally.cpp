@@ -1,5 +1,7 @@
 #include "sim/tally.h"
 
+#include "common/error.h"
+
 namespace fiberlab::sim {
 
 Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
@@ -41,6 +43,45 @@ void Tally::add(const Tally& o) {
   for (int c = 0; c < channels_; ++c) {
     absorbed_[c] += o.absorbed_[c];
     truncated_[c] += o.truncated_[c];
+  }
+}
+
+ExactTally Tally::exact() const {
+  ExactTally e(shape());
+  e.photons = photons_;
+  const std::size_t C = channels_;
+  for (std::size_t b = 0; b < e.count.size(); ++b) {
+    const Fixed* cell = &bins_[b * block()];
+    e.count[b] = static_cast<std::uint64_t>(cell[0]);
+    for (std::size_t c = 0; c < C; ++c) {
+      e.weight_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
+      e.weight_sq_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
+    }
+  }
+  for (std::size_t i = 0; i < exited_.size(); ++i) e.exited[i] = static_cast<ExactTally::Word>(exited_[i]);
+  for (std::size_t c = 0; c < C; ++c) {
+    e.absorbed[c] = static_cast<ExactTally::Word>(absorbed_[c]);
+    e.truncated[c] = static_cast<ExactTally::Word>(truncated_[c]);
+  }
+  return e;
+}
+
+void Tally::add(const ExactTally& e) {
+  if (!(e.shape == shape())) throw Error("internal error: adding an exact tally of another shape");
+  photons_ += e.photons;
+  const std::size_t C = channels_;
+  for (std::size_t b = 0; b < e.count.size(); ++b) {
+    Fixed* cell = &bins_[b * block()];
+    cell[0] += e.count[b];
+    for (std::size_t c = 0; c < C; ++c) {
+      cell[1 + c] += static_cast<Fixed>(e.weight_sum[b * C + c]);
+      cell[1 + C + c] += static_cast<Fixed>(e.weight_sq_sum[b * C + c]);
+    }
+  }
+  for (std::size_t i = 0; i < exited_.size(); ++i) exited_[i] += static_cast<Fixed>(e.exited[i]);
+  for (std::size_t c = 0; c < C; ++c) {
+    absorbed_[c] += static_cast<Fixed>(e.absorbed[c]);
+    truncated_[c] += static_cast<Fixed>(e.truncated[c]);
   }
 }
 
