@@ -396,6 +396,8 @@ std::vector<std::uint64_t> File::attr_uint64s(const std::string& obj, const std:
     out[i] = static_cast<std::uint64_t>(v[i]);
   }
   return out;
+}
+
 void File::create_dataset(const std::string& name, const Dims& dims, Type type) {
   Handle space = checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
                          H5Sclose, "dataspace for " + name, path_);

@@ -117,9 +117,9 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   h.software_version = f.attr_string("/", "software_version");
   h.created_utc = f.attr_string("/", "created_utc");
   if (f.has_attr("/", "merged_seeds")) {
-    for (double s : f.attr_doubles("/", "merged_seeds")) h.seeds.push_back(static_cast<std::uint64_t>(s));
+    h.seeds = f.attr_uint64s("/", "merged_seeds", 1u << 20);
   } else {
-    h.seeds = {static_cast<std::uint64_t>(f.attr_int("/", "seed"))};
+    h.seeds = {f.attr_uint64("/", "seed")};
   }
   if (h.seeds.empty()) throw Error(path + ": merged_seeds is empty");
   h.grid = read_bins(f);

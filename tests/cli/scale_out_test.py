@@ -91,7 +91,7 @@ def case_mpi(fl, d):
             fail(f"{ranks} ranks: expected one output file, found {left}")
     # SIGTERM to mpirun (forwarded to every rank): rank 0 saves a checkpoint;
     # one process with 2 threads finishes it, bit-identical.
-    big = write_config(d, "big.yaml", 1500000, "[20, 35]")
+    big = write_config(d, "big.yaml", 6000000, "[20, 35]")
     must([fl, "run", big, "-o", os.path.join(d, "big_ref.h5"), "--threads", "2", "--quiet"])
     out, nxt = interrupted_then_resumed(
         fl, d, big, signal.SIGTERM, "mpiterm",
