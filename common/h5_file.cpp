@@ -51,6 +51,34 @@ Handle open_attr(hid_t file, const std::string& obj, const std::string& name,
                  H5Aclose, "missing attribute " + obj + "@" + name, path);
 }
 
+// Large arrays are chunked and compressed (most histogram bins are empty),
+// with chunks of at most 65536 cells; `slab_rows`: one chunk never spans two
+// slabs along the first dimension (slab-at-a-time writing).
+Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& path) {
+  hsize_t n = 1;
+  for (hsize_t d : dims) n *= d;
+  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list", path);
+  if ((n >= 4096 || slab_rows) && !dims.empty() && n > 0 &&
+      H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
+    Dims chunk = dims;
+    hsize_t cells = n;
+    for (std::size_t i = 0; i < chunk.size() && (cells > 65536 || (i == 0 && slab_rows)); ++i) {
+      cells /= chunk[i];
+      chunk[i] = 1;
+      if (cells < 65536) {
+        if (!(i == 0 && slab_rows)) {
+          chunk[i] = std::max<hsize_t>(1, 65536 / std::max<hsize_t>(cells, 1));
+          chunk[i] = std::min(chunk[i], dims[i]);
+        }
+        break;
+      }
+    }
+    H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
+    H5Pset_deflate(dcpl.id(), 4);
+  }
+  return dcpl;
+}
+
 template <typename T>
 void write_dataset(hid_t file, const std::string& path, const std::string& name,
                    const Dims& dims, const std::vector<T>& data, hid_t mem_type, hid_t file_type) {
@@ -61,29 +89,48 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
                             data.size(), n));
   Handle space = checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
                          H5Sclose, "dataspace for " + name, path);
-  Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list", path);
-  // Large arrays are chunked and compressed: most histogram bins are empty.
-  if (n >= 4096 && H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
-    Dims chunk = dims;
-    hsize_t cells = n;
-    for (std::size_t i = 0; i < chunk.size() && cells > 65536; ++i) {
-      cells /= chunk[i];
-      chunk[i] = 1;
-      if (cells < 65536) {
-        chunk[i] = std::max<hsize_t>(1, 65536 / cells);
-        chunk[i] = std::min(chunk[i], dims[i]);
-        break;
-      }
-    }
-    H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
-    H5Pset_deflate(dcpl.id(), 4);
-  }
+  Handle dcpl = dataset_creation(dims, false, path);
   Handle set = checked(H5Dcreate2(file, name.c_str(), file_type, space.id(), H5P_DEFAULT,
                                   dcpl.id(), H5P_DEFAULT),
                        H5Dclose, "cannot create " + name, path);
   errno = 0;
   check(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()),
         "cannot write " + name, path);
+}
+
+// Reads or writes slab i (index i along the first dimension) of a dataset.
+template <typename T>
+void slab_io(hid_t file, const std::string& path, const std::string& name, hsize_t i,
+             std::vector<T>* read_into, const std::vector<T>* write_from, hid_t mem_type) {
+  Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
+                       path);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 1) throw Error(fmt::format("{}: {} is not an array", path, name));
+  Dims dims(rank);
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  if (i >= dims[0])
+    throw Error(fmt::format("{}: {} has {} slabs, not {}", path, name, dims[0], i + 1));
+  Dims start(rank, 0), count = dims;
+  start[0] = i;
+  count[0] = 1;
+  hsize_t n = 1;
+  for (hsize_t d : count) n *= d;
+  check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
+                            nullptr),
+        "select slab of " + name, path);
+  Handle mem = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "memory space", path);
+  if (read_into) {
+    read_into->resize(n);
+    check(H5Dread(set.id(), mem_type, mem.id(), space.id(), H5P_DEFAULT, read_into->data()),
+          "cannot read " + name, path);
+  } else {
+    if (write_from->size() != n)
+      throw Error(fmt::format("{}: internal error: slab of {} has {} values for {} cells", path,
+                              name, write_from->size(), n));
+    check(H5Dwrite(set.id(), mem_type, mem.id(), space.id(), H5P_DEFAULT, write_from->data()),
+          "cannot write " + name, path);
+  }
 }
 
 template <typename T>
@@ -349,6 +396,47 @@ std::vector<std::uint64_t> File::attr_uint64s(const std::string& obj, const std:
     out[i] = static_cast<std::uint64_t>(v[i]);
   }
   return out;
+}
+
+void File::create_dataset(const std::string& name, const Dims& dims, Type type) {
+  Handle space = checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
+                         H5Sclose, "dataspace for " + name, path_);
+  Handle dcpl = dataset_creation(dims, true, path_);
+  const hid_t file_type = type == Type::Float64 ? H5T_IEEE_F64LE : H5T_STD_U64LE;
+  checked(H5Dcreate2(handle_.id(), name.c_str(), file_type, space.id(), H5P_DEFAULT, dcpl.id(),
+                     H5P_DEFAULT),
+          H5Dclose, "cannot create " + name, path_);
+}
+
+void File::write_slab(const std::string& name, hsize_t i, const std::vector<double>& data) {
+  slab_io<double>(handle_.id(), path_, name, i, nullptr, &data, H5T_NATIVE_DOUBLE);
+}
+
+void File::write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data) {
+  slab_io<std::uint64_t>(handle_.id(), path_, name, i, nullptr, &data, H5T_NATIVE_UINT64);
+}
+
+std::vector<double> File::read_slab_doubles(const std::string& name, hsize_t i) const {
+  std::vector<double> v;
+  slab_io<double>(handle_.id(), path_, name, i, &v, nullptr, H5T_NATIVE_DOUBLE);
+  return v;
+}
+
+std::vector<std::uint64_t> File::read_slab_uint64s(const std::string& name, hsize_t i) const {
+  std::vector<std::uint64_t> v;
+  slab_io<std::uint64_t>(handle_.id(), path_, name, i, &v, nullptr, H5T_NATIVE_UINT64);
+  return v;
+}
+
+Dims File::dims(const std::string& name) const {
+  Handle set = checked(H5Dopen2(handle_.id(), name.c_str(), H5P_DEFAULT), H5Dclose,
+                       "missing " + name, path_);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path_);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 0) throw Error(fmt::format("{}: HDF5 error: dataspace of {}", path_, name));
+  Dims d(rank);
+  H5Sget_simple_extent_dims(space.id(), d.data(), nullptr);
+  return d;
 }
 
 void File::set_attr(const std::string& obj, const std::string& name, const std::string& value) {

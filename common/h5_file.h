@@ -63,6 +63,15 @@ class File {
   // Integer datasets only (a float or a negative signed value is refused).
   std::vector<std::uint64_t> read_uint64s(const std::string& name, const Dims& expected,
                                           const std::string& meaning) const;
+  // Datasets written and read one slab at a time (slab i = index i along the
+  // first dimension), so that a file larger than memory can be streamed.
+  enum class Type { Float64, UInt64 };
+  void create_dataset(const std::string& name, const Dims& dims, Type type);
+  void write_slab(const std::string& name, hsize_t i, const std::vector<double>& data);
+  void write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data);
+  std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;
+  std::vector<std::uint64_t> read_slab_uint64s(const std::string& name, hsize_t i) const;
+  Dims dims(const std::string& name) const;  // of a dataset
 
   // Attributes on an object ("/" for the root).
   void set_attr(const std::string& obj, const std::string& name, const std::string& value);

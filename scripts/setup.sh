@@ -9,6 +9,7 @@ packages=(
   libeigen3-dev libhdf5-dev libyaml-cpp-dev libcli11-dev libfmt-dev libxsimd-dev
   googletest libgtest-dev libbenchmark-dev libboost-dev libboost-math-dev
   python3 python3-h5py python3-numpy python3-matplotlib
+  libopenmpi-dev openmpi-bin
 )
 missing=()
 for p in "${packages[@]}"; do

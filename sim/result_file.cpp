@@ -65,20 +65,24 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
   return r;
 }
 
+void write_result_header(h5::File& f, const ResultFile& r) {
+  write_file_identity(f, "fiber-histogram", r.created_utc);
+  // Exact uint64: every seed in [0, 2^64 - 1] round-trips, and merge tells
+  // any two distinct seeds apart.
+  f.set_attr("/", "seed", r.seeds.front());
+  f.set_attr("/", "merged_seeds", r.seeds);
+  f.set_attr("/", "config_yaml", r.config_yaml);
+  write_bins(f, r.grid);
+  write_incidences(f, r.theta_i, r.phi_i);
+  write_parameters(f, r.settings);
+}
+
 void write_result(const ResultFile& r, const std::string& path,
                   const std::vector<std::string>& inputs) {
   AtomicOutput out(path, inputs);
   {
     h5::File f = h5::File::create(out.temp_path());
-    write_file_identity(f, "fiber-histogram", r.created_utc);
-    // Exact uint64: every seed in [0, 2^64 - 1] round-trips, and merge tells
-    // any two distinct seeds apart.
-    f.set_attr("/", "seed", r.seeds.front());
-    f.set_attr("/", "merged_seeds", r.seeds);
-    f.set_attr("/", "config_yaml", r.config_yaml);
-    write_bins(f, r.grid);
-    write_incidences(f, r.theta_i, r.phi_i);
-    write_parameters(f, r.settings);
+    write_result_header(f, r);
 
     const hsize_t K = r.configs(), L = r.lobes, C = r.channels;
     const hsize_t T = r.grid.n_theta(), P = r.grid.n_phi();
@@ -94,50 +98,6 @@ void write_result(const ResultFile& r, const std::string& path,
     f.close();
   }
   out.commit();
-}
-
-ResultFile merge_results(const std::vector<ResultFile>& parts,
-                         const std::vector<std::string>& names) {
-  if (parts.empty()) throw Error("merge: no input files");
-  ResultFile sum = parts.front();
-  // Everything but the seed and the photon count must agree.
-  auto comparable = [](Settings s) {
-    s.seed = 0;
-    s.photons = 1;
-    s.output.clear();
-    return to_yaml(s);
-  };
-  const std::string reference = comparable(sum.settings);
-  for (std::size_t i = 1; i < parts.size(); ++i) {
-    const ResultFile& p = parts[i];
-    if (comparable(p.settings) != reference || p.grid.theta_edges != sum.grid.theta_edges ||
-        p.grid.phi_edges != sum.grid.phi_edges || p.theta_i != sum.theta_i ||
-        p.lobes != sum.lobes || p.channels != sum.channels)
-      throw Error(fmt::format("merge: {} does not match {}: fiber, roughness, source, tally "
-                              "and segment settings must be identical (only seed and photons "
-                              "may differ)", names[i], names[0]));
-    for (std::uint64_t s : p.seeds)
-      for (std::uint64_t t : sum.seeds)
-        if (s == t)
-          throw Error(fmt::format("merge: {} repeats seed {}: merging runs with the same seed "
-                                  "double-counts identical photons", names[i], s));
-    append(sum.seeds, p.seeds);
-    for (std::size_t k = 0; k < sum.photons.size(); ++k) sum.photons[k] += p.photons[k];
-    auto add = [](std::vector<double>& a, const std::vector<double>& b) {
-      for (std::size_t j = 0; j < a.size(); ++j) a[j] += b[j];
-    };
-    add(sum.weight_sum, p.weight_sum);
-    add(sum.weight_sq_sum, p.weight_sq_sum);
-    add(sum.exited, p.exited);
-    add(sum.absorbed, p.absorbed);
-    add(sum.truncated, p.truncated);
-    for (std::size_t j = 0; j < sum.count.size(); ++j) sum.count[j] += p.count[j];
-  }
-  sum.settings.photons = sum.photons.front();  // every configuration has the same count
-  sum.config_yaml = to_yaml(sum.settings);
-  sum.created_utc = utc_timestamp();
-  sum.software_version = FIBERLAB_VERSION;
-  return sum;
 }
 
 Settings load_settings_or_result(const std::string& path) {

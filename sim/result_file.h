@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/bin_grid.h"
+#include "common/h5_file.h"
 #include "sim/settings.h"
 #include "sim/tally.h"
 
@@ -44,6 +45,9 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
 // Atomic (common/atomic_output.h); `inputs` are files the output must not replace.
 void write_result(const ResultFile& result, const std::string& path,
                   const std::vector<std::string>& inputs = {});
+// Everything but /tally and /ledger: identity, seeds, config, /bins, /source
+// and the parameter groups (shared with the streaming writer, sim/result_stream).
+void write_result_header(h5::File& f, const ResultFile& header);
 // Reads and validates a result file (sim/result_reader.cpp): format and
 // format_version, every dataset's shape against K x L x n_theta x n_phi x C
 // from the stored config_yaml (checked before anything is allocated), /bins
@@ -52,10 +56,7 @@ void write_result(const ResultFile& result, const std::string& path,
 // one line naming the file, the dataset or attribute and what is allowed.
 ResultFile read_result(const std::string& path);
 
-// Adds runs of the same fiber, bins and incident directions; throws
-// fiberlab::Error naming the first difference otherwise.
-ResultFile merge_results(const std::vector<ResultFile>& parts,
-                         const std::vector<std::string>& names);
+// (Merging result files: sim/merge.h, from their exact sums.)
 
 // The settings of a YAML config, or those stored in a result file's
 // config_yaml (told apart by the HDF5 signature).

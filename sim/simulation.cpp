@@ -1,5 +1,6 @@
 #include "sim/simulation.h"
 
+#include <fmt/core.h>
 #include <omp.h>
 
 #include <algorithm>
@@ -8,23 +9,263 @@
 #include <cmath>
 #include <exception>
 #include <memory>
+#include <mutex>
 #include <optional>
+#include <thread>
 
+#include "common/error.h"
+#include "common/interrupt.h"
 #include "common/units.h"
 #include "sim/exit_scoring.h"
+#include "sim/result_file.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
 
 namespace {
-// Photons handed to a thread at a time: large, because a chunk ends with its
-// few light-guided photons alone in the batch tracer's lanes (-4% CPU on case
-// b from 4096 to 32768), but at least 8 chunks per thread when there are
-// photons enough, for the load balance. Results do not depend on it.
-std::uint64_t chunk_size(std::uint64_t photons, int threads) {
-  return std::clamp<std::uint64_t>(photons / (8 * static_cast<std::uint64_t>(threads)), 4096,
-                                   32768);
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t) {
+  return std::chrono::duration<double>(Clock::now() - t).count();
 }
+
+// Calls `progress` about twice a second from its own thread while alive.
+class ProgressTicker {
+ public:
+  ProgressTicker(ProgressCallback progress, const std::atomic<std::uint64_t>& done,
+                 std::uint64_t total)
+      : progress_(std::move(progress)), done_(done), total_(total) {
+    if (progress_) thread_ = std::thread([this] { loop(); });
+  }
+  ~ProgressTicker() {
+    stop_ = true;
+    if (thread_.joinable()) thread_.join();
+  }
+
+ private:
+  void loop() {
+    auto last = Clock::now();
+    while (!stop_) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+      if (seconds_since(last) < 0.5) continue;
+      last = Clock::now();
+      progress_(std::min(done_.load(), total_), total_);
+    }
+  }
+  ProgressCallback progress_;
+  const std::atomic<std::uint64_t>& done_;
+  std::uint64_t total_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+}  // namespace
+
+// One call of Simulation::run(state, control): the rounds of every direction.
+class Simulation::Runner {
+ public:
+  Runner(const Simulation& sim, RunProgress& state, const RunControl& control)
+      : sim_(sim), state_(state), control_(control),
+        group_(control.group ? *control.group : ProcessGroup::single()),
+        threads_(control.threads > 0 ? control.threads : omp_get_max_threads()),
+        cap_(sim.settings_.photons) {}
+
+  RunOutcome run(RunStatistics* stats);
+
+ private:
+  std::uint64_t trace_round(std::size_t k, std::uint64_t first, std::uint64_t end);
+  void flush(std::size_t k);
+  bool target_reached(std::size_t k);
+  void check_errors();
+  std::uint64_t photons_done() const;
+
+  const Simulation& sim_;
+  RunProgress& state_;
+  const RunControl& control_;
+  const ProcessGroup& group_;
+  int threads_;
+  std::uint64_t cap_;  // photons per direction
+  // This rank's sums not yet flushed, one per thread, each allocated by its
+  // own thread: small arrays allocated together by one thread share cache
+  // lines, and threads scoring into them would slow each other down.
+  std::vector<std::unique_ptr<Tally>> thread_tallies_;
+  TracerCounters counters_;
+  std::atomic<std::uint64_t> progress_done_{0};
+  std::mutex error_mutex_;
+  std::exception_ptr error_;
+};
+
+std::uint64_t Simulation::Runner::photons_done() const {
+  std::uint64_t n = 0;
+  for (std::size_t k = 0; k < state_.next_photon.size(); ++k)
+    n += state_.done[k] ? cap_ : state_.next_photon[k];
+  return n;
+}
+
+// Traces this rank's chunks of photons [first, end) of direction k: chunk j
+// of the round goes to rank j mod size, threads take a rank's chunks in
+// order. A lone process stops early on a signal, after a prefix of the
+// round's chunks; returns the end of what was traced.
+std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first, std::uint64_t end) {
+  const std::uint64_t chunks = (end - first) / kChunk + ((end - first) % kChunk != 0);
+  const std::uint64_t rank = group_.rank(), size = group_.size();
+  const std::uint64_t mine = rank < chunks ? (chunks - rank + size - 1) / size : 0;
+  const bool may_stop_early = size == 1;
+  std::atomic<std::uint64_t> next{0};
+  std::atomic<bool> failed{false};
+#pragma omp parallel num_threads(threads_)
+  {
+    TracerCounters counters;
+    try {
+      std::unique_ptr<Tally>& mine_tally = thread_tallies_[omp_get_thread_num()];
+      const TallyShape s = sim_.tally_shape();
+      if (!mine_tally) mine_tally = std::make_unique<Tally>(s.lobes, s.n_theta, s.n_phi, s.channels);
+      Tally& tally = *mine_tally;
+      while (!failed.load(std::memory_order_relaxed)) {
+        if (may_stop_early && interrupt_requested()) break;
+        const std::uint64_t i = next.fetch_add(1);
+        if (i >= mine) break;
+        const std::uint64_t a = first + (rank + i * size) * kChunk;
+        const std::uint64_t n = std::min(kChunk, end - a);
+        sim_.trace_photons(k, a, n, tally, counters, &progress_done_, size);
+      }
+    } catch (...) {
+      failed = true;
+      std::lock_guard<std::mutex> lock(error_mutex_);
+      if (!error_) error_ = std::current_exception();
+    }
+#pragma omp critical
+    {
+      counters_.add(counters);
+    }
+  }
+  if (!may_stop_early) return end;
+  return std::min(end, first + std::min(next.load(), mine) * kChunk);
+}
+
+// Adds every rank's unflushed sums of direction k into rank 0's state.
+void Simulation::Runner::flush(std::size_t k) {
+  const TallyShape shape = sim_.tally_shape();
+  Tally sum(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
+  for (std::unique_ptr<Tally>& t : thread_tallies_) {
+    if (t) sum.add(*t);
+    t.reset();
+  }
+  if (group_.size() == 1) {
+    state_.tallies[k].add(sum);
+    return;
+  }
+  std::vector<ExactTally::Word> words = sum.exact().words();
+  group_.sum_to_root(words);
+  if (group_.is_root()) {
+    ExactTally e(shape);
+    e.from_words(words);
+    state_.tallies[k].add(e);
+  }
+}
+
+bool Simulation::Runner::target_reached(std::size_t k) {
+  std::vector<std::int64_t> reached{
+      group_.is_root() &&
+      largest_relative_error(state_.tallies[k].exact()) < control_.target_error};
+  group_.max(reached);
+  return reached[0] != 0;
+}
+
+// After a round: when any rank failed, every rank stops with rank 0 saying why.
+void Simulation::Runner::check_errors() {
+  std::optional<std::string> mine;
+  if (error_) {
+    try {
+      std::rethrow_exception(error_);
+    } catch (const std::bad_alloc&) {
+      mine = "out of memory while tracing (fewer --threads, or a smaller tally)";
+    } catch (const std::exception& e) {
+      mine = e.what();
+    }
+  }
+  std::vector<std::int64_t> any{mine.has_value()};
+  group_.max(any);
+  if (!any[0]) return;
+  const std::optional<std::string> message = group_.agree_on_error(mine);
+  if (!group_.is_root()) throw FailedElsewhere{};
+  if (group_.size() == 1) std::rethrow_exception(error_);
+  throw Error(*message);
+}
+
+RunOutcome Simulation::Runner::run(RunStatistics* stats) {
+  const auto start = Clock::now();
+  thread_tallies_.resize(threads_);
+  const std::size_t K = state_.next_photon.size();
+  const std::uint64_t total = cap_ * K;
+  std::uint64_t traced = 0;
+  std::uint64_t round_chunks = static_cast<std::uint64_t>(threads_) * group_.size();
+  auto last_checkpoint = Clock::now();
+  progress_done_ = photons_done();
+  RunOutcome outcome = RunOutcome::Finished;
+  {
+    ProgressTicker ticker(group_.is_root() ? control_.progress : ProgressCallback{},
+                          progress_done_, total);
+    for (std::size_t k = 0; k < K && outcome == RunOutcome::Finished; ++k) {
+      while (!state_.done[k]) {
+        const std::uint64_t first = state_.next_photon[k];
+        // (Written so that nothing wraps for photon counts near 2^64.)
+        std::uint64_t span = std::min(cap_ - first, round_chunks * kChunk);
+        if (control_.target_error > 0) span = std::min(span, kTargetBatch - first % kTargetBatch);
+        const std::uint64_t end = first + span;
+        const auto round_start = Clock::now();
+        const std::uint64_t reached = trace_round(k, first, end);
+        // Rank 0 proposes the next round's size and whether a checkpoint is
+        // due; every rank contributes its signal. Rounds last 0.2-0.8 s on
+        // several ranks (a signal waits for the round's end, and mpirun kills
+        // ranks a few seconds after forwarding one), 1-4 s alone (a signal
+        // stops a lone process within a chunk; fewer round ends, where
+        // threads wait for the slowest chunk).
+        const double took = seconds_since(round_start);
+        const double shortest = group_.size() == 1 ? 1.0 : 0.2;
+        std::uint64_t proposal = round_chunks;
+        if (took < shortest) proposal = std::min<std::uint64_t>(round_chunks * 2, 1u << 20);
+        if (took > 4 * shortest) proposal = std::max<std::uint64_t>(round_chunks / 2, threads_);
+        const bool due = control_.checkpoint && control_.checkpoint_every > 0 &&
+                         seconds_since(last_checkpoint) >= control_.checkpoint_every;
+        check_errors();
+        std::vector<std::int64_t> agreed{interrupt_signal(), group_.is_root() && due,
+                                         group_.is_root() ? static_cast<std::int64_t>(proposal) : 0};
+        group_.max(agreed);
+        const bool signalled = agreed[0] != 0, checkpoint = agreed[1] != 0 || signalled;
+        round_chunks = static_cast<std::uint64_t>(agreed[2]);
+
+        traced += reached - first;
+        state_.next_photon[k] = reached;
+        const bool last = reached == cap_;
+        const bool judged = control_.target_error > 0 && reached > first &&
+                            (reached % kTargetBatch == 0 || last);
+        if (last || judged || checkpoint) flush(k);
+        if (last) state_.done[k] = 1;
+        else if (judged && target_reached(k)) state_.done[k] = 1;
+        progress_done_ = photons_done();
+        if (checkpoint) {
+          if (group_.is_root() && control_.checkpoint) control_.checkpoint(state_);
+          last_checkpoint = Clock::now();
+        }
+        if (signalled) {
+          outcome = RunOutcome::Interrupted;
+          break;
+        }
+      }
+    }
+  }
+  if (outcome == RunOutcome::Finished && group_.is_root() && control_.progress)
+    control_.progress(total, total);
+  if (stats) {
+    stats->seconds = seconds_since(start);
+    stats->threads = threads_;
+    stats->ranks = group_.size();
+    stats->photons = traced;
+    stats->counters = counters_;
+  }
+  return outcome;
 }
 
 Simulation::Simulation(Settings settings)
@@ -36,11 +277,23 @@ Simulation::Simulation(Settings settings)
       use_batch_tracer_(settings_.polarization == Polarization::Scalar),
       incidences_(settings_.incidences()) {}
 
+TallyShape Simulation::tally_shape() const {
+  return {settings_.tally.lobes, settings_.tally.n_theta, settings_.tally.n_phi,
+          static_cast<int>(settings_.fiber.sigma_a.size())};
+}
+
 void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n,
-                               Tally& tally, TracerCounters& counters) const {
+                               Tally& tally, TracerCounters& counters,
+                               std::atomic<std::uint64_t>* traced, std::uint64_t per_photon) const {
   const Settings::Incidence inc = incidences_[k];
   ExitScorer scorer(grid_, settings_.fiber.sigma_a, tally.lobes());
-  auto score = [&](const FinishedPhotons& f) { scorer.score(f, tally); };
+  // Progress is published per block of finished photons (at most 256): a
+  // shared counter touched per photon costs threads a cache-line transfer.
+  auto score = [&](const FinishedPhotons& f) {
+    scorer.score(f, tally);
+    if (traced) traced->fetch_add(static_cast<std::uint64_t>(f.n) * per_photon,
+                                  std::memory_order_relaxed);
+  };
   if (use_batch_tracer_) {
     batch_tracer_.trace(inc.theta_i, inc.phi_i, first, n, score, counters);
   } else {
@@ -58,77 +311,44 @@ void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t
   tally.add_launched(n);
 }
 
+RunProgress Simulation::start() const {
+  RunProgress p;
+  const TallyShape s = tally_shape();
+  p.tallies.assign(incidences_.size(), Tally(s.lobes, s.n_theta, s.n_phi, s.channels));
+  p.next_photon.assign(incidences_.size(), 0);
+  p.done.assign(incidences_.size(), 0);
+  return p;
+}
+
+RunOutcome Simulation::run(RunProgress& state, const RunControl& control,
+                           RunStatistics* stats) const {
+  if (state.next_photon.size() != incidences_.size() || state.done.size() != incidences_.size())
+    throw Error("internal error: run state for another number of incident directions");
+  Runner runner(*this, state, control);
+  return runner.run(stats);
+}
+
 std::vector<Tally> Simulation::run(int threads, const ProgressCallback& progress,
                                    RunStatistics* stats) const {
-  using Clock = std::chrono::steady_clock;
-  const auto start = Clock::now();
-  if (threads <= 0) threads = omp_get_max_threads();
-  const TallySettings& ts = settings_.tally;
-  const int channels = static_cast<int>(settings_.fiber.sigma_a.size());
-  const std::uint64_t photons = settings_.photons;
-  const std::uint64_t kChunk = chunk_size(photons, threads);
-  // (photons + kChunk - 1) / kChunk would wrap for photons near 2^64.
-  const std::uint64_t chunks = photons / kChunk + (photons % kChunk != 0);
-  const std::uint64_t total = photons * incidences_.size();
-  std::atomic<std::uint64_t> done{0};
-  TracerCounters all_counters;
+  RunProgress state = start();
+  RunControl control;
+  control.threads = threads;
+  control.progress = progress;
+  if (run(state, control, stats) == RunOutcome::Interrupted)
+    throw Error(fmt::format("interrupted by signal {}", interrupt_signal()));
+  return std::move(state.tallies);
+}
 
-  std::vector<Tally> results;
-  for (std::size_t k = 0; k < incidences_.size(); ++k) {
-    Tally result(ts.lobes, ts.n_theta, ts.n_phi, channels);
-    // An exception must not leave an OpenMP region (std::terminate, SIGABRT):
-    // the first one (e.g. std::bad_alloc) is kept, the other threads skip
-    // their remaining chunks, and it is rethrown after the region.
-    std::exception_ptr failure;
-    std::atomic<bool> failed{false};
-    auto keep_failure = [&] {
-#pragma omp critical(fiberlab_run_failure)
-      if (!failure) failure = std::current_exception();
-      failed = true;
-    };
-#pragma omp parallel num_threads(threads)
-    {
-      std::optional<Tally> local;
-      try {
-        local.emplace(ts.lobes, ts.n_theta, ts.n_phi, channels);
-      } catch (...) {
-        keep_failure();
-      }
-      TracerCounters counters;
-      auto last_report = Clock::now();
-#pragma omp for schedule(dynamic, 1)
-      for (std::uint64_t c = 0; c < chunks; ++c) {
-        if (failed) continue;
-        try {
-          const std::uint64_t first = c * kChunk;
-          const std::uint64_t n = std::min(kChunk, photons - first);
-          trace_photons(k, first, n, *local, counters);
-          const std::uint64_t now_done = done.fetch_add(n) + n;
-          if (progress && omp_get_thread_num() == 0 &&
-              Clock::now() - last_report > std::chrono::milliseconds(250)) {
-            last_report = Clock::now();
-            progress(now_done, total);
-          }
-        } catch (...) {
-          keep_failure();
-        }
-      }
-#pragma omp critical
-      if (local && !failed) {
-        result.add(*local);  // integer sums: the order does not matter
-        all_counters.add(counters);
-      }
-    }
-    if (failure) std::rethrow_exception(failure);
-    results.push_back(std::move(result));
+double Simulation::largest_relative_error(const ExactTally& t) {
+  const std::size_t LC = static_cast<std::size_t>(t.shape.lobes) * t.shape.channels;
+  const std::vector<double> m = ExactTally::to_double(t.lobe_moments());
+  double worst = 0.0;
+  for (std::size_t i = 0; i < LC; ++i) {
+    if (m[i] <= 0.0) continue;
+    const Estimate e = bin_estimate(m[i], m[LC + i], t.photons);
+    worst = std::max(worst, e.std_error / e.mean);
   }
-  if (progress) progress(total, total);
-  if (stats) {
-    stats->seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    stats->threads = threads;
-    stats->counters = all_counters;
-  }
-  return results;
+  return worst;
 }
 
 }  // namespace fiberlab::sim

@@ -1,5 +1,7 @@
 #include "sim/tally.h"
 
+#include "common/error.h"
+
 namespace fiberlab::sim {
 
 Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
@@ -28,6 +30,47 @@ void Tally::add(const Tally& o) {
   photons_ += o.photons_;
   for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] += o.bins_[i];
   for (int c = 0; c < channels_; ++c) truncated_[c] += o.truncated_[c];
+}
+
+ExactTally Tally::exact() const {
+  ExactTally e(shape());
+  e.photons = photons_;
+  const std::size_t C = channels_;
+  for (std::size_t b = 0; b < e.count.size(); ++b) {
+    const Fixed* cell = &bins_[b * block()];
+    e.count[b] = static_cast<std::uint64_t>(cell[0]);
+    for (std::size_t c = 0; c < C; ++c) {
+      e.weight_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
+      e.weight_sq_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
+    }
+  }
+  // The ledger's exited and absorbed are derived from the bins (exact).
+  const std::vector<Fixed> exited = exited_fixed();
+  for (std::size_t i = 0; i < exited.size(); ++i) e.exited[i] = static_cast<ExactTally::Word>(exited[i]);
+  for (std::size_t c = 0; c < C; ++c) {
+    Fixed absorbed = static_cast<Fixed>(photons_) << 60;
+    for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
+    absorbed -= truncated_[c];
+    e.absorbed[c] = static_cast<ExactTally::Word>(absorbed);
+    e.truncated[c] = static_cast<ExactTally::Word>(truncated_[c]);
+  }
+  return e;
+}
+
+void Tally::add(const ExactTally& e) {
+  if (!(e.shape == shape())) throw Error("internal error: adding an exact tally of another shape");
+  photons_ += e.photons;
+  const std::size_t C = channels_;
+  for (std::size_t b = 0; b < e.count.size(); ++b) {
+    Fixed* cell = &bins_[b * block()];
+    cell[0] += e.count[b];
+    for (std::size_t c = 0; c < C; ++c) {
+      cell[1 + c] += static_cast<Fixed>(e.weight_sum[b * C + c]);
+      cell[1 + C + c] += static_cast<Fixed>(e.weight_sq_sum[b * C + c]);
+    }
+  }
+  // exited and absorbed follow from the bins, photons and truncated.
+  for (std::size_t c = 0; c < C; ++c) truncated_[c] += static_cast<Fixed>(e.truncated[c]);
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {

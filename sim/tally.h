@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "common/bin_grid.h"
+#include "sim/exact_tally.h"
 
 namespace fiberlab::sim {
 
@@ -47,6 +48,11 @@ class Tally {
   // is absorbed is derived from that (launched - exited - truncated, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
   void add(const Tally& other);  // exact: integer sums
+  // The same sums as exact integers in file order (checkpoints, MPI, merge),
+  // and back (a checkpoint's partial sums before resuming).
+  TallyShape shape() const { return {lobes_, n_theta_, n_phi_, channels_}; }
+  ExactTally exact() const;
+  void add(const ExactTally& e);
 
   std::uint64_t photons() const { return photons_; }
   // Results as float64, in the HDF5 index order [lobe][theta][phi][channel].

@@ -1,0 +1,99 @@
+#include "sim/exact_tally.h"
+
+#include <fmt/core.h>
+
+#include "common/error.h"
+
+namespace fiberlab::sim {
+
+ExactTally::ExactTally(const TallyShape& s)
+    : shape(s),
+      count(s.bins(), 0),
+      weight_sum(s.bin_cells(), 0),
+      weight_sq_sum(s.bin_cells(), 0),
+      exited(static_cast<std::size_t>(s.lobes) * s.channels, 0),
+      absorbed(s.channels, 0),
+      truncated(s.channels, 0) {}
+
+namespace {
+
+void add_words(std::vector<ExactTally::Word>& a, const std::vector<ExactTally::Word>& b) {
+  for (std::size_t i = 0; i < a.size(); ++i) a[i] += b[i];
+}
+
+std::uint64_t checked_add(std::uint64_t a, std::uint64_t b, const char* what) {
+  std::uint64_t s;
+  if (__builtin_add_overflow(a, b, &s))
+    throw Error(fmt::format("sum of {} exceeds 2^64 - 1", what));
+  return s;
+}
+
+}  // namespace
+
+ExactTally& ExactTally::operator+=(const ExactTally& o) {
+  if (!(shape == o.shape)) throw Error("internal error: adding tallies of different shapes");
+  photons = checked_add(photons, o.photons, "photons");
+  for (std::size_t i = 0; i < count.size(); ++i) count[i] = checked_add(count[i], o.count[i], "bin counts");
+  add_words(weight_sum, o.weight_sum);
+  add_words(weight_sq_sum, o.weight_sq_sum);
+  add_words(exited, o.exited);
+  add_words(absorbed, o.absorbed);
+  add_words(truncated, o.truncated);
+  return *this;
+}
+
+std::vector<ExactTally::Word> ExactTally::words() const {
+  std::vector<Word> w;
+  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 2 * absorbed.size());
+  w.push_back(photons);
+  w.insert(w.end(), count.begin(), count.end());
+  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated})
+    w.insert(w.end(), v->begin(), v->end());
+  return w;
+}
+
+void ExactTally::from_words(const std::vector<Word>& w) {
+  const std::size_t expected =
+      1 + count.size() + 2 * weight_sum.size() + exited.size() + 2 * absorbed.size();
+  if (w.size() != expected) throw Error("internal error: tally words of the wrong size");
+  std::size_t i = 0;
+  photons = static_cast<std::uint64_t>(w[i++]);
+  for (auto& c : count) c = static_cast<std::uint64_t>(w[i++]);
+  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated})
+    for (auto& x : *v) x = w[i++];
+}
+
+std::vector<ExactTally::Word> ExactTally::lobe_moments() const {
+  const std::size_t L = shape.lobes, C = shape.channels;
+  const std::size_t per_lobe = static_cast<std::size_t>(shape.n_theta) * shape.n_phi;
+  std::vector<Word> m(2 * L * C, 0);
+  for (std::size_t l = 0; l < L; ++l)
+    for (std::size_t b = 0; b < per_lobe; ++b)
+      for (std::size_t c = 0; c < C; ++c) m[L * C + l * C + c] += weight_sq_sum[(l * per_lobe + b) * C + c];
+  for (std::size_t i = 0; i < L * C; ++i) m[i] = exited[i];
+  return m;
+}
+
+std::vector<double> ExactTally::to_double(const std::vector<Word>& v) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(v[i]) / kScale;
+  return out;
+}
+
+std::vector<std::uint64_t> ExactTally::to_pairs(const std::vector<Word>& v) {
+  std::vector<std::uint64_t> out(2 * v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    out[2 * i] = static_cast<std::uint64_t>(v[i] >> 64);
+    out[2 * i + 1] = static_cast<std::uint64_t>(v[i]);
+  }
+  return out;
+}
+
+std::vector<ExactTally::Word> ExactTally::from_pairs(const std::vector<std::uint64_t>& v) {
+  std::vector<Word> out(v.size() / 2);
+  for (std::size_t i = 0; i < out.size(); ++i)
+    out[i] = (static_cast<Word>(v[2 * i]) << 64) | v[2 * i + 1];
+  return out;
+}
+
+}  // namespace fiberlab::sim

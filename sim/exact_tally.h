@@ -1,0 +1,55 @@
+#pragma once
+// One incident direction's tally as exact integers, in the result file's
+// index order: what checkpoints store, MPI ranks add up and `merge` sums.
+//
+// Weights are fixed point (Tally: a weight w counts as round(w 2^60)), so a
+// sum of any photons is an integer and adding sums is exact and associative:
+// totals do not depend on how photons were split across threads, ranks,
+// checkpoints or files, nor on the order the parts are added. float64 values
+// are derived once, from the final integers (value / 2^60).
+#include <cstdint>
+#include <vector>
+
+namespace fiberlab::sim {
+
+struct TallyShape {
+  int lobes = 0, n_theta = 0, n_phi = 0, channels = 0;
+
+  std::size_t bins() const { return static_cast<std::size_t>(lobes) * n_theta * n_phi; }
+  std::size_t bin_cells() const { return bins() * channels; }
+  friend bool operator==(const TallyShape&, const TallyShape&) = default;
+};
+
+struct ExactTally {
+  using Word = unsigned __int128;  // every sum is >= 0
+  static constexpr double kScale = 0x1.0p60;
+
+  explicit ExactTally(const TallyShape& shape);
+
+  TallyShape shape;
+  std::uint64_t photons = 0;
+  std::vector<std::uint64_t> count;             // [lobe][theta][phi]
+  std::vector<Word> weight_sum, weight_sq_sum;  // [lobe][theta][phi][channel]
+  std::vector<Word> exited;                     // [lobe][channel]
+  std::vector<Word> absorbed, truncated;        // [channel]
+
+  // Exact sum; throws fiberlab::Error when a count would overflow 64 bits.
+  ExactTally& operator+=(const ExactTally& other);
+
+  // Every number as one flat array of words (photons, count, weight_sum,
+  // weight_sq_sum, exited, absorbed, truncated), for element-wise sums
+  // across MPI ranks; from_words() is its inverse.
+  std::vector<Word> words() const;
+  void from_words(const std::vector<Word>& w);
+
+  // Per lobe and channel, the lobe's S1 (= exited) and S2 (sum over its bins):
+  // [lobe][channel], S1 first, then S2. What --target-error judges.
+  std::vector<Word> lobe_moments() const;
+
+  static std::vector<double> to_double(const std::vector<Word>& v);
+  // Two uint64 per word, (high, low): how files store them.
+  static std::vector<std::uint64_t> to_pairs(const std::vector<Word>& v);
+  static std::vector<Word> from_pairs(const std::vector<std::uint64_t>& v);
+};
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,173 @@
+#include "sim/result_stream.h"
+
+#include <fmt/core.h>
+
+#include "common/error.h"
+#include "common/result_layout.h"
+
+namespace fiberlab::sim {
+
+namespace {
+
+struct DatasetShape {
+  const char* name;
+  bool exact;  // a trailing dimension of 2 (high, low)
+  int rank;    // 5: K L T P C, 4: K L T P, 3: K L C, 2: K C
+};
+
+constexpr DatasetShape kTallyDatasets[] = {
+    {"/tally/weight_sum", false, 5}, {"/tally/weight_sq_sum", false, 5},
+    {"/tally/count", false, 4},      {"/ledger/exited", false, 3},
+    {"/ledger/absorbed", false, 2},  {"/ledger/truncated", false, 2},
+    {"/exact/weight_sum", true, 5},  {"/exact/weight_sq_sum", true, 5},
+    {"/exact/exited", true, 3},      {"/exact/absorbed", true, 2},
+    {"/exact/truncated", true, 2},
+};
+
+h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
+  const hsize_t L = s.lobes, T = s.n_theta, P = s.n_phi, C = s.channels;
+  h5::Dims dims;
+  switch (d.rank) {
+    case 5: dims = {K, L, T, P, C}; break;
+    case 4: dims = {K, L, T, P}; break;
+    case 3: dims = {K, L, C}; break;
+    default: dims = {K, C}; break;
+  }
+  if (d.exact) dims.push_back(2);
+  return dims;
+}
+
+TallyShape shape_of(const ResultFile& r) {
+  return {r.lobes, r.grid.n_theta(), r.grid.n_phi(), r.channels};
+}
+
+}  // namespace
+
+ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
+                           const DirectionSeeds& direction_seeds)
+    : out_(path), photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
+  file_.emplace(h5::File::create(out_.temp_path()));
+  h5::File& f = *file_;
+  write_result_header(f, header);
+  f.create_group("/tally");
+  f.create_group("/ledger");
+  f.create_group("/exact");
+  const hsize_t K = photons_.size();
+  for (const DatasetShape& d : kTallyDatasets) {
+    const bool integer = d.exact || d.rank == 4;
+    f.create_dataset(d.name, dims_of(d, K, shape_),
+                     integer ? h5::File::Type::UInt64 : h5::File::Type::Float64);
+  }
+  if (!direction_seeds.empty()) {
+    std::vector<std::uint64_t> rows;
+    for (std::size_t k = 0; k < direction_seeds.size(); ++k)
+      for (std::uint64_t s : direction_seeds[k]) {
+        rows.push_back(k);
+        rows.push_back(s);
+      }
+    f.create_group("/merge");
+    f.write("/merge/direction_seeds", {rows.size() / 2, 2}, rows);
+  }
+}
+
+void ResultWriter::write(std::size_t k, const ExactTally& t) {
+  if (!(t.shape == shape_) || k >= photons_.size())
+    throw Error("internal error: writing a tally of the wrong shape or direction");
+  h5::File& f = *file_;
+  photons_[k] = t.photons;
+  f.write_slab("/tally/weight_sum", k, ExactTally::to_double(t.weight_sum));
+  f.write_slab("/tally/weight_sq_sum", k, ExactTally::to_double(t.weight_sq_sum));
+  f.write_slab("/tally/count", k, t.count);
+  f.write_slab("/ledger/exited", k, ExactTally::to_double(t.exited));
+  f.write_slab("/ledger/absorbed", k, ExactTally::to_double(t.absorbed));
+  f.write_slab("/ledger/truncated", k, ExactTally::to_double(t.truncated));
+  f.write_slab("/exact/weight_sum", k, ExactTally::to_pairs(t.weight_sum));
+  f.write_slab("/exact/weight_sq_sum", k, ExactTally::to_pairs(t.weight_sq_sum));
+  f.write_slab("/exact/exited", k, ExactTally::to_pairs(t.exited));
+  f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(t.absorbed));
+  f.write_slab("/exact/truncated", k, ExactTally::to_pairs(t.truncated));
+}
+
+void ResultWriter::commit() {
+  file_->write("/tally/photons", {photons_.size()}, photons_);
+  file_->close();
+  file_.reset();
+  out_.commit();
+}
+
+void write_result_exact(const std::string& path, const ResultFile& header,
+                        const std::vector<ExactTally>& tallies) {
+  ResultWriter w(path, header);
+  for (std::size_t k = 0; k < tallies.size(); ++k) w.write(k, tallies[k]);
+  w.commit();
+}
+
+ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
+    : path_(path), file_(h5::File::open_read(path)) {
+  const h5::File& f = file_;
+  if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-histogram")
+    throw Error(fmt::format("{}: not a fiberlab result file (root attribute format is not "
+                            "\"fiber-histogram\")", path));
+  if (!f.has_attr("/", "format_version") || f.attr_int("/", "format_version") != kFormatVersion)
+    throw Error(fmt::format("{}: format_version is not {} (written by another fiberlab version)",
+                            path, kFormatVersion));
+  ResultFile& h = header_;
+  h.config_yaml = f.attr_string("/", "config_yaml");
+  h.settings = parse_settings_yaml(h.config_yaml, path + ":/config_yaml");
+  h.software_version = f.attr_string("/", "software_version");
+  h.created_utc = f.attr_string("/", "created_utc");
+  if (f.has_attr("/", "merged_seeds")) {
+    h.seeds = f.attr_uint64s("/", "merged_seeds", 1u << 20);
+  } else {
+    h.seeds = {f.attr_uint64("/", "seed")};
+  }
+  if (h.seeds.empty()) throw Error(path + ": merged_seeds is empty");
+  h.grid = read_bins(f);
+  h.theta_i = f.read_doubles("/source/theta_i");
+  h.phi_i = f.read_doubles("/source/phi_i");
+  h.photons = f.read_uint64s("/tally/photons");
+  h.lobes = h.settings.tally.lobes;
+  h.channels = static_cast<int>(h.settings.fiber.sigma_a.size());
+  shape_ = shape_of(h);
+  const std::size_t K = h.photons.size();
+  if (K == 0 || h.theta_i.size() != K || h.phi_i.size() != K)
+    throw Error(fmt::format("{}: /tally/photons, /source/theta_i and /source/phi_i must have the "
+                            "same length >= 1", path));
+  if (h.grid.n_theta() != h.settings.tally.n_theta || h.grid.n_phi() != h.settings.tally.n_phi)
+    throw Error(fmt::format("{}: /bins do not match config_yaml's tally", path));
+  for (std::uint64_t n : h.photons)
+    if (n == 0 && !allow_empty_directions) throw Error(fmt::format("{}: /tally/photons holds 0 (must be >= 1)", path));
+  if (!f.exists("/exact"))
+    throw Error(fmt::format("{}: has no exact sums (/exact; files written before fiberlab 0.2 "
+                            "cannot be merged exactly)", path));
+  for (const DatasetShape& d : kTallyDatasets)
+    if (f.dims(d.name) != dims_of(d, K, shape_))
+      throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
+                              d.name));
+  direction_seeds_.assign(K, h.seeds);
+  if (f.exists("/merge/direction_seeds")) {
+    h5::Dims dims;
+    const std::vector<std::uint64_t> rows = f.read_uint64s("/merge/direction_seeds", &dims);
+    if (dims.size() != 2 || dims[1] != 2)
+      throw Error(path + ": /merge/direction_seeds is not an M x 2 array");
+    for (auto& s : direction_seeds_) s.clear();
+    for (std::size_t i = 0; i < rows.size(); i += 2) {
+      if (rows[i] >= K) throw Error(path + ": /merge/direction_seeds names a direction >= K");
+      direction_seeds_[rows[i]].push_back(rows[i + 1]);
+    }
+  }
+}
+
+ExactTally ResultReader::read(std::size_t k) const {
+  ExactTally t(shape_);
+  t.photons = header_.photons.at(k);
+  t.count = file_.read_slab_uint64s("/tally/count", k);
+  t.weight_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sum", k));
+  t.weight_sq_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sq_sum", k));
+  t.exited = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/exited", k));
+  t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
+  t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
+  return t;
+}
+
+}  // namespace fiberlab::sim

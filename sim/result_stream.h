@@ -1,0 +1,71 @@
+#pragma once
+// A result file (SPEC section 9) written and read one incident direction at
+// a time, so that neither `run` nor `merge` ever needs more than one
+// direction's tally per file in memory beyond what it holds anyway.
+//
+// Besides the float64 datasets of SPEC section 9, files carry the exact sums
+// (fiberlab's own addition; docs in README "The result file"):
+//   /exact/weight_sum, /exact/weight_sq_sum  K x L x n_theta x n_phi x C x 2
+//   /exact/exited  K x L x C x 2,  /exact/absorbed, /exact/truncated  K x C x 2
+// uint64 pairs (high, low) of an unsigned 128-bit integer; the value is
+// integer / 2^60. The float64 datasets are these integers / 2^60 rounded once.
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/atomic_output.h"
+#include "common/h5_file.h"
+#include "sim/exact_tally.h"
+#include "sim/result_file.h"
+
+namespace fiberlab::sim {
+
+// Which seeds went into each direction: `merge` refuses to add a direction
+// twice with the same seed (the same photons). Stored as /merge/direction_seeds
+// (M x 2 uint64 rows: direction index, seed) when they are not all the run's seed.
+using DirectionSeeds = std::vector<std::vector<std::uint64_t>>;
+
+class ResultWriter {
+ public:
+  // `header`: a ResultFile whose tally arrays may be empty (everything else is
+  // written now). The file appears at `path` only on commit().
+  ResultWriter(const std::string& path, const ResultFile& header,
+               const DirectionSeeds& direction_seeds = {});
+  void write(std::size_t k, const ExactTally& t);  // each direction once
+  h5::File& file() { return *file_; }              // for extra groups (checkpoints)
+  void commit();  // writes /tally/photons, closes, renames into place
+
+ private:
+  AtomicOutput out_;
+  std::optional<h5::File> file_;
+  std::vector<std::uint64_t> photons_;
+  TallyShape shape_;
+};
+
+// Writes a whole run (one ExactTally per direction) atomically.
+void write_result_exact(const std::string& path, const ResultFile& header,
+                        const std::vector<ExactTally>& tallies);
+
+class ResultReader {
+ public:
+  // Opens and checks a result file: format and version, the stored config,
+  // every dataset's shape against K, lobes, bins and channels, photons >= 1,
+  // and the presence of the exact sums. Throws fiberlab::Error naming the file.
+  // allow_empty_directions: directions of 0 photons (a checkpoint's).
+  explicit ResultReader(const std::string& path, bool allow_empty_directions = false);
+  const ResultFile& header() const { return header_; }  // no tally arrays
+  const DirectionSeeds& direction_seeds() const { return direction_seeds_; }
+  TallyShape shape() const { return shape_; }
+  ExactTally read(std::size_t k) const;
+  const h5::File& file() const { return file_; }
+
+ private:
+  std::string path_;
+  h5::File file_;
+  ResultFile header_;
+  DirectionSeeds direction_seeds_;
+  TallyShape shape_;
+};
+
+}  // namespace fiberlab::sim
