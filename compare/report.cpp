@@ -123,6 +123,9 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
     o.message = fmt::format("plots skipped: {} not found", python);
     return o;
   }
+  const fs::path page = fs::path(dir) / "report.html";
+  std::error_code ignored;
+  fs::remove(page, ignored);  // never leave a page describing an earlier run
   const std::string log = (fs::path(dir) / "plot_log.txt").string();
   const std::string cmd = fmt::format("{} {} {} {} > {} 2>&1", shell_quote(python), shell_quote(script),
                                       kind, shell_quote(dir), shell_quote(log));
@@ -145,6 +148,7 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.path().extension() == ".png") o.pngs.push_back(entry.path().filename().string());
   std::sort(o.pngs.begin(), o.pngs.end());
+  o.html = o.ran && fs::exists(page);
   return o;
 }
 
