@@ -73,3 +73,27 @@ def predict(result_or_config, model, **params):
     return Prediction(d["probability"], model=model, params=d["params"], alpha=d["alpha"],
                       theta_i=d["theta_i"], phi_i=d["phi_i"], theta_edges=d["theta_edges"],
                       phi_edges=d["phi_edges"])
+
+
+SUPPORTED_FORMAT_VERSION = 1
+
+
+def load_prediction(path):
+    """A `fiberlab predict` file (docs/FILE_FORMAT.md) as a Prediction."""
+    import h5py
+    with h5py.File(path, "r") as f:
+        version = int(f.attrs.get("format_version", 0))
+        if version < 1 or version > SUPPORTED_FORMAT_VERSION:
+            raise _fiberlab.Error("%s: format_version %d is not supported (this fiberlab reads 1 to %d)"
+                                  % (path, version, SUPPORTED_FORMAT_VERSION))
+        if "prediction/probability" not in f:
+            raise _fiberlab.Error("%s: no /prediction/probability dataset" % path)
+        group = f["prediction"]
+        text = lambda v: v.decode() if isinstance(v, bytes) else v
+        params = {k: (text(v) if isinstance(v, (bytes, str)) else np.asarray(v).tolist())
+                  for k, v in group.attrs.items() if k not in ("model",)}
+        alpha = np.atleast_1d(group.attrs["alpha"]).tolist() if "alpha" in group.attrs else [0.0]
+        return Prediction(group["probability"][...], model=text(group.attrs.get("model", "unknown")),
+                          params=params, alpha=alpha, theta_i=f["source/theta_i"][...],
+                          phi_i=f["source/phi_i"][...], theta_edges=f["bins/theta_edges"][...],
+                          phi_edges=f["bins/phi_edges"][...])

@@ -202,6 +202,24 @@ def run(config, photons=None, seed=None, threads=None, progress=True):
     return Result(_fiberlab.run(settings, photons, seed, threads, progress))
 
 
+def _file_format(path):
+    """The root attribute `format` of an HDF5 file, None when unreadable
+    (the C++ reader then says why)."""
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            value = f.attrs.get("format")
+    except (ImportError, OSError):
+        return None
+    return value.decode() if isinstance(value, bytes) else value
+
+
 def load(path):
-    """Reads a result file (format "fiber-histogram")."""
-    return Result(_fiberlab.read_result(os.fspath(path)))
+    """Reads a result file (format "fiber-histogram") as a Result, or a
+    prediction file of `fiberlab predict` ("fiber-prediction") as a
+    Prediction (docs/FILE_FORMAT.md)."""
+    path = os.fspath(path)
+    if _file_format(path) == "fiber-prediction":
+        from .prediction import load_prediction
+        return load_prediction(path)
+    return Result(_fiberlab.read_result(path))

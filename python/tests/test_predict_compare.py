@@ -79,3 +79,27 @@ def test_unknown_model_or_parameter(smooth_result):
     with pytest.raises(fiberlab.Error, match="bogus"):
         fiberlab.predict(smooth_result, "exact", bogus=1)
     assert "exact" in fiberlab.model_names()
+
+
+def test_cli_prediction_file_loads_and_describes_itself(smooth_result, fiberlab_binary, tmp_path):
+    """A `fiberlab predict` file: load() gives the Prediction fiberlab.predict
+    makes, and the file carries the schema's names and units."""
+    import subprocess
+    import h5py
+    result = tmp_path / "r.h5"
+    smooth_result.save(result)
+    pred_path = tmp_path / "p.h5"
+    out = subprocess.run([fiberlab_binary, "predict", str(result), "--model", "exact", "--set", "absorption=chord",
+                          "-o", str(pred_path)], capture_output=True, text=True, timeout=120)
+    assert out.returncode == 0, out.stderr
+    loaded = fiberlab.load(pred_path)
+    assert isinstance(loaded, fiberlab.Prediction) and loaded.model == "exact"
+    np.testing.assert_array_equal(loaded.probability, exact_prediction(smooth_result).probability)
+    assert fiberlab.compare(smooth_result, loaded).accepted
+    with h5py.File(pred_path, "r") as f:
+        assert f.attrs["format"] == "fiber-prediction"
+        assert f.attrs["lobe_names"] == "R,TT,TRT,p>=3"
+        assert f.attrs["channel_names"] == "c0,c1"
+        assert f["prediction/probability"].attrs["units"] == "probability"
+        assert f["prediction/probability"].attrs["dimensions"] == "incidence,lobe,theta,phi,channel"
+        assert f["bins/solid_angle"].attrs["units"] == "steradians"
