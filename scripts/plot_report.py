@@ -66,7 +66,9 @@ def text_attr(f, name, default):
 
 
 def incidence_name(theta_i_deg, phi_i_deg):
-    phi = "uniform (randomly rotated fiber)" if phi_i_deg != phi_i_deg else "%.2f deg" % phi_i_deg
+    # NaN (report_data.h5) or None (null in metrics.json): a randomly rotated fiber.
+    uniform = phi_i_deg is None or phi_i_deg != phi_i_deg
+    phi = "uniform (randomly rotated fiber)" if uniform else "%.2f deg" % phi_i_deg
     return "theta_i = %.2f deg, phi_i = %s" % (theta_i_deg, phi)
 
 

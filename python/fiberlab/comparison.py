@@ -32,6 +32,11 @@ class Comparison:
             return self.records
         return pandas.DataFrame.from_records(self.records)
 
+    def _repr_html_(self):
+        """The table in a notebook."""
+        table = self.table
+        return table.to_html() if hasattr(table, "to_html") else None
+
     @property
     def rejected(self):
         """The records of the judged lobes that were not accepted."""
