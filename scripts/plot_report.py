@@ -12,23 +12,24 @@ it with /usr/bin/python3, not a pyenv `python3`). Exit status 3 when those
 are missing (the caller then reports "plots skipped"), 2 on bad arguments.
 
 Figures have fixed pixel sizes (no tight bounding box), so tests can check
-the PNG headers. Per incident direction k (named by theta_i and phi_i):
-  compare_k{K}_heatmaps.png   1200 x 1200: per lobe, simulated and predicted
+the PNG headers. Per incident direction, named by theta_i and phi_i in
+degrees ({DIR} = theta30.0_phi0.0, or theta30.0_phiuniform):
+  compare_{DIR}_heatmaps.png  1200 x 1200: per lobe, simulated and predicted
                               density (sr^-1, log colour scale), the
                               normalised residual (P_sim - P_model) / se and
                               log10(P_sim / P_model) (the colour bar's end
                               colours where only one side has light: the
                               simulation, or the model expecting >= 3
-                              photons in the bin); grey =
-                              no data (no simulated photon in the bin, and
-                              for the ratio no light on either side); a lobe whose light
-                              lies mostly at |phi| > 90 deg (TT) is drawn on
-                              phi in [0, 360) so it is not cut at +-180 deg
-  compare_k{K}_marginals.png  1200 x 1200: per lobe, the theta_r marginal
+                              photons in the bin); grey = no data (no
+                              simulated photon in the bin; for the ratio, no
+                              light on either side); a lobe with 3/4 of its
+                              light at |phi| > 90 deg (TT) is drawn on phi in
+                              [0, 360) so it is not cut at +-180 deg
+  compare_{DIR}_marginals.png 1200 x 1200: per lobe, the theta_r marginal
                               (probability per degree, log y; simulation with
                               1-se error bars, model as steps) over its
                               normalised residual
-  compare_k{K}_polar.png      1200 x 400: per lobe, the phi marginal in polar
+  compare_{DIR}_polar.png     1200 x 400: per lobe, the phi marginal in polar
                               form for every channel (points: simulation,
                               lines: model)
   compare_energy.png          1200 x 400: per lobe, energy against theta_i,
@@ -70,6 +71,12 @@ def incidence_name(theta_i_deg, phi_i_deg):
     uniform = phi_i_deg is None or phi_i_deg != phi_i_deg
     phi = "uniform (randomly rotated fiber)" if uniform else "%.2f deg" % phi_i_deg
     return "theta_i = %.2f deg, phi_i = %s" % (theta_i_deg, phi)
+
+
+def incidence_stem(theta_i_deg, phi_i_deg):
+    """File-name part naming the incident direction: theta30.0_phi0.0 (phiuniform)."""
+    uniform = phi_i_deg is None or phi_i_deg != phi_i_deg
+    return "theta%.1f_phi%s" % (theta_i_deg, "uniform" if uniform else "%.1f" % phi_i_deg)
 
 
 def load_compare(d, np, h5py):
@@ -318,6 +325,13 @@ img { max-width: 100%; display: block; margin: 0.5em 0; }
 """
 
 
+def param_text(v):
+    """A metrics.json parameter: a number or list, or {"value": ..., "unit": ...}."""
+    if isinstance(v, dict) and "value" in v:
+        return ("%s %s" % (v["value"], v.get("unit") or "")).strip()
+    return str(v)
+
+
 def verdict_cell(row):
     if not row["judged"]:
         return '<td class="l nj">not judged</td>'
@@ -366,10 +380,11 @@ def plot_compare(d, np, plt, h5py):
     title = "%s against %s" % (metrics["result"] if metrics else "simulation", r["model"])
     parts = ["<h1>%s</h1>" % html.escape(title)]
     if metrics:
-        params = ", ".join("%s = %s" % (k, v) for k, v in metrics["params"].items())
+        params = ", ".join("%s = %s" % (key, param_text(v)) for key, v in (metrics["params"] or {}).items())
         judged = [x for x in metrics["lobes"] if x["judged"]]
         accepted = sum(1 for x in judged if x["accepted"])
-        parts.append("<p>Model parameters: <code>%s</code></p>" % html.escape(params))
+        if params:
+            parts.append("<p>Model parameters: <code>%s</code></p>" % html.escape(params))
         parts.append("<p>Criterion per lobe: %s. Verdict: <b class=\"%s\">%s</b> (%d of %d judged lobes accepted).</p>"
                      % (html.escape(metrics["criterion"]), "ok" if metrics["accepted"] else "bad",
                         "accepted" if metrics["accepted"] else "rejected", accepted, len(judged)))
@@ -401,7 +416,8 @@ def plot_compare(d, np, plt, h5py):
         for suffix, fig in (("heatmaps", plot_heatmaps(r, k, np, plt, colors)),
                             ("marginals", plot_theta_marginals(r, k, np, plt)),
                             ("polar", plot_polar(r, k, np, plt))):
-            b64 = save_png(fig, os.path.join(d, "compare_k%d_%s.png" % (k, suffix)), plt)
+            stem = incidence_stem(r["theta_i"][k], r["phi_i"][k])
+            b64 = save_png(fig, os.path.join(d, "compare_%s_%s.png" % (stem, suffix)), plt)
             parts.append(img(b64, "%s: %s" % (names[k], suffix)))
     write_html(os.path.join(d, "report.html"), title, parts)
 

@@ -71,11 +71,12 @@ def test_compare_report_html_is_self_contained_and_names_every_direction(compare
 
 def test_compare_report_figure_sizes(compare_report):
     rep, _ = compare_report
-    for name, size in (("compare_k0_heatmaps.png", (1200, 1200)), ("compare_k0_marginals.png", (1200, 1200)),
-                       ("compare_k0_polar.png", (1200, 400)), ("compare_energy.png", (1200, 400))):
+    for name, size in (("compare_theta0.0_phi0.0_heatmaps.png", (1200, 1200)),
+                       ("compare_theta0.0_phi0.0_marginals.png", (1200, 1200)),
+                       ("compare_theta0.0_phi0.0_polar.png", (1200, 400)), ("compare_energy.png", (1200, 400))):
         assert png_size(rep / name) == size, name
         assert (rep / name).stat().st_size > 20_000, name
-    assert not (rep / "compare_k1_heatmaps.png").exists()
+    assert not (rep / "compare_theta40.0_phi0.0_heatmaps.png").exists()  # left out
 
 
 def test_compare_report_renders_in_headless_chromium(compare_report, tmp_path):
