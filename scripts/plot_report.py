@@ -39,6 +39,8 @@ degrees ({DIR} = theta30.0_phi0.0, or theta30.0_phiuniform):
   energy_roughness.png        1200 x 600: total energy against theta_i per
                               beta_long (only with --beta-sweep), as in
                               d'Eon et al. 2011 Fig. 3
+  energy_furnace.png          1200 x 400: white fibers only, |total - 1|
+                              against theta_i per source (log scale)
 """
 import base64
 import html
@@ -471,7 +473,36 @@ def plot_energy(d, np, plt):
             ax.legend(fontsize=7)
         figures.append(("Total energy per longitudinal roughness (cf. d'Eon et al. 2011 Fig. 3)",
                         save_png(fig, os.path.join(d, "energy_roughness.png"), plt)))
+    if m["white"]:
+        figures.append(("White furnace: departure of the total from 1",
+                        save_png(plot_furnace(curves, np, plt), os.path.join(d, "energy_furnace.png"), plt)))
     write_energy_html(d, m, figures)
+
+
+def plot_furnace(curves, np, plt):
+    """White furnace (d'Eon et al. 2011 s4, Figs. 3 and 5): a white fiber
+    absorbs nothing, so every source's total energy should be 1. |total - 1|
+    on a log scale against theta_i, the simulation with its standard error
+    (its ledger balances to rounding, so this is the Monte Carlo noise)."""
+    fig, ax = plt.subplots(figsize=(12, 4), dpi=100)
+    fig.suptitle("White furnace: |total energy - 1| against theta_i (0 for an energy-conserving source)",
+                 fontsize=10)
+    floor = 1e-7
+    for c in curves:
+        th = np.array(c["theta_i_deg"], dtype=float)
+        dev = np.abs(np.array(c["total"], dtype=float) - 1.0)
+        label = c["label"]
+        if c["simulated"]:
+            ax.errorbar(th, np.maximum(dev, floor), yerr=c["total_error"], fmt="ko", ms=4, label=label)
+        else:
+            ax.plot(th, np.maximum(dev, floor), "-", lw=1.2, label=label)
+    ax.set_yscale("log")
+    ax.set_ylim(bottom=floor)
+    ax.set_xlabel("theta_i (deg)")
+    ax.set_ylabel("|total - 1| (floored at 1e-7)")
+    ax.legend(fontsize=6, ncol=2)
+    fig.subplots_adjust(left=0.07, right=0.98, top=0.88, bottom=0.14)
+    return fig
 
 
 def write_energy_html(d, m, figures):

@@ -101,3 +101,20 @@ def test_energy_report_html(smooth_result, fiberlab_binary, tmp_path):
     assert_self_contained(page)
     assert page.count("data:image/png;base64,") == 1
     assert "simulation" in page and "exact" in page
+
+
+def test_energy_report_of_a_white_fiber_has_the_furnace_plot(fiberlab_binary, tmp_path):
+    import fiberlab
+    white = fiberlab.run({"fiber": {"eta": 1.55, "sigma_a": 0}, "roughness": {"model": "smooth"},
+                          "source": {"theta_i": [0, 30, 60]}, "tally": {"n_theta": 45, "n_phi": 36}},
+                         photons=20_000, seed=3, progress=False)
+    result = tmp_path / "white.h5"
+    white.save(result)
+    out = subprocess.run([fiberlab_binary, "energy", str(result), "--models", "exact", "--grid-theta", "45",
+                          "--grid-phi", "36", "--report", str(tmp_path / "e")], capture_output=True, text=True,
+                         timeout=300)
+    assert out.returncode == 0, out.stderr
+    assert png_size(tmp_path / "e" / "energy_furnace.png") == (1200, 400)
+    page = (tmp_path / "e" / "report.html").read_text()
+    assert page.count("data:image/png;base64,") == 2 and "White furnace" in page
+    assert_self_contained(page)
