@@ -291,11 +291,13 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
         md += fmt::format("| {} | {:.1f} | {:.5f} | {:.5f} |{}\n", e.label, rad_to_deg(theta_i[k]), e.total(k, c),
                           e.three_lobe(k, c), white ? fmt::format(" {:+.4f} |", e.total(k, c) - 1.0) : "");
     md += "\n## Plots\n\n";
+    if (plots.html) md += "All figures on one page: [report.html](report.html).\n\n";
     if (!plots.ran) md += plots.message + "\n\n";
     for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
     md += "Numbers: `metrics.csv` (every channel), `metrics.json`.\n";
     compare::write_text(o.report, "report.md", md);
-    fmt::print("\nreport: {}/report.md{}\n", o.report, plots.ran ? "" : " (" + plots.message + ")");
+    fmt::print("\nreport: {}/report.md{}{}\n", o.report, plots.html ? fmt::format(", {}/report.html", o.report) : "",
+               plots.ran ? "" : " (" + plots.message + ")");
   }
 }
 

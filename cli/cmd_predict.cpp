@@ -14,6 +14,7 @@
 #include "cli/commands.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 #include "common/units.h"
@@ -68,6 +69,11 @@ void predict(const PredictOptions& o) {
   std::string approx;
   for (const std::string& a : analytic::approximations(spec.name, params)) approx += a + "\n";
   f.set_attr("/prediction", "approximations", approx);
+  // Descriptive attributes (docs/FILE_FORMAT.md).
+  write_axis_names(f, L, C, s.fiber.eumelanin.has_value());
+  describe_bins_and_source(f);
+  describe(f, "/prediction/probability", kHistogramDims, "probability",
+           "the model's probability of each bin (its density integrated over the bin)");
   // Only this model's parameters (its table), angles in radians.
   for (const analytic::ParamAttribute& a : analytic::param_attributes(spec.name, params)) {
     if (a.is_text) f.set_attr("/prediction", a.name, a.text);

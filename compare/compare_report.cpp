@@ -25,11 +25,14 @@ std::string write_compare_report(const CompareReport& rep, const sim::ResultFile
   md += verdict_markdown(v, result.lobes);
   md += "\n" + rep.fit_markdown;
   md += "\n## Plots\n\n";
+  if (plots.html) md += "All figures on one page: [report.html](report.html).\n\n";
   if (!plots.ran) md += plots.message + "\n\n";
   for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
   md += "Numbers: `metrics.csv`, `metrics.json`; arrays: `report_data.h5`.\n";
   write_text(rep.dir, "report.md", md);
-  return fmt::format("report: {}/report.md{}\n", rep.dir, plots.ran ? "" : " (" + plots.message + ")");
+  return fmt::format("report: {}/report.md{}{}\n", rep.dir,
+                     plots.html ? fmt::format(", {}/report.html", rep.dir) : "",
+                     plots.ran ? "" : " (" + plots.message + ")");
 }
 
 }  // namespace fiberlab::compare

@@ -6,14 +6,11 @@
 #include <cmath>
 
 #include "analytic/model.h"
+#include "common/file_schema.h"
 
 namespace fiberlab::compare {
 
-std::string lobe_name(int lobe, int lobes) {
-  static const char* names[] = {"R", "TT", "TRT", "TRRT", "TR3T", "TR4T"};
-  if (lobe == lobes - 1 && lobes > 1) return fmt::format("p>={}", lobe);
-  return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
-}
+std::string lobe_name(int lobe, int lobes) { return fiberlab::lobe_name(lobe, lobes); }
 
 namespace {
 

@@ -12,7 +12,9 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_file.h"
+#include "common/result_layout.h"
 
 #ifndef FIBERLAB_SOURCE_DIR
 #define FIBERLAB_SOURCE_DIR ""
@@ -47,9 +49,12 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     h5::File f = h5::File::create(out.temp_path());
     const std::size_t K = r.configs();
     const hsize_t L = r.lobes, nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
+    write_file_identity(f, "fiber-report-data", utc_timestamp());
     f.set_attr("/", "kind", std::string("compare"));
     f.set_attr("/", "model", model_label);
     f.set_attr("/", "plot_channel", static_cast<std::int64_t>(plot_channel));
+    f.set_attr("/", "config_yaml", r.config_yaml);
+    write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
     f.write("theta_edges", {nt + 1}, r.grid.theta_edges);
     f.write("phi_edges", {np + 1}, r.grid.phi_edges);
     std::vector<double> omega(nt * np);
@@ -58,6 +63,7 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     f.write("solid_angle", {nt, np}, omega);
     f.write("theta_i", {K}, r.theta_i);
     f.write("phi_i", {K}, r.phi_i);  // NaN: a randomly rotated fiber
+    f.write("photons", {K}, r.photons);
     std::vector<double> p(r.weight_sum.size()), se(r.weight_sum.size()), m;
     m.reserve(r.weight_sum.size());
     for (std::size_t k = 0; k < K; ++k) {
@@ -73,6 +79,15 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     f.write("sim_p", dims, p);
     f.write("sim_se", dims, se);
     f.write("model_p", dims, m);
+    describe(f, "/theta_edges", "theta_edge", "radians", "theta_r bin edges, in [-pi/2, pi/2]");
+    describe(f, "/phi_edges", "phi_edge", "radians", "relative azimuth phi_r - phi_i bin edges, in [-pi, pi]");
+    describe(f, "/solid_angle", "theta,phi", "steradians", "(sin theta_hi - sin theta_lo)(phi_hi - phi_lo)");
+    describe(f, "/theta_i", "incidence", "radians", "incident inclination per incident direction");
+    describe(f, "/phi_i", "incidence", "radians", "incident azimuth (NaN: randomly rotated fiber)");
+    describe(f, "/photons", "incidence", "photons", "photons launched per incident direction");
+    describe(f, "/sim_p", kHistogramDims, "probability", "simulated probability of each bin, S1/N");
+    describe(f, "/sim_se", kHistogramDims, "probability", "standard error of sim_p");
+    describe(f, "/model_p", kHistogramDims, "probability", "the model's probability of each bin");
     f.close();
   }
   out.commit();
@@ -108,6 +123,9 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
     o.message = fmt::format("plots skipped: {} not found", python);
     return o;
   }
+  const fs::path page = fs::path(dir) / "report.html";
+  std::error_code ignored;
+  fs::remove(page, ignored);  // never leave a page describing an earlier run
   const std::string log = (fs::path(dir) / "plot_log.txt").string();
   const std::string cmd = fmt::format("{} {} {} {} > {} 2>&1", shell_quote(python), shell_quote(script),
                                       kind, shell_quote(dir), shell_quote(log));
@@ -130,6 +148,7 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.path().extension() == ".png") o.pngs.push_back(entry.path().filename().string());
   std::sort(o.pngs.begin(), o.pngs.end());
+  o.html = o.ran && fs::exists(page);
   return o;
 }
 

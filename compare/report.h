@@ -1,8 +1,9 @@
 #pragma once
 // Report folders (`--report DIR`): metrics.csv and metrics.json (written by
-// the commands), report_data.h5 (the arrays the plots need), PNG plots made
-// by scripts/plot_report.py with Debian's /usr/bin/python3 (matplotlib,
-// h5py, numpy), and report.md linking them. Without that Python the numbers
+// the commands), report_data.h5 (the arrays the plots need), PNG plots and
+// report.html (one self-contained page, figures embedded) made by
+// scripts/plot_report.py with Debian's /usr/bin/python3 (matplotlib, h5py,
+// numpy), and report.md linking them. Without that Python the numbers
 // are still written and the report says the plots were skipped.
 #include <string>
 #include <vector>
@@ -32,8 +33,10 @@ struct PlotOutcome {
   bool ran = false;
   std::string message;            // why plots were skipped, or the script's complaint
   std::vector<std::string> pngs;  // file names in DIR, sorted
+  bool html = false;              // DIR/report.html written
 };
-// Runs `/usr/bin/python3 SCRIPT KIND DIR` (KIND "compare" or "energy").
+// Runs `/usr/bin/python3 SCRIPT KIND DIR` (KIND "compare" or "energy"),
+// after removing a report.html left by an earlier run.
 // $FIBERLAB_PYTHON replaces /usr/bin/python3 (tests use it to simulate a
 // machine without matplotlib).
 PlotOutcome make_plots(const std::string& kind, const std::string& dir);

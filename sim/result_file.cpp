@@ -9,6 +9,7 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 
@@ -95,6 +96,10 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/exited", {K, L, C}, r.exited);
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
+    // Descriptive attributes (docs/FILE_FORMAT.md): axis names, units, lobe and channel names.
+    write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
+    describe_bins_and_source(f);
+    describe_result_datasets(f);
     f.close();
   }
   out.commit();

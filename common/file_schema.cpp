@@ -1,0 +1,72 @@
+#include "common/file_schema.h"
+
+#include <fmt/core.h>
+
+namespace fiberlab {
+
+std::string lobe_name(int lobe, int lobes) {
+  static const char* names[] = {"R", "TT", "TRT", "TRRT", "TR3T", "TR4T"};
+  if (lobe == lobes - 1 && lobes > 1) return fmt::format("p>={}", lobe);
+  return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
+}
+
+std::vector<std::string> lobe_names(int lobes) {
+  std::vector<std::string> out;
+  for (int l = 0; l < lobes; ++l) out.push_back(lobe_name(l, lobes));
+  return out;
+}
+
+std::vector<std::string> channel_names(int channels, bool from_melanin) {
+  if (from_melanin && channels == 3) return {"R", "G", "B"};
+  std::vector<std::string> out;
+  for (int c = 0; c < channels; ++c) out.push_back(fmt::format("c{}", c));
+  return out;
+}
+
+std::string join_names(const std::vector<std::string>& names) {
+  std::string s;
+  for (const std::string& n : names) s += (s.empty() ? "" : ",") + n;
+  return s;
+}
+
+void describe(h5::File& f, const std::string& path, const std::string& dimensions, const std::string& units,
+              const std::string& description) {
+  if (!dimensions.empty()) f.set_attr(path, "dimensions", dimensions);
+  f.set_attr(path, "units", units);
+  f.set_attr(path, "description", description);
+}
+
+void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin) {
+  f.set_attr("/", "lobe_names", join_names(lobe_names(lobes)));
+  f.set_attr("/", "channel_names", join_names(channel_names(channels, from_melanin)));
+}
+
+void describe_bins_and_source(h5::File& f) {
+  describe(f, "/bins/theta_edges", "theta_edge", "radians",
+           "theta_r bin edges, inclination from the plane normal to the fiber axis, in [-pi/2, pi/2]");
+  describe(f, "/bins/phi_edges", "phi_edge", "radians",
+           "relative azimuth phi_r - phi_i bin edges, in [-pi, pi]");
+  describe(f, "/bins/solid_angle", "theta,phi", "steradians",
+           "(sin theta_hi - sin theta_lo)(phi_hi - phi_lo) per bin");
+  describe(f, "/source/theta_i", "incidence", "radians", "incident inclination per incident direction");
+  describe(f, "/source/phi_i", "incidence", "radians",
+           "incident azimuth per incident direction (NaN: randomly rotated fiber)");
+}
+
+void describe_result_datasets(h5::File& f) {
+  describe(f, "/tally/photons", "incidence", "photons", "photons launched per incident direction (N)");
+  describe(f, "/tally/weight_sum", kHistogramDims, "weight",
+           "S1: sum of exit weights per bin; probability P = S1/N");
+  describe(f, "/tally/weight_sq_sum", kHistogramDims, "weight^2",
+           "S2: sum of squared exit weights per bin; standard error of P sqrt((S2/N - P^2)/(N - 1))");
+  describe(f, "/tally/count", "incidence,lobe,theta,phi", "photons", "photons scored per bin");
+  describe(f, "/ledger/exited", "incidence,lobe,channel", "weight", "weight that left, per lobe (divide by N)");
+  describe(f, "/ledger/absorbed", "incidence,channel", "weight", "weight absorbed inside (divide by N)");
+  describe(f, "/ledger/truncated", "incidence,channel", "weight",
+           "weight still inside when max_segments was reached (divide by N)");
+  describe(f, "/fiber", "", "eta: 1, eccentricity: 1, scale_tilt: radians, sigma_a: 1/R per channel",
+           "the fiber's parameters (attributes)");
+  describe(f, "/roughness", "", "beta_long, beta_azim: radians", "the surface roughness (attributes)");
+}
+
+}  // namespace fiberlab

@@ -1,0 +1,45 @@
+#pragma once
+// The self-describing part of fiberlab's HDF5 files (docs/FILE_FORMAT.md):
+// what each dataset's axes are, its unit and meaning, and the names of the
+// lobes and colour channels. Descriptive attributes only, added beside the
+// data every reader already uses; a reader may ignore them.
+#include <string>
+#include <vector>
+
+#include "common/h5_file.h"
+
+namespace fiberlab {
+
+// Tally lobe names (SPEC s6): lobes 0..L-2 by their paths (R, TT, TRT, TRRT,
+// ...), the last one collecting every larger p ("p>=3" for L = 4).
+std::string lobe_name(int lobe, int lobes);
+std::vector<std::string> lobe_names(int lobes);
+
+// Channel names: "R", "G", "B" for a fiber whose sigma_a came from melanin
+// (three channels, d'Eon et al. 2011 s6.1), else "c0", "c1", ...
+std::vector<std::string> channel_names(int channels, bool from_melanin);
+
+// Comma-separated, as stored in the attributes below.
+std::string join_names(const std::vector<std::string>& names);
+
+// Dimension labels of a histogram dataset ((K, L, n_theta, n_phi, C) and its
+// sub-shapes), as the attribute `dimensions` holds them.
+inline constexpr const char* kHistogramDims = "incidence,lobe,theta,phi,channel";
+
+// Attributes `dimensions` (comma-separated axis names), `units` and
+// `description` on the dataset or group `path`.
+void describe(h5::File& f, const std::string& path, const std::string& dimensions, const std::string& units,
+              const std::string& description);
+
+// Root attributes `lobe_names` and `channel_names` (comma-separated).
+void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin);
+
+// The dimension labels, units and descriptions of /bins and /source/theta_i,
+// /source/phi_i (common/result_layout.h writes those datasets).
+void describe_bins_and_source(h5::File& f);
+
+// Dimension labels, units and descriptions of a result file's /tally and
+// /ledger datasets (sim/result_file.h writes them).
+void describe_result_datasets(h5::File& f);
+
+}  // namespace fiberlab

@@ -1,0 +1,225 @@
+"""A simulation's result: fiberlab.run() and fiberlab.load() give one.
+
+The estimators are those of SPEC section 6, computed by the C++ library
+(sim::bin_estimate, sim::lobe_energy): P_b = S1_b / N, its standard error
+sqrt((S2_b/N - P_b^2)/(N - 1)), and the density P_b / Omega_b per steradian.
+"""
+import dataclasses
+import functools
+import os
+
+import numpy as np
+
+from . import _fiberlab
+from ._config import to_settings
+from .progress import ProgressLine
+
+
+@dataclasses.dataclass(frozen=True)
+class LobeEnergy:
+    """Fraction of the launched photons' weight per lobe (the ledger), with
+    standard errors: mean and std_err (K, L, C); absorbed and truncated (K, C)."""
+    mean: np.ndarray
+    std_err: np.ndarray
+    absorbed: np.ndarray
+    truncated: np.ndarray
+
+
+@dataclasses.dataclass(frozen=True)
+class Marginals:
+    """Probability per theta_r bin (summed over phi; (K, L, n_theta, C)) and
+    per phi bin (summed over theta_r; (K, L, n_phi, C)), with standard errors."""
+    theta: np.ndarray
+    theta_std_err: np.ndarray
+    phi: np.ndarray
+    phi_std_err: np.ndarray
+
+
+def channel_names(settings):
+    """"R", "G", "B" for a melanin fiber (d'Eon 2011 s6.1), else "c0", "c1", ..."""
+    return list(_fiberlab.channel_names(settings))
+
+
+class Result:
+    """Histograms of one simulation (or of merged ones), as in its HDF5 file.
+
+    Arrays are NumPy, index order (K, L, n_theta, n_phi, C): K incident
+    directions (theta_i, phi_i), L lobes (lobe_names), theta_r bins
+    (theta_edges), relative-azimuth bins (phi_edges), C colour channels.
+    Angles in radians.
+    """
+
+    def __init__(self, file):
+        self._file = file  # a _fiberlab.ResultFile
+
+    def _settings(self):
+        return self._file.settings
+
+    # --- what was simulated -------------------------------------------------
+    @functools.cached_property
+    def config(self):
+        """The resolved configuration as a dict with the YAML's keys (degrees)."""
+        return self._file.settings.config
+
+    @property
+    def config_yaml(self):
+        return self._file.config_yaml
+
+    @property
+    def seeds(self):
+        return list(self._file.seeds)
+
+    @property
+    def software_version(self):
+        return self._file.software_version
+
+    @functools.cached_property
+    def theta_edges(self):
+        """theta_r bin edges (n_theta + 1), radians in [-pi/2, pi/2]."""
+        return self._file.theta_edges
+
+    @functools.cached_property
+    def phi_edges(self):
+        """Relative azimuth phi_r - phi_i bin edges (n_phi + 1), radians in [-pi, pi]."""
+        return self._file.phi_edges
+
+    @functools.cached_property
+    def solid_angle(self):
+        """(n_theta, n_phi) steradians: (sin theta_hi - sin theta_lo)(phi_hi - phi_lo)."""
+        return self._file.solid_angle
+
+    @functools.cached_property
+    def theta_i(self):
+        """(K,) incident inclinations, radians."""
+        return self._file.theta_i
+
+    @functools.cached_property
+    def phi_i(self):
+        """(K,) incident azimuths, radians (NaN for a randomly rotated fiber)."""
+        return self._file.phi_i
+
+    @functools.cached_property
+    def photons(self):
+        """(K,) photons launched per incident direction."""
+        return self._file.photons
+
+    @functools.cached_property
+    def lobe_names(self):
+        return list(_fiberlab.lobe_names(self._file.lobes))
+
+    @functools.cached_property
+    def channel_names(self):
+        return channel_names(self._file.settings)
+
+    # --- raw sums -------------------------------------------------------------
+    @functools.cached_property
+    def weight_sum(self):
+        """S1 per bin, (K, L, n_theta, n_phi, C)."""
+        return self._file.weight_sum
+
+    @functools.cached_property
+    def weight_sq_sum(self):
+        """S2 per bin, (K, L, n_theta, n_phi, C)."""
+        return self._file.weight_sq_sum
+
+    @functools.cached_property
+    def count(self):
+        """Photons per bin, (K, L, n_theta, n_phi)."""
+        return self._file.count
+
+    # --- estimators (SPEC s6) ---------------------------------------------------
+    @functools.cached_property
+    def _estimators(self):
+        return self._file.estimators()
+
+    @property
+    def mean(self):
+        """Probability of each bin, P = S1/N, (K, L, n_theta, n_phi, C)."""
+        return self._estimators[0]
+
+    @property
+    def std_err(self):
+        """Standard error of mean, sqrt((S2/N - P^2)/(N - 1))."""
+        return self._estimators[1]
+
+    @property
+    def density(self):
+        """Probability per steradian, P / Omega (sr^-1)."""
+        return self._estimators[2]
+
+    @property
+    def density_std_err(self):
+        return self._estimators[3]
+
+    @functools.cached_property
+    def energy(self):
+        """Lobe energies with standard errors, absorbed and truncated fractions."""
+        return LobeEnergy(**self._file.energy())
+
+    @functools.cached_property
+    def marginals(self):
+        theta, theta_se = self._file.marginal("theta")
+        phi, phi_se = self._file.marginal("phi")
+        return Marginals(theta, theta_se, phi, phi_se)
+
+    # --- files ------------------------------------------------------------------
+    def save(self, path):
+        """Writes the result file (SPEC s9; written to a temporary name, then renamed)."""
+        self._file.save(os.fspath(path))
+
+    def __repr__(self):
+        K, L, T, P, C = self.weight_sum.shape
+        return ("<fiberlab.Result: %d incident direction(s), lobes %s, %d x %d bins, %d channel(s), "
+                "%s photons each>" % (K, ", ".join(self.lobe_names), T, P, C,
+                                      ", ".join(str(int(n)) for n in np.unique(self.photons))))
+
+
+def _check_count(name, value, minimum):
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise _fiberlab.Error("%s = %r is not an integer" % (name, value))
+    if value < minimum or value >= 2 ** 64:
+        raise _fiberlab.Error("%s = %d is out of range (must be an integer >= %d)" % (name, value, minimum))
+    return int(value)
+
+
+def run(config, photons=None, seed=None, threads=None, progress=True):
+    """Simulates a config: a YAML path, or a dict with the YAML's keys
+    (degrees, as in the file; see configs/README.md). photons, seed override
+    the config's; threads defaults to every core (the tallies do not depend
+    on it). progress: True (a line on stderr after a second), False, or a
+    callable(done, total). Returns a Result (not written to disk: save() it).
+    """
+    settings = to_settings(config)
+    photons = _check_count("photons", photons, 1)
+    seed = _check_count("seed", seed, 0)
+    threads = _check_count("threads", threads, 1) or 0
+    if progress is True:
+        progress = ProgressLine()
+    elif progress is False:
+        progress = None
+    return Result(_fiberlab.run(settings, photons, seed, threads, progress))
+
+
+def _file_format(path):
+    """The root attribute `format` of an HDF5 file, None when unreadable
+    (the C++ reader then says why)."""
+    try:
+        import h5py
+        with h5py.File(path, "r") as f:
+            value = f.attrs.get("format")
+    except (ImportError, OSError):
+        return None
+    return value.decode() if isinstance(value, bytes) else value
+
+
+def load(path):
+    """Reads a result file (format "fiber-histogram") as a Result, or a
+    prediction file of `fiberlab predict` ("fiber-prediction") as a
+    Prediction (docs/FILE_FORMAT.md)."""
+    path = os.fspath(path)
+    if _file_format(path) == "fiber-prediction":
+        from .prediction import load_prediction
+        return load_prediction(path)
+    return Result(_fiberlab.read_result(path))

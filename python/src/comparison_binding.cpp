@@ -1,0 +1,111 @@
+// fiberlab.compare from Python: compare::compare() on a result and any bin
+// probabilities of the same shape (a model's or a researcher's own), and the
+// acceptance rule of `fiberlab compare`.
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <optional>
+
+#include "analytic/model_registry.h"
+#include "bindings.h"
+#include "common/error.h"
+#include "common/units.h"
+#include "compare/comparison.h"
+#include "compare/verdict.h"
+#include "sim/result_file.h"
+
+namespace fiberlab::python {
+
+namespace {
+
+// The acceptance rule of `fiberlab compare` (compare/verdict.h).
+double acceptance_threshold(std::optional<double> max_chi2, int dof) {
+  return compare::acceptance_threshold(max_chi2 ? *max_chi2 : 0.0, dof);
+}
+
+// Rows keyed as in `fiberlab compare --report`'s metrics.json (angles in degrees).
+py::dict row(const compare::LobeComparison& r, int lobes, std::optional<double> max_chi2) {
+  const double limit = acceptance_threshold(max_chi2, r.bins.dof);
+  py::dict d;
+  d["k"] = r.k;
+  d["theta_i_deg"] = rad_to_deg(r.theta_i);
+  d["phi_i_deg"] = rad_to_deg(r.phi_i);
+  d["lobe"] = r.lobe;
+  d["lobe_name"] = compare::lobe_name(r.lobe, lobes);
+  d["channel"] = r.channel;
+  d["sim_energy"] = r.sim_energy;
+  d["sim_error"] = r.sim_error;
+  d["model_energy"] = r.model_energy;
+  d["energy_z"] = r.energy_z;
+  d["chi2"] = r.bins.chi2;
+  d["dof"] = r.bins.dof;
+  d["chi2_per_dof"] = r.bins.per_dof();
+  d["compared_bins"] = r.compared_bins;
+  d["rest_sim"] = r.rest_sim;
+  d["rest_model"] = r.rest_model;
+  d["theta_chi2_per_dof"] = r.theta_marginal.per_dof();
+  d["theta_dof"] = r.theta_marginal.dof;
+  d["phi_chi2_per_dof"] = r.phi_marginal.per_dof();
+  d["phi_dof"] = r.phi_marginal.dof;
+  d["l1"] = r.l1;
+  d["peak_sim_deg"] = rad_to_deg(r.peak_sim);
+  d["peak_model_deg"] = rad_to_deg(r.peak_model);
+  d["centroid_sim_deg"] = rad_to_deg(r.centroid_sim);
+  d["centroid_sim_error_deg"] = rad_to_deg(r.centroid_sim_error);
+  d["centroid_model_deg"] = rad_to_deg(r.centroid_model);
+  d["alpha_model_deg"] = rad_to_deg(r.alpha_model);
+  d["measured_shift_deg"] = rad_to_deg(r.measured_shift);
+  d["judged"] = r.judged;
+  d["threshold"] = limit;
+  d["accepted"] = !r.judged || r.bins.per_dof() <= limit;
+  return d;
+}
+
+py::list compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c_style | py::array::forcecast> p,
+                      const std::vector<double>& alpha, std::optional<double> max_chi2, double min_effective,
+                      double model_error, double min_energy) {
+  const std::vector<py::ssize_t> want{static_cast<py::ssize_t>(r.configs()), r.lobes, r.grid.n_theta(),
+                                      r.grid.n_phi(), r.channels};
+  const std::vector<py::ssize_t> got(p.shape(), p.shape() + p.ndim());
+  if (got != want) {
+    auto text = [](const std::vector<py::ssize_t>& s) {
+      std::string t;
+      for (auto x : s) t += (t.empty() ? "" : ", ") + std::to_string(x);
+      return "(" + t + ")";
+    };
+    throw Error("prediction probability has shape " + text(got) + ", the result's histogram " + text(want) +
+                " (K, lobes, n_theta, n_phi, channels)");
+  }
+  if (max_chi2 && !(*max_chi2 > 0.0)) throw Error("max_chi2 must be > 0");
+  if (!(min_effective > 0.0)) throw Error("min_effective must be > 0");
+  const double* data = p.data();
+  for (py::ssize_t i = 0; i < p.size(); ++i)
+    if (!std::isfinite(data[i])) throw Error("prediction probability holds a NaN or infinite value");
+  std::vector<std::vector<double>> bins(r.configs());
+  for (std::size_t k = 0; k < r.configs(); ++k)
+    bins[k].assign(data + k * r.bin_cells(), data + (k + 1) * r.bin_cells());
+  compare::Options o;
+  o.min_effective = min_effective;
+  o.model_rel_error = model_error;
+  o.min_lobe_energy = min_energy;
+  std::vector<compare::LobeComparison> rows;
+  {
+    py::gil_scoped_release release;
+    rows = compare::compare(r, bins, alpha.empty() ? std::vector<double>{0.0} : alpha, o);
+  }
+  py::list out;
+  for (const auto& x : rows) out.append(row(x, r.lobes, max_chi2));
+  return out;
+}
+
+}  // namespace
+
+void bind_comparison(py::module_& m) {
+  m.def("compare", &compare_bins, py::arg("result"), py::arg("probability"), py::arg("alpha"),
+        py::arg("max_chi2") = py::none(), py::arg("min_effective") = 30.0, py::arg("model_error") = 1e-4,
+        py::arg("min_energy") = 1e-4,
+        "One row per (k, lobe, channel): compare::compare's statistics and the verdict");
+  m.def("model_names", &analytic::model_names);
+}
+
+}  // namespace fiberlab::python

@@ -1,0 +1,190 @@
+// A simulation's result (sim/result_file.h) as seen from Python: the raw
+// sums, the estimators of SPEC section 6 (computed by sim::bin_estimate and
+// sim::lobe_energy, not here), the energy ledger, and file I/O.
+#include <pybind11/stl.h>
+#include <yaml-cpp/yaml.h>
+
+#include <memory>
+#include <string>
+
+#include "bindings.h"
+#include "common/error.h"
+#include "common/file_schema.h"
+#include "compare/energy.h"
+#include "sim/result_file.h"
+#include "sim/settings.h"
+
+namespace fiberlab::python {
+
+namespace {
+
+using Result = sim::ResultFile;
+using Shape = std::vector<py::ssize_t>;
+
+Shape bins_shape(const Result& r) {
+  return {static_cast<py::ssize_t>(r.configs()), r.lobes, r.grid.n_theta(), r.grid.n_phi(), r.channels};
+}
+
+// A YAML node as Python objects: maps -> dict, sequences -> list, scalars ->
+// bool, int, float or str (in that order of preference).
+py::object yaml_to_python(const YAML::Node& node) {
+  switch (node.Type()) {
+    case YAML::NodeType::Map: {
+      py::dict d;
+      for (const auto& kv : node) d[py::str(kv.first.as<std::string>())] = yaml_to_python(kv.second);
+      return d;
+    }
+    case YAML::NodeType::Sequence: {
+      py::list l;
+      for (const auto& item : node) l.append(yaml_to_python(item));
+      return l;
+    }
+    case YAML::NodeType::Scalar: {
+      const std::string text = node.Scalar();
+      if (node.Tag() != "!") {  // unquoted: a number or a boolean when it parses as one
+        if (text == "true" || text == "false") return py::bool_(text == "true");
+        long long i;
+        if (YAML::convert<long long>::decode(node, i)) return py::int_(i);
+        double x;
+        if (YAML::convert<double>::decode(node, x)) return py::float_(x);
+      }
+      return py::str(text);
+    }
+    default:
+      return py::none();
+  }
+}
+
+// P = S1/N, its standard error, and P / Omega with its standard error, for
+// every bin (SPEC s6, sim::bin_estimate).
+py::tuple estimators(const Result& r) {
+  const std::size_t n = r.weight_sum.size();
+  std::vector<double> mean(n), err(n), density(n), density_err(n);
+  const int nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t k = i / r.bin_cells();
+    const sim::Estimate e = sim::bin_estimate(r.weight_sum[i], r.weight_sq_sum[i], r.photons[k]);
+    const std::size_t b = i / C;  // (k, lobe, theta, phi)
+    const double omega = r.grid.solid_angle(static_cast<int>(b / np % nt), static_cast<int>(b % np));
+    mean[i] = e.mean;
+    err[i] = e.std_error;
+    density[i] = e.mean / omega;
+    density_err[i] = e.std_error / omega;
+  }
+  const Shape s = bins_shape(r);
+  return py::make_tuple(to_array(mean, s), to_array(err, s), to_array(density, s), to_array(density_err, s));
+}
+
+// Marginal probabilities over theta_r (summed over phi) or over phi (summed
+// over theta_r), with their standard errors: a photon lands in one bin, so a
+// marginal bin's S1 and S2 are its bins' sums (then sim::bin_estimate).
+py::tuple marginal(const Result& r, const std::string& axis) {
+  if (axis != "theta" && axis != "phi") throw Error("marginal axis '" + axis + "': must be theta or phi");
+  const bool theta = axis == "theta";
+  const std::size_t K = r.configs();
+  const int L = r.lobes, nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
+  const int n = theta ? nt : np;
+  std::vector<double> s1(K * L * n * C, 0.0), s2(s1.size(), 0.0);
+  for (std::size_t k = 0; k < K; ++k)
+    for (int l = 0; l < L; ++l)
+      for (int i = 0; i < nt; ++i)
+        for (int j = 0; j < np; ++j)
+          for (int c = 0; c < C; ++c) {
+            const std::size_t from = r.cell(k, l, i, j, c);
+            const std::size_t to = ((k * L + l) * n + (theta ? i : j)) * C + c;
+            s1[to] += r.weight_sum[from];
+            s2[to] += r.weight_sq_sum[from];
+          }
+  std::vector<double> mean(s1.size()), err(s1.size());
+  for (std::size_t x = 0; x < s1.size(); ++x) {
+    const sim::Estimate e = sim::bin_estimate(s1[x], s2[x], r.photons[x / (static_cast<std::size_t>(L) * n * C)]);
+    mean[x] = e.mean;
+    err[x] = e.std_error;
+  }
+  const Shape s{static_cast<py::ssize_t>(K), L, n, C};
+  return py::make_tuple(to_array(mean, s), to_array(err, s));
+}
+
+// The energy ledger (compare::simulation_energy): lobe energies with their
+// standard errors (K, L, C), absorbed and truncated fractions (K, C).
+py::dict energy(const Result& r) {
+  const compare::EnergyCurve e = compare::simulation_energy(r);
+  const py::ssize_t K = static_cast<py::ssize_t>(r.configs());
+  py::dict d;
+  d["mean"] = to_array(e.lobe, {K, r.lobes, r.channels});
+  d["std_err"] = to_array(e.lobe_error, {K, r.lobes, r.channels});
+  d["absorbed"] = to_array(e.absorbed, {K, r.channels});
+  d["truncated"] = to_array(e.truncated, {K, r.channels});
+  return d;
+}
+
+}  // namespace
+
+void bind_result(py::module_& m) {
+  py::class_<sim::Settings>(m, "Settings", "A resolved simulation configuration (sim/settings.h)")
+      .def_property_readonly("yaml", [](const sim::Settings& s) { return sim::to_yaml(s); })
+      .def_property_readonly("config", [](const sim::Settings& s) { return yaml_to_python(YAML::Load(sim::to_yaml(s))); })
+      .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally.lobes; })
+      .def_property_readonly("channels", [](const sim::Settings& s) { return s.fiber.sigma_a.size(); })
+      .def_property_readonly("melanin", [](const sim::Settings& s) { return s.fiber.eumelanin.has_value(); });
+  m.def("parse_settings", &sim::parse_settings_yaml, py::arg("yaml_text"), py::arg("origin"),
+        "Parses a YAML config (errors name `origin` and the field)");
+  m.def("load_settings", &sim::load_settings_or_result, py::arg("path"),
+        "The settings of a YAML config or of a result file's config_yaml");
+
+  py::class_<Result, std::shared_ptr<Result>>(m, "ResultFile", "A result file's contents (sim/result_file.h)")
+      .def_property_readonly("settings", [](const Result& r) { return r.settings; })
+      .def_property_readonly("config_yaml", [](const Result& r) { return r.config_yaml; })
+      .def_property_readonly("seeds", [](const Result& r) { return r.seeds; })
+      .def_property_readonly("software_version", [](const Result& r) { return r.software_version; })
+      .def_property_readonly("created_utc", [](const Result& r) { return r.created_utc; })
+      .def_property_readonly("lobes", [](const Result& r) { return r.lobes; })
+      .def_property_readonly("channels", [](const Result& r) { return r.channels; })
+      .def_property_readonly("theta_binning", [](const Result& r) { return to_string(r.grid.theta_binning); })
+      .def_property_readonly("theta_edges", [](const Result& r) {
+        return to_array(r.grid.theta_edges, {r.grid.n_theta() + 1});
+      })
+      .def_property_readonly("phi_edges", [](const Result& r) {
+        return to_array(r.grid.phi_edges, {r.grid.n_phi() + 1});
+      })
+      .def_property_readonly("solid_angle", [](const Result& r) {
+        std::vector<double> omega;
+        for (int i = 0; i < r.grid.n_theta(); ++i)
+          for (int j = 0; j < r.grid.n_phi(); ++j) omega.push_back(r.grid.solid_angle(i, j));
+        return to_array(omega, {r.grid.n_theta(), r.grid.n_phi()});
+      })
+      .def_property_readonly("theta_i", [](const Result& r) {
+        return to_array(r.theta_i, {static_cast<py::ssize_t>(r.configs())});
+      })
+      .def_property_readonly("phi_i", [](const Result& r) {
+        return to_array(r.phi_i, {static_cast<py::ssize_t>(r.configs())});
+      })
+      .def_property_readonly("photons", [](const Result& r) {
+        return to_array(r.photons, {static_cast<py::ssize_t>(r.configs())});
+      })
+      .def_property_readonly("weight_sum", [](const Result& r) { return to_array(r.weight_sum, bins_shape(r)); })
+      .def_property_readonly("weight_sq_sum", [](const Result& r) { return to_array(r.weight_sq_sum, bins_shape(r)); })
+      .def_property_readonly("count", [](const Result& r) {
+        Shape s = bins_shape(r);
+        s.pop_back();
+        return to_array(r.count, s);
+      })
+      .def("estimators", &estimators, "(mean, std_err, density, density_std_err), each (K, L, n_theta, n_phi, C)")
+      .def("marginal", &marginal, py::arg("axis"), "(mean, std_err) of the theta or phi marginal, (K, L, n, C)")
+      .def("energy", &energy, "lobe energies with errors, absorbed and truncated fractions")
+      .def("save", [](const Result& r, const std::string& path) {
+        py::gil_scoped_release release;
+        sim::write_result(r, path);
+      }, py::arg("path"), "Writes the result file (atomically)");
+
+  m.def("read_result", [](const std::string& path) {
+    py::gil_scoped_release release;
+    return std::make_shared<Result>(sim::read_result(path));
+  }, py::arg("path"));
+  m.def("lobe_names", &lobe_names, py::arg("lobes"), "R, TT, TRT, ..., p>=L-1 (common/file_schema.h)");
+  m.def("channel_names", [](const sim::Settings& s) {
+    return channel_names(static_cast<int>(s.fiber.sigma_a.size()), s.fiber.eumelanin.has_value());
+  }, py::arg("settings"), "R, G, B for a melanin fiber, else c0, c1, ... (common/file_schema.h)");
+}
+
+}  // namespace fiberlab::python
