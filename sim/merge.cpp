@@ -1,5 +1,7 @@
 #include "sim/merge.h"
 
+#include "sim/result_file.h"
+
 #include <fmt/core.h>
 
 #include <algorithm>
@@ -89,6 +91,13 @@ MergeSummary merge_result_files(const std::vector<std::string>& inputs, const st
       throw Error(fmt::format("merge: the output {} is one of the inputs", output));
   }
   std::vector<std::unique_ptr<ResultReader>> readers;
+  // Every input is first validated whole by read_result (shapes against the
+  // stored config before allocating, finite sums, a balanced ledger), one
+  // file at a time: its one-line errors are the reader's. Then the merge
+  // itself streams one incident direction at a time.
+  // TODO(merge): a streaming validator would avoid holding one whole input
+  // in memory during this pass.
+  for (const std::string& p : inputs) (void)read_result(p);
   for (const std::string& p : inputs) readers.push_back(std::make_unique<ResultReader>(p));
   check_compatible(readers, inputs);
 

@@ -91,7 +91,7 @@ def case_mpi(fl, d):
             fail(f"{ranks} ranks: expected one output file, found {left}")
     # SIGTERM to mpirun (forwarded to every rank): rank 0 saves a checkpoint;
     # one process with 2 threads finishes it, bit-identical.
-    big = write_config(d, "big.yaml", 6000000, "[20, 35]")
+    big = write_config(d, "big.yaml", 40000000, "[20, 35]")
     must([fl, "run", big, "-o", os.path.join(d, "big_ref.h5"), "--threads", "2", "--quiet"])
     out, nxt = interrupted_then_resumed(
         fl, d, big, signal.SIGTERM, "mpiterm",
@@ -146,7 +146,7 @@ def interrupted_then_resumed(fl, d, cfg, sig, tag, launcher=(), resume_threads="
 
 
 def case_signal(fl, d):
-    cfg = write_config(d, "c.yaml", 1500000, "[20, 35]")
+    cfg = write_config(d, "c.yaml", 30000000, "[20, 35]")
     ref = os.path.join(d, "ref.h5")
     must([fl, "run", cfg, "-o", ref, "--threads", "2", "--quiet"])
     for sig, tag in [(signal.SIGINT, "int"), (signal.SIGTERM, "term")]:
@@ -160,7 +160,7 @@ def case_signal(fl, d):
     again = run([fl, "run", cfg, "-o", ck_out, "--quiet"])
     if again.returncode != 2 or "--resume" not in again.stderr:
         fail(f"run over a checkpoint: {again.returncode} {again.stderr}")
-    other = write_config(d, "other.yaml", 1500000, "[20, 36]")
+    other = write_config(d, "other.yaml", 30000000, "[20, 36]")
     changed = run([fl, "run", "--resume", ck, other, "--quiet"])
     if changed.returncode != 2 or changed.stderr.count("\n") != 1 or "differs" not in changed.stderr:
         fail(f"changed config accepted: {changed.returncode} {changed.stderr}")

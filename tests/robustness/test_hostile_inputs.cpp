@@ -222,16 +222,17 @@ TEST_F(Hostile, LargestSeedRoundTripsExactly) {
   ASSERT_EQ(fiberlab("run " + path("c.yaml") + " --quiet --seed 18446744073709551615 -o " + path("a.h5")).status, 0);
   ASSERT_EQ(fiberlab("run " + path("c.yaml") + " --quiet --seed 18446744073709551614 -o " + path("b.h5")).status, 0);
   // float64 would make these two seeds equal (and merge refuse them as a repeat).
+  // merge lists seeds in increasing order; the file's seed is the first.
   const Outcome m = fiberlab("merge " + path("a.h5") + " " + path("b.h5") + " -o " + path("m.h5"));
   ASSERT_EQ(m.status, 0) << m.err;
   std::ofstream(path("check.py"))
       << "import h5py, sys\nf = h5py.File(sys.argv[1])\n"
-         "assert f.attrs['seed'] == 2**64 - 1 and f.attrs['seed'].dtype == 'uint64', f.attrs['seed']\n"
+         "assert f.attrs['seed'] == 2**64 - 2 and f.attrs['seed'].dtype == 'uint64', f.attrs['seed']\n"
          "s = [int(x) for x in f.attrs['merged_seeds']]\n"
-         "assert s == [2**64 - 1, 2**64 - 2] and f.attrs['merged_seeds'].dtype == 'uint64', s\n";
+         "assert s == [2**64 - 2, 2**64 - 1] and f.attrs['merged_seeds'].dtype == 'uint64', s\n";
   const Outcome c = run("/usr/bin/python3 " + path("check.py") + " " + path("m.h5"));
   EXPECT_EQ(c.status, 0) << c.err;
-  EXPECT_NE(fiberlab("info " + path("m.h5")).out.find("18446744073709551615, 18446744073709551614"), std::string::npos);
+  EXPECT_NE(fiberlab("info " + path("m.h5")).out.find("18446744073709551614, 18446744073709551615"), std::string::npos);
   // fiberlab 0.1 stored the seed as int64: -1 is read back as 2^64 - 1.
   const auto legacy = crafted("legacy.h5", "f.attrs['seed'] = np.int64(-1); del f.attrs['merged_seeds']");
   EXPECT_NE(fiberlab("info " + legacy).out.find("seeds: 18446744073709551615"), std::string::npos);
