@@ -339,7 +339,6 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
 
   std::vector<double> a(C), theta_w, phi_w;
   std::vector<HNode> nodes;
-  std::vector<cylinder::PathNode> smooth;
   for (int p = 0; p <= kResidualP; ++p) {
     theta_w.assign(nt, 0.0);
     theta_bin_integrals(variance(p), rotated_theta_i(p, theta_i), grid, refine_, theta_w);
@@ -351,12 +350,7 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
         for (int c = 0; c < C; ++c) phi_w[static_cast<std::size_t>(j) * C + c] = a[c] / np;
     } else if (s_ < kSmoothS) {
       // Delta detector: the smooth cylinder's nodes, split at the bin edges.
-      cylinder::smooth_nodes(p, att.eta_p(), np, 6, smooth);
-      for (const auto& nd : smooth) {
-        att.A(p, nd.gamma, a.data());
-        double* r = &phi_w[static_cast<std::size_t>(cylinder::phi_bin(nd.phi, np)) * C];
-        for (int c = 0; c < C; ++c) r[c] += nd.weight * a[c];
-      }
+      cylinder::add_smooth_lobe(att, p, np, phi_w);
     } else {
       logistic_nodes(p, att.eta_p(), s_, edges, false, refine_, nodes);
       for (const HNode& nd : nodes) {

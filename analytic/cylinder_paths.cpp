@@ -90,6 +90,18 @@ int phi_bin(double phi, int n_phi) {
   return std::clamp(j, 0, n_phi - 1);
 }
 
+void add_smooth_lobe(const Attenuation& att, int p, int n_phi, std::vector<double>& bins) {
+  const int C = att.channels();
+  std::vector<PathNode> nodes;
+  std::vector<double> a(C);
+  smooth_nodes(p, att.eta_p(), n_phi, 6, nodes);
+  for (const PathNode& nd : nodes) {
+    att.A(p, nd.gamma, a.data());
+    double* r = &bins[static_cast<std::size_t>(phi_bin(nd.phi, n_phi)) * C];
+    for (int c = 0; c < C; ++c) r[c] += nd.weight * a[c];
+  }
+}
+
 namespace {
 
 // The monotonic pieces of Phi(p, .) on [-pi/2, pi/2].

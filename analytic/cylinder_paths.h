@@ -71,6 +71,10 @@ void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNod
 void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out);
 // Bin of a wrapped phi in n uniform bins on [-pi, pi).
 int phi_bin(double phi, int n_phi);
+// Adds the smooth cylinder's lobe p, (1/2) integral of A(p, h) dh, to the phi
+// bins it exits into (a delta detector), by smooth_nodes split at the bin
+// edges: bins[j * C + c] for n_phi uniform bins and C = att.channels().
+void add_smooth_lobe(const Attenuation& att, int p, int n_phi, std::vector<double>& bins);
 
 }  // namespace cylinder
 

@@ -353,12 +353,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
           for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += s;
         }
       } else if (t.beta < kSmoothBeta) {
-        cylinder::smooth_nodes(p, att.eta_p(), np, 6, nodes);
-        for (const auto& nd : nodes) {
-          att.A(p, nd.gamma, a.data());
-          double* r = &nb[static_cast<std::size_t>(cylinder::phi_bin(nd.phi, np)) * C];
-          for (int c = 0; c < C; ++c) r[c] += nd.weight * a[c];
-        }
+        cylinder::add_smooth_lobe(att, p, np, nb);
       } else {
         // Panels over which Phi moves by up to 4 beta: 8 Gauss points resolve the
         // detector to ~1e-12 there (checked against beta / 4 panels).
