@@ -74,7 +74,9 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
       }
     }
     H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
-    H5Pset_deflate(dcpl.id(), 4);
+    // Level 1: 30% less compression time than level 4 for 5% larger files
+    // (measured on 90 x 180 x 8-lobe, 3-channel results).
+    H5Pset_deflate(dcpl.id(), 1);
   }
   return dcpl;
 }
@@ -119,7 +121,9 @@ void slab_io(hid_t file, const std::string& path, const std::string& name, hsize
   check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
                             nullptr),
         "select slab of " + name, path);
-  Handle mem = checked(H5Screate_simple(1, &n, nullptr), H5Sclose, "memory space", path);
+  // The memory space has the selection's shape: a flat one makes HDF5 map
+  // cells one run at a time (H5S_select_iterate), a third of a run's writing.
+  Handle mem = checked(H5Screate_simple(rank, count.data(), nullptr), H5Sclose, "memory space", path);
   if (read_into) {
     read_into->resize(n);
     check(H5Dread(set.id(), mem_type, mem.id(), space.id(), H5P_DEFAULT, read_into->data()),

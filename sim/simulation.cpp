@@ -144,18 +144,25 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
   return std::min(end, first + std::min(next.load(), mine) * kChunk);
 }
 
-// Adds every rank's unflushed sums of direction k into rank 0's state.
+// Adds every rank's unflushed sums of direction k into rank 0's state. The
+// threads' tallies are cleared, not freed: they serve the next round and
+// direction without being allocated and faulted in again.
 void Simulation::Runner::flush(std::size_t k) {
-  const TallyShape shape = sim_.tally_shape();
-  Tally sum(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
-  for (std::unique_ptr<Tally>& t : thread_tallies_) {
-    if (t) sum.add(*t);
-    t.reset();
-  }
   if (group_.size() == 1) {
-    state_.tallies[k].add(sum);
+    for (std::unique_ptr<Tally>& t : thread_tallies_)
+      if (t) {
+        state_.tallies[k].add(*t);
+        t->clear();
+      }
     return;
   }
+  const TallyShape shape = sim_.tally_shape();
+  Tally sum(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
+  for (std::unique_ptr<Tally>& t : thread_tallies_)
+    if (t) {
+      sum.add(*t);
+      t->clear();
+    }
   std::vector<ExactTally::Word> words = sum.exact().words();
   group_.sum_to_root(words);
   if (group_.is_root()) {
