@@ -18,6 +18,8 @@
 #include "analytic/smooth_cylinder.h"
 #include "common/bin_grid.h"
 #include "common/error.h"
+#include "common/fiber_frame.h"
+#include "common/fresnel.h"
 #include "common/units.h"
 
 using namespace fiberlab;
@@ -58,8 +60,8 @@ std::vector<double> phi_marginal(const std::vector<double>& b, const BinGrid& g,
 // no tilt is that cylinder (orders p >= 3: with sigma_a = 0 the residual
 // carries all the light that reaches the third interface's reflection).
 // Mutations caught: eta instead of 1/eta at the inner interfaces (TT, TRT
-// off by > 0.1); the entry weight without cos(g) (every lobe off); Fresnel
-// of the 2D instead of the 3D angle (60 and 80 deg off by > 1e-2).
+// off by > 0.1); the entry weight without cos(g) (every lobe off);
+// refraction weight F instead of 1 - F.
 TEST(Huang2022, SmoothLimitIsTheExactCylinder) {
   for (const Known& k : kKnown) {
     const Huang2022 model(fiber(0.0));
@@ -75,8 +77,7 @@ TEST(Huang2022, SmoothLimitIsTheExactCylinder) {
 // 1e-4 every lobe is within 2e-3 of SPEC s8 (GGX's long tails make 1e-2
 // already move 2% of TT near the critical angle at 60 deg, 1e-3 still 1% of
 // p >= 3 at 80 deg: real, not quadrature), with a masking loss below 1e-3.
-// Mutation caught: the leaving masking G1(o) evaluated with 1 / alpha
-// (loss of order 1).
+// Mutations caught: as the smooth limit's.
 TEST(Huang2022, SmallRoughnessApproachesTheExactCylinder) {
   for (const Known& k : kKnown) {
     double previous = 1.0;
@@ -99,9 +100,10 @@ TEST(Huang2022, SmallRoughnessApproachesTheExactCylinder) {
 // bins split at the roots), per bin, for R, TT and TRT at roughness 0, with
 // absorption (chord, SPEC s7), at theta_i = 35 deg; and every exit lies in
 // the theta bin of the specular cone -theta_i.
-// Mutations caught: the relative azimuth with the wrong sign (phi_i - phi_r:
-// TRT bins mirrored, off by 1e-2); absorption over the 2D chord instead of
-// the 3D length (TT off by > 1e-3).
+// Mutations caught: absorption over the 2D chord instead of the 3D length
+// (TT off by > 1e-3); the residual's series with T_avg and 1 - T_avg swapped
+// (p >= 3 with absorption off). (The relative azimuth's sign is invisible on
+// a circle: tests/compare/test_huang2022_vs_simulation.cpp catches it.)
 TEST(Huang2022, SmoothLimitPhiBinsAreTheExactCylinders) {
   const double ti = deg_to_rad(35.0);
   Huang2022Params p = fiber(0.0, 1L << 18);
@@ -118,6 +120,11 @@ TEST(Huang2022, SmoothLimitPhiBinsAreTheExactCylinders) {
         EXPECT_NEAR(m[j], exact.phi_bins[(static_cast<std::size_t>(lobe) * 36 + j) * 2 + c], 2e-4)
             << "lobe " << lobe << " channel " << c << " bin " << j;
     }
+  // p >= 3: Cycles' geometric series is exact on the smooth circle, with absorption too.
+  for (int c = 0; c < 2; ++c) {
+    const std::vector<double> m = phi_marginal(b, g, 3, 2, c);
+    EXPECT_NEAR(sum(m), exact.energy[3 * 2 + c], 2e-5) << "channel " << c;
+  }
   const int spec = g.theta_bin(-ti);
   double off = 0.0;
   for (int lobe = 0; lobe < 4; ++lobe)
@@ -135,8 +142,7 @@ TEST(Huang2022, SmoothLimitPhiBinsAreTheExactCylinders) {
 // small and vanishes with the roughness; with the masking on, the loss
 // grows with the roughness (the paper's G1: energy <= 1).
 // Mutations caught: refraction weight F instead of 1 - F (ledger off);
-// the residual's geometric series with T_avg replaced by 1 - T_avg
-// (ledger off at sigma_a = 0: the series is no longer 1).
+// eta instead of 1/eta at the inner interfaces.
 TEST(Huang2022, WhiteFurnaceLosesOnlyToMaskingAndStoppedPaths) {
   for (double e : {1.0, 0.7}) {
     double previous_loss = 0.0;
@@ -207,7 +213,8 @@ TEST(Huang2022, TiltMovesRTowardsTheRoot) {
 // of its cross-section (phi_i = 0 or 90 deg): phi -> -phi; and on a circle
 // theta_i -> -theta_i mirrors theta_r (to the quadrature's error: the VNDF
 // map of the point set is not itself mirror-symmetric; bins up to 2e-2).
-// Mutation caught: the entry point mirrored on one side (q_w sign).
+// (The entry point mirrored on one side, q_w's sign, is caught by the smooth
+// limit's phi bins and the white furnace.)
 TEST(Huang2022, MirrorSymmetries) {
   const BinGrid g = BinGrid::make(12, 24, ThetaBinning::Uniform);
   Huang2022Params p = fiber(0.3);
@@ -266,6 +273,47 @@ TEST(Huang2022, PaperDensityIntegratesToTheLobeEnergies) {
     }
   EXPECT_NEAR(total[0], e.lobe[0], 0.02 * e.lobe[0]);
   EXPECT_NEAR(total[1], e.lobe[1], 0.05 * e.lobe[1]);
+}
+
+// Oracle: the paper's R lobe written from textbook formulas (Walter et al.
+// 2007's GGX: D = alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2), Smith G1 =
+// 2 / (1 + sqrt(1 + alpha^2 tan^2)); the unit circle: dl = dt, projected
+// width 2): S_R = 1/(2 cos theta_i) int F(wi.h) D(h.n) G1(wi) G1(wr) / 4 dt,
+// density S_R cos theta_r, with masking=separable.
+// Mutations caught: Smith's Lambda doubled in the separable masking; D of the
+// half vector about n0 instead of the mesonormal (with tilt: here 0, so via
+// the density test); the R lobe's G2 without G1(wi).
+TEST(Huang2022, RDensityIsTheTextbookMicrofacetIntegral) {
+  const double alpha = 0.25, ti = deg_to_rad(30.0);
+  Huang2022Params p = fiber(alpha);
+  const Huang2022 model(p);
+  auto g1 = [&](double c) {
+    const double t2 = (1.0 - c * c) / (c * c);
+    return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * t2));
+  };
+  auto ggx_d = [&](double c) {
+    const double t2 = (1.0 - c * c) / (c * c);
+    return alpha * alpha / (kPi * c * c * c * c * (alpha * alpha + t2) * (alpha * alpha + t2));
+  };
+  std::vector<double> v;
+  for (double tr_deg : {-40.0, -25.0, 10.0})
+    for (double ph_deg : {0.0, 60.0, 150.0}) {
+      const double tr = deg_to_rad(tr_deg), ph = deg_to_rad(ph_deg);
+      const Vec3 wi = direction_from_angles(ti, 0.0), wr = direction_from_angles(tr, ph);
+      const Vec3 h = (wi + wr).normalized();
+      double s = 0.0;
+      const int n = 20000;
+      for (int k = 0; k < n; ++k) {
+        const double t = (k + 0.5) * kTwoPi / n;
+        const Vec3 nn(0.0, std::cos(t), std::sin(t));
+        const double ci = wi.dot(nn), co = wr.dot(nn), ch = h.dot(nn);
+        if (ci <= 0.0 || co <= 0.0 || ch <= 0.0) continue;
+        s += fresnel_dielectric(wi.dot(h), 1.55) * ggx_d(ch) * g1(ci) * g1(co) / 4.0 * kTwoPi / n;
+      }
+      const double expected = s / (2.0 * std::cos(ti)) * std::cos(tr);
+      model.density(0, ti, 0.0, tr, ph, v);
+      EXPECT_NEAR(v[0], expected, 2e-3 * expected + 1e-9) << tr_deg << " " << ph_deg;
+    }
 }
 
 // The parameter table: defaults, --set parsing and refusals.
