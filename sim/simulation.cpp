@@ -281,7 +281,9 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      use_batch_tracer_(settings_.polarization == Polarization::Scalar),
+      // The microfacet models (issue 12) run on the reference tracer for now.
+      use_batch_tracer_(settings_.polarization == Polarization::Scalar &&
+                        !settings_.roughness.microfacet()),
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {

@@ -83,7 +83,8 @@ class Simulation {
   RunOutcome run(RunProgress& state, const RunControl& control, RunStatistics* stats = nullptr) const;
 
   // Traces photons [first, first + n) of incident configuration k into `tally`
-  // (with the batched tracer for scalar light, the reference tracer otherwise).
+  // (with the batched tracer for scalar light, the reference tracer for Stokes
+  // light and the microfacet roughness models).
   // `traced`, when given, grows by `per_photon` as each photon is scored (progress).
   void trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n, Tally& tally,
                      TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,

@@ -8,6 +8,7 @@ Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
     : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels),
       memory_(bins() * block() * sizeof(Fixed)), touched_(pages(), 0) {
   truncated_.assign(channels, 0);
+  lost_.assign(channels, 0);
 }
 
 Tally::Tally(const Tally& o) : Tally(o.lobes_, o.n_theta_, o.n_phi_, o.channels_) { add(o); }
@@ -38,10 +39,15 @@ void Tally::clear() {
   }
   photons_ = 0;
   std::fill(truncated_.begin(), truncated_.end(), Fixed{0});
+  std::fill(lost_.begin(), lost_.end(), Fixed{0});
 }
 
 void Tally::score_truncated(const double* weight) {
   for (int c = 0; c < channels_; ++c) truncated_[c] += to_fixed(weight[c]);
+}
+
+void Tally::score_lost(const double* weight) {
+  for (int c = 0; c < channels_; ++c) lost_[c] += to_fixed(weight[c]);
 }
 
 void Tally::add(const Tally& o) {
@@ -54,7 +60,10 @@ void Tally::add(const Tally& o) {
     touched_[p] = 1;
     for (std::size_t i = page_begin(p); i < page_end(p); ++i) to[i] += from[i];
   }
-  for (int c = 0; c < channels_; ++c) truncated_[c] += o.truncated_[c];
+  for (int c = 0; c < channels_; ++c) {
+    truncated_[c] += o.truncated_[c];
+    lost_[c] += o.lost_[c];
+  }
 }
 
 ExactTally Tally::exact() const {
@@ -77,9 +86,10 @@ ExactTally Tally::exact() const {
   for (std::size_t c = 0; c < C; ++c) {
     Fixed absorbed = static_cast<Fixed>(photons_) << 60;
     for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
-    absorbed -= truncated_[c];
+    absorbed -= truncated_[c] + lost_[c];
     e.absorbed[c] = static_cast<ExactTally::Word>(absorbed);
     e.truncated[c] = static_cast<ExactTally::Word>(truncated_[c]);
+    e.lost[c] = static_cast<ExactTally::Word>(lost_[c]);
   }
   return e;
 }
@@ -101,8 +111,11 @@ void Tally::add(const ExactTally& e) {
       cell[1 + C + c] += static_cast<Fixed>(e.weight_sq_sum[b * C + c]);
     }
   }
-  // exited and absorbed follow from the bins, photons and truncated.
-  for (std::size_t c = 0; c < C; ++c) truncated_[c] += static_cast<Fixed>(e.truncated[c]);
+  // exited and absorbed follow from the bins, photons, truncated and lost.
+  for (std::size_t c = 0; c < C; ++c) {
+    truncated_[c] += static_cast<Fixed>(e.truncated[c]);
+    lost_[c] += static_cast<Fixed>(e.lost[c]);
+  }
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
@@ -132,8 +145,8 @@ std::vector<std::uint64_t> Tally::count() const {
 }
 // The ledger (SPEC section 4) from the bins: exited is the sum of S1 over a
 // lobe's bins, and every photon launched left a weight w that exited or was
-// truncated and 1 - w absorbed. Integer sums: exactly what per-photon
-// counters would hold.
+// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed.
+// Integer sums: exactly what per-photon counters would hold.
 std::vector<Tally::Fixed> Tally::exited_fixed() const {
   std::vector<Fixed> out(static_cast<std::size_t>(lobes_) * channels_, 0);
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;
@@ -153,10 +166,11 @@ std::vector<double> Tally::absorbed() const {
   std::vector<Fixed> absorbed(channels_, static_cast<Fixed>(photons_) << 60);
   for (int c = 0; c < channels_; ++c) {
     for (int l = 0; l < lobes_; ++l) absorbed[c] -= exited[static_cast<std::size_t>(l) * channels_ + c];
-    absorbed[c] -= truncated_[c];
+    absorbed[c] -= truncated_[c] + lost_[c];
   }
   return to_double(absorbed);
 }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
+std::vector<double> Tally::lost() const { return to_double(lost_); }
 
 }  // namespace fiberlab::sim

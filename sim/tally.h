@@ -58,8 +58,11 @@ class Tally {
   }
   // A photon still inside when it was stopped, with weight[c] left.
   void score_truncated(const double* weight);
-  // Every launched photon must have been scored (exited or truncated): what
-  // is absorbed is derived from that (launched - exited - truncated, exact).
+  // Weight weight[c] removed from a photon by masking (roughness.masking:
+  // smith_g1), or the whole weight of a path it killed: the ledger's `lost`.
+  void score_lost(const double* weight);
+  // Every launched photon must have been scored (exited, truncated, lost): what
+  // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
   void add(const Tally& other);  // exact: integer sums
   // The same sums as exact integers in file order (checkpoints, MPI, merge),
@@ -76,6 +79,7 @@ class Tally {
   std::vector<double> exited() const;     // [lobe][channel]
   std::vector<double> absorbed() const;   // [channel]
   std::vector<double> truncated() const;  // [channel]
+  std::vector<double> lost() const;       // [channel]
 
  private:
   // Bins are tracked in pages of kPageBins consecutive bins.
@@ -99,6 +103,7 @@ class Tally {
   ZeroedMemory memory_;                 // cells(): [bin][count, S1[C], S2[C]]
   std::vector<std::uint8_t> touched_;   // [page]: 1 once a cell of the page was written
   std::vector<Fixed> truncated_;
+  std::vector<Fixed> lost_;
 };
 
 }  // namespace fiberlab::sim

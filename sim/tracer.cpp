@@ -26,6 +26,8 @@ Tracer::Tracer(const Settings& s)
       beta_long_(s.roughness.beta_long.front()),
       beta_azim_(s.roughness.beta_azim.front()),
       exit_blur_(s.roughness),
+      microfacet_(s.roughness.microfacet() ? std::optional<MicrofacetRoughness>(s.roughness)
+                                           : std::nullopt),
       max_segments_(s.max_segments),
       max_events_(s.max_events_per_point) {}
 
@@ -37,19 +39,31 @@ RoughnessModel Tracer::effective_model(const RoughnessSettings& r) {
 }
 
 // Returns false when the photon must be truncated (too many events at this
-// point, or no visible normal found). On return d is the new direction and
-// `inside` the photon's new side, consistent with the untilted normal.
+// point, or no visible normal found) or was killed by masking, with out.fate
+// set. On return d is the new direction and `inside` the photon's new side,
+// consistent with the untilted normal.
 template <typename Light>
 bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& light,
-                                 PhotonRandom& rng, TracerCounters& counters) const {
+                                 PhotonRandom& rng, TracerCounters& counters,
+                                 PhotonOutcome& out) const {
+  out.fate = PhotonFate::Truncated;  // unless an event below decides otherwise
   const Vec3 n0 = ellipse_.normal(p);
   // Cuticle tilt towards the root, on both sides (SPEC section 2).
   const Vec3 n_s = cos_tilt_ * n0 - sin_tilt_ * Vec3::UnitX();
   for (int k = 0; k < max_events_; ++k) {
     ++counters.events;
     const BoundaryNormals normals{inside ? Vec3(-n_s) : n_s, inside ? Vec3(-n0) : n0};
-    Vec3 m;
-    if (model_ == RoughnessModel::Gaussian) {
+    Vec3 m, mean;
+    if (microfacet_) {
+      ++counters.normal_draws;
+      mean = MicrofacetRoughness::mean_normal(d, normals);
+      const std::optional<Vec3> drawn = microfacet_->sample_normal(d, mean, rng);
+      if (!drawn) {
+        ++counters.sampler_caps;
+        return false;
+      }
+      m = *drawn;
+    } else if (model_ == RoughnessModel::Gaussian) {
       auto drawn = gaussian_normal(d, normals.facing, beta_long_, beta_azim_, rng,
                                    kMaxNormalTries, counters.normal_draws);
       if (!drawn) {
@@ -64,11 +78,23 @@ bool Tracer::scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& 
     const EventResult r = light.interact(d, m, eta_rel, rng);
     d = r.direction;
     if (r.refracted) inside = !inside;
+    if (microfacet_ && microfacet_->masks() && !apply_masking(mean, d, r.refracted, out)) return false;
     // Consistency rule (SPEC section 3): the new direction must leave the
     // boundary on the photon's side, judged with the untilted normal.
     const double dn = d.dot(n0);
     if (inside ? dn < 0.0 : dn > 0.0) return true;
   }
+  return false;
+}
+
+bool Tracer::apply_masking(const Vec3& mean, const Vec3& d, bool refracted,
+                           PhotonOutcome& out) const {
+  const double g1 = microfacet_->masking_factor(mean, d, refracted);
+  if (g1 < 1.0) out.losses.push_back({out.weight * (1.0 - g1), out.path_length});
+  out.weight *= g1;
+  if (g1 > 0.0) return true;
+  out.weight = 0.0;
+  out.fate = PhotonFate::Lost;
   return false;
 }
 
@@ -91,10 +117,7 @@ PhotonOutcome Tracer::trace_with(const Vec3& wi, double h, PhotonRandom& rng,
   Point2 p = ellipse_.entry_point(d, h);
   bool inside = false;
   while (true) {
-    if (!scatter_at_boundary(p, d, inside, light, rng, counters)) {
-      out.fate = PhotonFate::Truncated;
-      break;
-    }
+    if (!scatter_at_boundary(p, d, inside, light, rng, counters, out)) break;  // truncated or lost
     if (!inside) {  // left the fiber
       out.fate = PhotonFate::Exited;
       if (model_ == RoughnessModel::ExitBlur) {
