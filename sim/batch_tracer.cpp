@@ -357,12 +357,15 @@ void BatchTracer::launch(Lanes& l, int i, const Source& source, const Eigen::Vec
 // launch() for `n` <= W photons of a fixed incident direction d (beam
 // geometry g) into lanes [o, o + n), their streams seeded and their entry
 // points computed side by side.
-void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, std::uint64_t key,
+void BatchTracer::launch_group(Lanes& l, int o, int n, std::uint64_t photon0, const Source& source,
                                const Vec3& d, const Eigen::Vector2d& g, double phi_i) const {
   alignas(64) std::uint64_t index[W];
   for (int i = 0; i < W; ++i) index[i] = photon0 + static_cast<std::uint64_t>(i);
-  LaneRandom rng(key, UBatch::load_aligned(index));
-  const Batch h = Batch(2.0) * rng.uniform(Batch(0.0) == Batch(0.0)) - Batch(1.0);
+  LaneRandom rng(source.stream_key(), UBatch::load_aligned(index));
+  alignas(64) double hs[W];  // the Source's h (stratified or not) from each lane's draw
+  rng.uniform(Batch(0.0) == Batch(0.0)).store_aligned(hs);
+  for (int i = 0; i < W; ++i) hs[i] = source.impact_parameter(index[i], hs[i]);
+  const Batch h = Batch::load_aligned(hs);
   const Batch root = xsimd::sqrt(xsimd::max(Batch(0.0), Batch(1.0) - h * h));
   // EllipseCrossSection::entry_point_in_beam: q = h g_perp - sqrt(1 - h^2) g.
   const Batch px = Batch(ellipse_.r_v()) * (h * Batch(-g.y()) - root * Batch(g.x()));
@@ -532,16 +535,15 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
     }
   };
 
-  const Source source(settings_.seed, theta_i, phi_i, settings_.source.phi_i_uniform);
+  const Source source(settings_, theta_i, phi_i);
   const Vec3 d0 = -direction_from_angles(theta_i, phi_i);
   const Eigen::Vector2d beam = ellipse_.beam_direction(d0);
-  const std::uint64_t key = source.stream_key();
   while (true) {
     if (source.fixed_direction()) {
       while (n_active < kPoolLanes && next < end) {
         const int n = static_cast<int>(std::min<std::uint64_t>(
             std::min(W, kPoolLanes - n_active), end - next));
-        launch_group(l, n_active, n, next, key, d0, beam, phi_i);
+        launch_group(l, n_active, n, next, source, d0, beam, phi_i);
         n_active += n;
         next += n;
       }

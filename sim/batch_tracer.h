@@ -40,7 +40,7 @@ class BatchTracer {
   void launch(Lanes& lanes, int lane, const Source& source, const Eigen::Vector2d& beam,
               std::uint64_t photon) const;
   void launch_group(Lanes& lanes, int first_lane, int n, std::uint64_t first_photon,
-                    std::uint64_t stream_key, const Vec3& d, const Eigen::Vector2d& beam,
+                    const Source& source, const Vec3& d, const Eigen::Vector2d& beam,
                     double phi_i) const;
   void interface_events(Lanes& lanes, int n_active) const;
   void travel(Lanes& lanes, int n_active) const;

@@ -39,6 +39,7 @@ constexpr std::size_t kMaxConfigBytes = std::size_t{16} << 20;  // 16 MiB
 
 const char* const kModels[] = {"smooth", "gaussian", "exit_blur", "beckmann", "ggx"};
 const char* const kMaskings[] = {"none", "smith_g1"};
+const char* const kHSampling[] = {"stratified", "independent"};
 const char* const kPolarizations[] = {"scalar", "stokes"};
 const char* const kThetaBins[] = {"uniform", "equal_area"};
 
@@ -443,7 +444,7 @@ std::vector<double> read_theta_range(const Reader& r, const YAML::Node& n) {
 }
 
 void read_source(const Reader& r, const YAML::Node& parent, SourceSettings& s) {
-  const YAML::Node n = r.section(parent["source"], "source", {"theta_i", "phi_i"});
+  const YAML::Node n = r.section(parent["source"], "source", {"theta_i", "phi_i", "h_sampling"});
   if (const YAML::Node t = n["theta_i"]) {
     const Rule rule{kThetaI.text + "; a number, a list, or {from, to, step}", kThetaI.ok};
     s.theta_i = to_radians(t.IsMap() ? read_theta_range(r, t)
@@ -453,6 +454,7 @@ void read_source(const Reader& r, const YAML::Node& parent, SourceSettings& s) {
     s.phi_i_uniform = p.IsScalar() && p.Scalar() == "uniform";
     if (!s.phi_i_uniform) s.phi_i = to_radians(r.numbers(p, "source.phi_i", kAnyAngle, true));
   }
+  if (n["h_sampling"]) s.h_stratified = r.word(n["h_sampling"], "source.h_sampling", kHSampling) == 0;
 }
 
 void read_tally(const Reader& r, const YAML::Node& parent, TallySettings& t) {
@@ -609,6 +611,7 @@ std::string to_yaml(const Settings& s) {
       "source:\n"
       "  theta_i: {}\n"
       "  phi_i: {}\n"
+      "  h_sampling: {}\n"
       "tally:\n"
       "  n_theta: {}\n"
       "  n_phi: {}\n"
@@ -620,7 +623,8 @@ std::string to_yaml(const Settings& s) {
       s.photons, s.seed, quoted(s.output), number_text(f.eta), number_text(f.eccentricity),
       degrees_text(f.scale_tilt), absorption, to_string(s.roughness.model),
       roughness_parameters_text(s.roughness),
-      list_text(s.source.theta_i, degrees_text), phi_i, s.tally.n_theta, s.tally.n_phi,
+      list_text(s.source.theta_i, degrees_text), phi_i, kHSampling[s.source.h_stratified ? 0 : 1],
+      s.tally.n_theta, s.tally.n_phi,
       kThetaBins[s.tally.theta_bins == ThetaBinning::Uniform ? 0 : 1], s.tally.lobes,
       s.max_segments, s.max_events_per_point, to_string(s.polarization));
 }

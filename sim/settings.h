@@ -57,6 +57,9 @@ struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
   bool phi_i_uniform = false;        // a randomly rotated fiber
   std::vector<double> phi_i{0.0};    // radians (unused when uniform)
+  // Impact parameters h stratified by photon index (sim/source.h), or each
+  // photon's h independent. Either way every h is uniform in [-1, 1).
+  bool h_stratified = true;
 
   friend bool operator==(const SourceSettings&, const SourceSettings&) = default;
 };

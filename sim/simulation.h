@@ -60,6 +60,9 @@ class Simulation {
   // waits for the slowest (light-guided) photon of each call, and 256-photon
   // chunks ran at half the speed. Progress is counted per photon instead.
   static constexpr std::uint64_t kChunk = 4096;
+  // A thread traces up to kMaxRunChunks consecutive chunks in one call (a
+  // signal waits for the run: 64 Ki photons, a few hundredths of a second).
+  static constexpr std::uint64_t kMaxRunChunks = 16;
   // --target-error is judged after every kTargetBatch photons of a direction
   // (and at its last photon): a fixed schedule, so the stopping point depends
   // only on the seed and config, never on timing, threads or ranks.
