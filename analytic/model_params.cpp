@@ -162,7 +162,11 @@ ParamSpec beta_long_param(std::string meaning) {
                            "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_long,
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
-  return fittable(s, 0.0, 90.0);
+  // A fit keeps widths >= 1 deg: the published models' azimuthal
+  // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
+  // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
+  // use resolves narrower lobes. --set still accepts any width >= 0.
+  return fittable(s, 1.0, 90.0);
 }
 
 ParamSpec beta_azim_param(std::string meaning) {
@@ -170,7 +174,11 @@ ParamSpec beta_azim_param(std::string meaning) {
                            "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_azim,
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
-  return fittable(s, 0.0, 90.0);
+  // A fit keeps widths >= 1 deg: the published models' azimuthal
+  // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
+  // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
+  // use resolves narrower lobes. --set still accepts any width >= 0.
+  return fittable(s, 1.0, 90.0);
 }
 
 ParamSpec alpha_param(std::string meaning) {

@@ -238,7 +238,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
           const std::string size = f.roughness_model == "smooth" ? ""
                                    : f.roughness_unit == "deg" ? fmt::format(" {:g} deg", f.roughness)
                                                                : fmt::format(" alpha {:g}", f.roughness);
-          f.label = fmt::format("{}{} | {} | tilt {:g} | e {:g}", f.roughness_model, size, f.absorption_label,
+          f.label = fmt::format("{}{}, {}, tilt {:g}, e {:g}", f.roughness_model, size, f.absorption_label,
                                 tilts[t], eccs[e]);
           c.fibers.push_back(std::move(f));
         }

@@ -35,7 +35,7 @@ namespace fiberlab::compare {
 // One physical fiber of the sweep.
 struct AtlasFiber {
   sim::Settings settings;       // what the simulator traces (every theta_i)
-  std::string label;            // "gaussian beta_long=5 | sigma_a=0 | tilt 3 | e 1"
+  std::string label;            // "gaussian 5 deg, sigma_a=0, tilt 3, e 1"
   std::string roughness_model;  // the simulator's roughness model name
   double roughness = 0.0;       // its size: beta_long (deg) or alpha; 0 for smooth
   std::string roughness_unit;   // "deg" (beta) or "" (alpha)

@@ -83,9 +83,9 @@ void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResul
   describe(f, "/fibers/photons", "fiber", "photons", "photons per incident direction");
   describe(f, "/fibers/sim_seconds", "fiber", "seconds", "wall time of the simulation");
   describe(f, "/fibers/fit_seconds", "fiber", "seconds", "wall time of every model's comparison and fit");
-  describe(f, "/fibers/sim_energy", "fiber,incidence,lobe,channel", "fraction of incident light",
+  describe(f, "/fibers/sim_energy", kAtlasDims, "fraction of incident light",
            "simulated lobe energy (ledger)");
-  describe(f, "/fibers/sim_energy_error", "fiber,incidence,lobe,channel", "fraction of incident light",
+  describe(f, "/fibers/sim_energy_error", kAtlasDims, "fraction of incident light",
            "standard error of sim_energy");
 }
 
@@ -168,7 +168,7 @@ void write_model(h5::File& f, const Shape& s, const std::string& name, const std
   f.write(g + "/fit_chi2", {s.F}, chi2);
   f.write(g + "/fit_dof", {s.F}, dof);
   f.write(g + "/fit_iterations", {s.F}, iterations);
-  const std::string dims4 = "fiber,incidence,lobe,channel";
+  const std::string dims4 = kAtlasDims;
   describe(f, "/" + g + "/applicable", "fiber", "0/1", "1: the model accepted the fiber (status says why not)");
   describe(f, "/" + g + "/fitted", "fiber", "0/1", "1: the free parameters were fitted");
   describe(f, "/" + g + "/converged", "fiber", "0/1", "1: the fit converged");

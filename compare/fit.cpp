@@ -314,7 +314,13 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
         bool small_step = true;
         for (int j = 0; j < n; ++j)
           if (std::fabs(step[j]) > 1e-6 * std::max(1.0, std::fabs(x[j]))) small_step = false;
-        if (drop < 1e-3 || small_step) fr.converged = true;
+        // For a model that does not describe the data (chi2/dof = S >> 1)
+        // the parameters' errors are scaled by sqrt(S), so the chi2 change
+        // that moves them by one error is S, not 1: the same test is then
+        // drop < 1e-3 S (the atlas's fits of wrong models stop there instead
+        // of polishing digits far below their errors).
+        const double unit = std::max(1.0, chi2 / fr.dof);
+        if (drop < 1e-3 * unit || small_step) fr.converged = true;
       } else {
         lambda *= 10.0;
       }
