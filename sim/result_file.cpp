@@ -87,7 +87,7 @@ void write_result(const ResultFile& r, const std::string& path,
                   const std::vector<std::string>& inputs) {
   AtomicOutput out(path, inputs);
   {
-    h5::File f = h5::File::create(out.temp_path());
+    h5::File f = h5::File::create(out.temp_path(), out.target());
     write_result_header(f, r);
 
     const hsize_t K = r.configs(), L = r.lobes, C = r.channels;

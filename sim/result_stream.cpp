@@ -50,7 +50,7 @@ TallyShape shape_of(const ResultFile& r) {
 ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
                            const DirectionSeeds& direction_seeds)
     : out_(path), photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
-  file_.emplace(h5::File::create(out_.temp_path()));
+  file_.emplace(h5::File::create(out_.temp_path(), out_.target()));
   h5::File& f = *file_;
   write_result_header(f, header);
   f.create_group("/tally");
