@@ -11,7 +11,8 @@ namespace fiberlab::sim {
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
     : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
-      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()) {}
+      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
+      kept_(sigma_a_.size()) {}
 
 void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   using Batch = xsimd::batch<double>;
@@ -38,10 +39,18 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     if (f.exited[i]) tally.score_exit(bin[i], weight);
     else if (!f.lost[i]) tally.score_truncated(weight);
   }
-  // Masking's removals (issue 12), absorbed along the path up to each.
-  for (const FinishedPhotons::Loss& l : f.losses) {
-    for (int c = 0; c < channels; ++c) weight[c] = l.loss.weight * std::exp(-sigma_a_[c] * l.loss.path_length);
-    tally.score_lost(weight);
+  // Masking's removals (issue 12), each absorbed along the path up to it,
+  // summed per photon (a photon's removals are consecutive in f.losses).
+  double* kept = kept_.data();
+  for (std::size_t j = 0; j < f.losses.size();) {
+    const int slot = f.losses[j].slot;
+    std::fill(weight, weight + channels, 0.0);
+    for (; j < f.losses.size() && f.losses[j].slot == slot; ++j) {
+      const WeightLoss& l = f.losses[j].loss;
+      for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
+    }
+    for (int c = 0; c < channels; ++c) kept[c] = weights_[static_cast<std::size_t>(c) * kCap + slot];
+    tally.score_lost(weight, kept);
   }
 }
 

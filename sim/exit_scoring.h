@@ -24,6 +24,7 @@ class ExitScorer {
   int last_lobe_;
   std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
+  std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
 };
 
 }  // namespace fiberlab::sim

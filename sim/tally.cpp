@@ -1,5 +1,7 @@
 #include "sim/tally.h"
 
+#include <algorithm>
+
 #include "common/error.h"
 
 namespace fiberlab::sim {
@@ -46,8 +48,9 @@ void Tally::score_truncated(const double* weight) {
   for (int c = 0; c < channels_; ++c) truncated_[c] += to_fixed(weight[c]);
 }
 
-void Tally::score_lost(const double* weight) {
-  for (int c = 0; c < channels_; ++c) lost_[c] += to_fixed(weight[c]);
+void Tally::score_lost(const double* lost, const double* kept) {
+  constexpr Fixed one = Fixed{1} << 60;
+  for (int c = 0; c < channels_; ++c) lost_[c] += std::min(to_fixed(lost[c]), one - to_fixed(kept[c]));
 }
 
 void Tally::add(const Tally& o) {

@@ -58,9 +58,13 @@ class Tally {
   }
   // A photon still inside when it was stopped, with weight[c] left.
   void score_truncated(const double* weight);
-  // Weight weight[c] removed from a photon by masking (roughness.masking:
-  // smith_g1), or the whole weight of a path it killed: the ledger's `lost`.
-  void score_lost(const double* weight);
+  // The weight lost[c] that masking (roughness.masking: smith_g1) removed
+  // from one photon, which kept kept[c] (exited or truncated; 0 when killed):
+  // the ledger's `lost`. In exact arithmetic lost + kept <= 1; the products
+  // that make them round by a few 2^-53, so when nothing was absorbed they
+  // can exceed 1 by that much: lost is held at 1 - kept in the fixed point
+  // here, so that absorbed (the complement) is never below 0.
+  void score_lost(const double* lost, const double* kept);
   // Every launched photon must have been scored (exited, truncated, lost): what
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }

@@ -1,0 +1,119 @@
+// The ledger's `lost` (issue 12) through the files: the exact sums a run
+// writes (as `fiberlab run` and checkpoints do), the validating reader's
+// balance exited + absorbed + truncated + lost = N, files written before
+// `lost` existed (read as 0), a tampered `lost` (refused), and the exact sums'
+// flat words (MPI, merge) carrying it.
+//
+// Mutation tried: Tally::score_lost without its cap at 1 - kept: the white
+// masking run's exact absorbed wraps below 0 and the reader refuses the file
+// (WhiteMaskingRunWritesAndReadsBack).
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "common/error.h"
+#include "sim/checkpoint.h"
+#include "sim/result_stream.h"
+#include "tests/sim/sim_test_support.h"
+
+namespace fiberlab::sim {
+namespace {
+
+namespace fs = std::filesystem;
+
+class LedgerFile : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("fiberlab_lost_" + std::to_string(getpid()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs s and writes its exact sums as `fiberlab run` does.
+  std::string write_run(const Settings& s, const std::string& name) const {
+    const Simulation sim(s);
+    const std::vector<Tally> tallies = sim.run(2);
+    std::vector<ExactTally> exact;
+    for (const Tally& t : tallies) exact.push_back(t.exact());
+    const std::string path = (dir_ / name).string();
+    write_result_exact(path, result_header(s, sim.grid()), exact);
+    return path;
+  }
+
+  // h5py edits of a file (Debian's python3-h5py).
+  void edit(const std::string& path, const std::string& python) const {
+    const std::string script = (dir_ / "edit.py").string();
+    std::ofstream(script) << "import h5py, sys\nf = h5py.File(sys.argv[1], 'r+')\n" << python << "\nf.close()\n";
+    ASSERT_EQ(std::system(("/usr/bin/python3 " + script + " " + path).c_str()), 0);
+  }
+
+  fs::path dir_;
+};
+
+Settings masked_white_fiber(Masking masking) {
+  Settings s = testing::smooth_circle(30.0, 50000);
+  s.fiber.scale_tilt = deg_to_rad(3.0);
+  s.fiber.sigma_a = {0.0, 0.7};
+  s.tally.n_theta = 18;
+  s.tally.n_phi = 36;
+  s.roughness.model = RoughnessModel::GGX;
+  s.roughness.alpha_long = s.roughness.alpha_azim = 0.3;
+  s.roughness.masking = masking;
+  return s;
+}
+
+TEST_F(LedgerFile, WhiteMaskingRunWritesAndReadsBack) {
+  const std::string path = write_run(masked_white_fiber(Masking::SmithG1), "masked.h5");
+  const ResultFile r = read_result(path);  // validates the balance with lost
+  const double N = static_cast<double>(r.photons[0]);
+  ASSERT_EQ(r.lost.size(), 2u);
+  EXPECT_GT(r.lost[0] / N, 0.1);  // GGX 0.3 loses about a quarter
+  EXPECT_GT(r.lost[0], r.lost[1]);
+  EXPECT_GE(r.absorbed[0], 0.0);
+  EXPECT_LT(r.absorbed[0] / N, 1e-12);  // white channel: nothing absorbed, to rounding
+  // The exact sums hold the same lost.
+  const ResultReader exact(path);
+  EXPECT_EQ(ExactTally::to_double(exact.read(0).lost), std::vector<double>(r.lost.begin(), r.lost.end()));
+}
+
+TEST_F(LedgerFile, FilesWithoutLostReadAsLosingNothing) {
+  const std::string path = write_run(masked_white_fiber(Masking::None), "old.h5");
+  edit(path, "del f['ledger/lost']; del f['exact/lost']");
+  const ResultFile r = read_result(path);
+  EXPECT_EQ(r.lost, std::vector<double>(2, 0.0));
+  const ResultReader exact(path);
+  const ExactTally t = exact.read(0);
+  EXPECT_EQ(t.lost, std::vector<ExactTally::Word>(2, 0));
+}
+
+TEST_F(LedgerFile, TamperedLostIsRefused) {
+  const std::string path = write_run(masked_white_fiber(Masking::SmithG1), "tampered.h5");
+  edit(path, "f['ledger/lost'][0, 0] += 1.0");
+  try {
+    read_result(path);
+    FAIL() << "read_result accepted a ledger that does not balance";
+  } catch (const Error& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("exited + absorbed + truncated + lost"), std::string::npos) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+  }
+}
+
+TEST(ExactTallyLost, WordsAndSumsCarryLost) {
+  ExactTally a(TallyShape{2, 3, 4, 2});
+  a.lost = {5, 7};
+  a.photons = 1;
+  ExactTally b = a;
+  b += a;
+  EXPECT_EQ(b.lost, (std::vector<ExactTally::Word>{10, 14}));
+  ExactTally c(a.shape);
+  c.from_words(b.words());
+  EXPECT_EQ(c.lost, b.lost);
+}
+
+}  // namespace
+}  // namespace fiberlab::sim
