@@ -50,9 +50,12 @@ Settings bench_case(char which) {
   return s;
 }
 
-void trace(benchmark::State& state, char which) {
+// `batch`: photons per call of the tracer (0: 65536, 2048 for case d). Each
+// call ends with its lane pool draining; `run` makes calls of up to 16 chunks
+// of 4096 (Simulation::kMaxRunChunks), trace_per_chunk shows one chunk per call.
+void trace(benchmark::State& state, char which, std::uint64_t batch = 0) {
   const Simulation sim(bench_case(which));
-  const std::uint64_t batch = which == 'd' ? 2048 : 65536;
+  if (batch == 0) batch = which == 'd' ? 2048 : 65536;
   Tally tally(8, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
   TracerCounters counters;
   std::uint64_t first = 0;
@@ -91,6 +94,8 @@ BENCHMARK_CAPTURE(trace, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->M
 BENCHMARK_CAPTURE(trace, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, b_per_chunk, 'b', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, c_per_chunk, 'c', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
 BENCHMARK_CAPTURE(trace_reference, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(1.0);

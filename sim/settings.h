@@ -58,8 +58,9 @@ struct SourceSettings {
   bool phi_i_uniform = false;        // a randomly rotated fiber
   std::vector<double> phi_i{0.0};    // radians (unused when uniform)
   // Impact parameters h stratified by photon index (sim/source.h), or each
-  // photon's h independent. Either way every h is uniform in [-1, 1).
-  bool h_stratified = true;
+  // photon's h independent (the default: stratification measured no gain,
+  // README "Stratified impact parameters"). Either way every h is uniform in [-1, 1).
+  bool h_stratified = false;
 
   friend bool operator==(const SourceSettings&, const SourceSettings&) = default;
 };

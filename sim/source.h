@@ -3,8 +3,9 @@
 // its own random stream, its incident azimuth (drawn when the fiber is
 // randomly rotated) and its impact parameter h uniform in [-1, 1).
 //
-// Stratified h (the default; SPEC section 5 allows it: it changes the
-// variance, never the expectation). Photons are taken in blocks of kStrata
+// Stratified h (`source.h_sampling: stratified`, opt-in; SPEC section 5
+// allows it: it changes the variance, never the expectation; measured, it
+// removed no measurable variance: README "Stratified impact parameters"). Photons are taken in blocks of kStrata
 // consecutive indices from photon 0; in a block that lies wholly within the
 // run's photons, photon i draws its h in the i mod kStrata-th of kStrata
 // equal strata of [-1, 1). Every h is still uniform in [-1, 1) in law, each
