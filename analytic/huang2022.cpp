@@ -594,7 +594,7 @@ ModelInfo huang2022_info() {
       [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
       [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
-                                  "integer", "1048576", "an integer in [1024, 1073741824]",
+                                  "integer", "4194304", "an integer in [1024, 1073741824]",
                                   &ModelParams::quadrature_points, [](double x) {
                                     return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
                                   });

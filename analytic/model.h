@@ -65,7 +65,7 @@ struct ModelParams {
   std::vector<double> lobe_scale{1.0, 1.0, 1.0};
   int huang_masking = 0;
   bool mesonormal_flux = true;
-  double quadrature_points = 1048576.0;
+  double quadrature_points = 4194304.0;
 };
 
 // Value of a per-lobe list for lobe p: the last entry applies to every larger p.
