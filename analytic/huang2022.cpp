@@ -598,7 +598,10 @@ ModelInfo huang2022_info() {
                                   &ModelParams::quadrature_points, [](double x) {
                                     return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
                                   });
-  m.params = {eta_param(), sigma_a_param(), roughness, tilt, ecc, scale, masking, flux, lobes_param(), points};
+  // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
+  m.params = {eta_param(),   sigma_a_param(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
+              ecc,           scale,           masking,
+              flux,          lobes_param(),   points};
   m.make = [](const ModelParams& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
   m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {

@@ -118,12 +118,10 @@ std::string absorption_label(const Reader& r, const YAML::Node& entry, const std
   r.fail(path + " gives neither sigma_a nor melanin (give one)");
 }
 
-bool is_microfacet(const std::string& model) { return model == "beckmann" || model == "ggx"; }
-
 // The simulator config of one fiber, parsed by the simulator's own parser.
 sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML::Node& roughness,
                              const YAML::Node& absorption, double tilt, double eccentricity,
-                             const YAML::Node& theta_i, const std::string& where, const std::string& model) {
+                             const YAML::Node& theta_i, const std::string& where) {
   YAML::Node c;
   c["photons"] = top["photons"];
   c["seed"] = top["seed"] ? top["seed"] : YAML::Node(1);
@@ -145,10 +143,6 @@ sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML:
   try {
     return sim::parse_settings_yaml(e.c_str(), "fiber");
   } catch (const Error& err) {
-    if (is_microfacet(model))
-      r.fail(fmt::format("{}: roughness model {} is not yet in this simulator (issue 12 part 1; allowed "
-                         "now: smooth | gaussian | exit_blur); the simulator said: {}",
-                         where, model, err.what()));
     r.fail(fmt::format("{}: {}", where, err.what()));
   }
 }
@@ -228,8 +222,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
           roughness_size(roughness[g], f);
           const std::string where =
               fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e);
-          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], theta_node, where,
-                                      f.roughness_model);
+          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], theta_node, where);
           f.roughness_index = static_cast<int>(g);
           f.absorption_index = static_cast<int>(a);
           f.tilt_index = static_cast<int>(t);

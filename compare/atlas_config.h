@@ -10,7 +10,7 @@
 //   sweep:                # every combination of these lists is one fiber
 //     roughness:          # each entry a simulator roughness block (SPEC s3 / s11)
 //       - {model: gaussian, beta_long: 5}
-//       - {model: ggx, alpha: 0.1}       # once the simulator has microfacet roughness
+//       - {model: ggx, alpha: 0.1}       # microfacet (SPEC s3)
 //     absorption:         # each entry {sigma_a: X or [X, ...]} or {melanin: {eumelanin, pheomelanin}}
 //       - {sigma_a: 0.0}
 //     scale_tilt: [0, 3]  # degrees

@@ -85,14 +85,6 @@ models: [huang1999]"
 bad "absorption both" "both sigma_a and melanin" "$base
 sweep: {roughness: [{model: smooth}], absorption: [{sigma_a: 1, melanin: {eumelanin: 1}}], theta_i: [10]}"
 bad "missing photons" "photons is missing" "sweep: {roughness: [{model: smooth}], theta_i: [10]}"
-# Microfacet roughness: refused with "not yet" while the simulator lacks it
-# (the atlas passes roughness blocks through to the simulator's parser).
-printf 'photons: 1\nroughness: {model: ggx, alpha: 0.1}\n' >"$work/ggx.yaml"
-if ! "$fiberlab" run "$work/ggx.yaml" -o "$work/ggx.h5" --quiet >/dev/null 2>&1; then
-  bad "microfacet not yet" "not yet in this simulator" "$base
-sweep: {roughness: [{model: ggx, alpha: 0.1}], theta_i: [10]}"
-fi
-
 # Ctrl-C: a sweep of several seconds, interrupted after one.
 cat >"$work/long.yaml" <<'YAML'
 photons: 2000000
