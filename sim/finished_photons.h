@@ -15,8 +15,10 @@ struct FinishedPhotons {
   alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
   alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
   std::uint64_t photon[kCapacity];
+  alignas(64) double weight[kCapacity];  // the roughness model's throughput factor (1 by default)
   int segments[kCapacity];
   bool exited[kCapacity];
+  bool lost[kCapacity];  // fate Lost (not exited, not truncated)
 
   bool full() const { return n == kCapacity; }
   void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
@@ -25,6 +27,8 @@ struct FinishedPhotons {
     path[n] = o.path_length;
     segments[n] = o.segments;
     exited[n] = o.fate == PhotonFate::Exited;
+    lost[n] = o.fate == PhotonFate::Lost;
+    weight[n] = o.weight;
     theta[n] = o.theta;
     phi[n] = o.phi;
     dx[n] = o.direction.x();
@@ -34,7 +38,8 @@ struct FinishedPhotons {
   }
   PhotonOutcome outcome(int i) const {
     PhotonOutcome o;
-    o.fate = exited[i] ? PhotonFate::Exited : PhotonFate::Truncated;
+    o.fate = exited[i] ? PhotonFate::Exited : lost[i] ? PhotonFate::Lost : PhotonFate::Truncated;
+    o.weight = weight[i];
     o.direction = Vec3(dx[i], dy[i], dz[i]);
     o.segments = segments[i];
     o.path_length = path[i];

@@ -274,7 +274,7 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      use_batch_tracer_(settings_.polarization == Polarization::Scalar),
+      use_batch_tracer_(true),  // the batched life serves scalar and Stokes light
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {
