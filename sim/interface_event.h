@@ -50,11 +50,9 @@ struct ScalarLight {
                           const MaskOf<T>& act, LaneRandom<T>& rng) {
     // F uses the true 3D angle between d and m (SPEC section 3).
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
-    const FresnelAmplitudesOf<T> a = fresnel_amplitudes(cos_i, n.eta_rel);
-    const MaskOf<T> tir = a.tir;
-    const T F = T(0.5) * (a.r_s * a.r_s + a.r_p * a.r_p);
-    const MaskOf<T> reflect = tir | (rng.uniform(act & !tir) < F);
-    return {scatter_direction(d, m, reflect, cos_i, a.cos_t, n.ratio), !reflect};
+    const FresnelReflectanceOf<T> f = fresnel_reflectance(cos_i, n.eta_rel, n.ratio);
+    const MaskOf<T> reflect = f.tir | (rng.uniform(act & !f.tir) < f.F);
+    return {scatter_direction(d, m, reflect, cos_i, f.cos_t, n.ratio), !reflect};
   }
 };
 

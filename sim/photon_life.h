@@ -82,9 +82,10 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   const Vec3Of<T> n0 = c.ellipse.normal_at(s.px, s.py);
   // The tilted normal n_s = cos(alpha) n0 - sin(alpha) u, on the photon's side.
   const T side = select(inside, T(-1.0), T(1.0));
+  const T sin_n = side * T(-c.sin_tilt);
   const BoundaryFrame<T> frame{
-      Vec3Of<T>(side * T(-c.sin_tilt), side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z),
-      side * n0};
+      Vec3Of<T>(sin_n, side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z), side * n0,
+      sin_n, T(c.cos_tilt)};
   const FacetDraw<T> f = model.draw_normal(s.d, frame, live, s.rng, s.tries, counts, rounds);
   const MaskOf<T> act = f.ready & !f.failed;
   const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),

@@ -52,12 +52,10 @@ class GaussianRoughness {
   FacetDraw<T> draw_normal(const Vec3Of<T>& d, const BoundaryFrame<T>& frame,
                            const MaskOf<T>& live, LaneRandom<T>& rng, T& tries,
                            LifeCounts<T>& counts, int rounds) const {
-    // n_f = sin(theta_n) u + cos(theta_n) (0, pv, pw); never parallel to u (|tilt| < 45 deg).
-    const Vec3Of<T>& f = frame.facing;
-    const T sin_n = f.x, cos_n = sqrt(f.y * f.y + f.z * f.z);
-    const T inv = T(1.0) / cos_n;
-    const T pv = f.y * inv, pw = f.z * inv;
-    const Envelope<T> env = envelope(-d.dot(f));
+    // n_f = sin(theta_n) u + cos(theta_n) (0, pv, pw).
+    const T sin_n = frame.sin_n, cos_n = frame.cos_n;
+    const T pv = frame.untilted_facing.y, pw = frame.untilted_facing.z;
+    const Envelope<T> env = envelope(-d.dot(frame.facing));
     FacetDraw<T> out{Vec3Of<T>(T(0.0), T(0.0), T(0.0)), MaskOf<T>(false), MaskOf<T>(false)};
     MaskOf<T> pending = live;
     for (int k = 0; k < rounds && any(pending); ++k) {
@@ -95,12 +93,14 @@ class GaussianRoughness {
   template <class T>
   Envelope<T> envelope(const T& c0) const {
     constexpr double kSqrt2 = 1.4142135623730951;
-    const T c = select(c0 < T(0.0), asin(max(T(-1.0), c0)), c0);
+    const MaskOf<T> away = c0 < T(0.0);
+    const T c = any(away) ? select(away, asin(max(T(-1.0), c0)), c0) : c0;
     const T rho0 = max(T(0.0), -c) * T(1.0 / b_);
-    const T k = select(rho0 > T(1.0 / kSqrt2), T(0.5) * (rho0 + sqrt(rho0 * rho0 + T(4.0))),
-                       T(kSqrt2));
-    const T a = c + T(0.5 * b_) * k, b = T(b_) / k;
-    const T w0 = max(T(0.0), -a / b);
+    const MaskOf<T> tail = rho0 > T(1.0 / kSqrt2);
+    const T k = select(tail, T(0.5) * (rho0 + sqrt(rho0 * rho0 + T(4.0))), T(kSqrt2));
+    const T inv_k = select(tail, k - rho0, T(1.0 / kSqrt2));  // k^2 - rho0 k - 1 = 0
+    const T a = c + T(0.5 * b_) * k, b = T(b_) * inv_k;
+    const T w0 = max(T(0.0), -a * k * T(1.0 / b_));
     const T a0 = max(T(0.0), a);
     const MaskOf<T> plain = (w0 == T(0.0)) & (a0 + b >= T(1.0));
     return {select(plain, T(1.0), a0), select(plain, T(0.0), b), w0};
@@ -135,10 +135,9 @@ inline std::optional<Vec3> gaussian_normal(const Vec3& d, const Vec3& n_facing, 
   const life::GaussianRoughness model(beta_long, beta_azim);
   life::LifeCounts<double> counts;
   double pending_tries = 0.0;
-  const life::Vec3Of<double> facing(n_facing);
   const life::FacetDraw<double> f = model.draw_normal(
-      life::Vec3Of<double>(d), life::BoundaryFrame<double>{facing, facing}, true, rng.core(),
-      pending_tries, counts, max_tries);
+      life::Vec3Of<double>(d), life::BoundaryFrame<double>::from_facing(life::Vec3Of<double>(n_facing)),
+      true, rng.core(), pending_tries, counts, max_tries);
   tries += static_cast<long>(counts.normal_draws);
   if (!f.ready) return std::nullopt;
   return f.m.to_vec3();

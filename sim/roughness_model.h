@@ -55,6 +55,15 @@ template <class T>
 struct BoundaryFrame {
   Vec3Of<T> facing;           // n_f: the tilted normal facing the photon's side
   Vec3Of<T> untilted_facing;  // n0 (or -n0 inside): the smooth model's fallback
+  // n_f = sin_n u + cos_n untilted_facing (cos_n > 0: |tilt| < 45 deg).
+  T sin_n, cos_n;
+
+  // The frame of a facing normal alone (untilted_facing: its part in the normal plane).
+  static BoundaryFrame from_facing(const Vec3Of<T>& f) {
+    const T cos_n = sqrt(f.y * f.y + f.z * f.z);
+    const T inv = T(1.0) / cos_n;
+    return {f, Vec3Of<T>(T(0.0), f.y * inv, f.z * inv), f.x, cos_n};
+  }
 };
 
 template <class T>
