@@ -415,7 +415,13 @@ ModelInfo chiang2016_info() {
                                  "deg", "2", "degrees in (-45, 45)", &ModelParams::scale_tilt,
                                  [](double x) { return std::abs(x) < 45.0; });
   alpha.from_fiber = "fiber.scale_tilt";
-  m.params = {eta_param(), sigma_a_param(), beta_m, beta_n, alpha, lobes_param()};
+  // Free parameters (what `fiberlab atlas` fits), in the table's ranges.
+  m.params = {eta_param(),
+              sigma_a_param(),
+              fittable(beta_m, 0.0, 1.0),
+              fittable(beta_n, 0.0, 1.0),
+              fittable(alpha, -45.0 + 1e-6, 45.0 - 1e-6),
+              lobes_param()};
   m.make = [](const ModelParams& p) { return make_chiang2016(p); };
   m.approximations = chiang_approximations;
   m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {

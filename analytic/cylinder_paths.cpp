@@ -42,6 +42,17 @@ double fold_gamma(int p, double eta_p) {
   return std::asin(std::sqrt(std::clamp(s2, 0.0, 1.0)));
 }
 
+namespace {
+// x^n for an integer n >= 0 by repeated squaring (a few multiplications
+// instead of std::pow's exp and log; within ~2 log2(n) ulp).
+double power(double x, int n) {
+  double r = 1.0;
+  for (; n > 0; n >>= 1, x *= x)
+    if (n & 1) r *= x;
+  return r;
+}
+}  // namespace
+
 Attenuation::Attenuation(double eta, double theta, const std::vector<double>& sigma_a,
                          Absorption absorption)
     : eta_(eta), cos_theta_(std::cos(theta)), eta_p_(eta_prime(eta, theta)),
@@ -70,18 +81,18 @@ void Attenuation::A(int p, double gamma_i, double* out) const {
     return;
   }
   T(gamma_i, out);
-  const double base = (1.0 - fr) * (1.0 - fr) * std::pow(fr, p - 1);
-  for (int c = 0; c < C; ++c) out[c] = base * std::pow(out[c], p);
+  const double base = (1.0 - fr) * (1.0 - fr) * power(fr, p - 1);
+  for (int c = 0; c < C; ++c) out[c] = base * power(out[c], p);
 }
 
 void Attenuation::A_beyond(int P, double gamma_i, double* out) const {
   const double fr = f(gamma_i);
   T(gamma_i, out);
-  const double base = (1.0 - fr) * (1.0 - fr) * std::pow(fr, P);
+  const double base = (1.0 - fr) * (1.0 - fr) * power(fr, P);
   for (int c = 0; c < channels(); ++c) {
     const double denom = 1.0 - fr * out[c];
     // f T -> 1 only when f -> 1, where (1 - f)^2 / (1 - f T) -> 0.
-    out[c] = denom > 1e-300 ? base * std::pow(out[c], P + 1) / denom : 0.0;
+    out[c] = denom > 1e-300 ? base * power(out[c], P + 1) / denom : 0.0;
   }
 }
 

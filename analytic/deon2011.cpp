@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <cstring>
 
 #include "analytic/model_registry.h"
 #include "analytic/quadrature.h"
@@ -140,6 +141,76 @@ void deposit_gaussian(double mu, double beta, const double* mass, int C, int n,
     for (int c = 0; c < C; ++c) r[c] += frac * mass[c];
   }
 }
+
+// The sums F_n = sum over nodes of mass e^{-i n Phi} (n = 0..N) of the
+// Fourier deposit of Eq. 11. The nodes are collected first, then the sums
+// run with the nodes innermost: each node's e^{-i n Phi} by the recurrence
+// z_{n+1} = z_n e^{-i Phi} as before, the sum over nodes in independent
+// lanes (vectorized; only the order of the additions differs).
+class FourierSums {
+ public:
+  void clear(int channels) {
+    e_re_.clear();
+    e_im_.clear();
+    mass_.assign(channels, {});
+  }
+  void add(double phi, const double* mass) {
+    e_re_.push_back(std::cos(phi));
+    e_im_.push_back(-std::sin(phi));
+    for (std::size_t c = 0; c < mass_.size(); ++c) mass_[c].push_back(mass[c]);
+  }
+  // Adds F_n to f_re/f_im[n * C + c], n = 0..N. Tiles of kTile nodes keep
+  // their z in the first-level cache across the n loop.
+  void coefficients(int N, std::vector<double>& f_re, std::vector<double>& f_im) const {
+    const std::size_t K = e_re_.size(), C = mass_.size();
+    for (std::size_t k0 = 0; k0 < K; k0 += kTile) {
+      const std::size_t len = std::min(kTile, K - k0);
+      double zr[kTile], zi[kTile];
+      std::fill(zr, zr + len, 1.0);
+      std::fill(zi, zi + len, 0.0);
+      const double* er = e_re_.data() + k0;
+      const double* ei = e_im_.data() + k0;
+      for (int n = 0; n <= N; ++n) {
+        for (std::size_t c = 0; c < C; ++c) {
+          const double* m = mass_[c].data() + k0;
+          // kLanes partial sums in one vector register each (GCC vector
+          // extension), added up at the end.
+          Lanes sr = {}, si = {};
+          std::size_t k = 0;
+          for (; k + kLanes <= len; k += kLanes) {
+            const Lanes mk = load(m + k);
+            sr += mk * load(zr + k);
+            si += mk * load(zi + k);
+          }
+          double sum_r = 0.0, sum_i = 0.0;
+          for (std::size_t l = 0; l < kLanes; ++l) sum_r += sr[l], sum_i += si[l];
+          for (; k < len; ++k) {
+            sum_r += m[k] * zr[k];
+            sum_i += m[k] * zi[k];
+          }
+          f_re[static_cast<std::size_t>(n) * C + c] += sum_r;
+          f_im[static_cast<std::size_t>(n) * C + c] += sum_i;
+        }
+        for (std::size_t k = 0; k < len; ++k) {
+          const double next_re = zr[k] * er[k] - zi[k] * ei[k];
+          zi[k] = zr[k] * ei[k] + zi[k] * er[k];
+          zr[k] = next_re;
+        }
+      }
+    }
+  }
+
+ private:
+  static constexpr std::size_t kLanes = 8, kTile = 256;
+  typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
+  static Lanes load(const double* p) {
+    Lanes v;
+    std::memcpy(&v, p, sizeof v);
+    return v;
+  }
+  std::vector<double> e_re_, e_im_;
+  std::vector<std::vector<double>> mass_;  // [channel][node]
+};
 
 // G_0(phi) = (1/2) int D_0(phi - Phi(0, h)) dh = (D_0 * |cos(psi/2)|/4)(phi):
 // the R lobe's azimuthal shape before Eq. 12's direction-dependent Fresnel.
@@ -326,7 +397,8 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
 
   std::vector<cylinder::PathNode> nodes;
   std::vector<double> a(C);
-  std::vector<std::complex<double>> bin_factor;  // [n * np + j], see the Fourier deposit
+  std::vector<double> bin_factor_re, bin_factor_im, bin_sum;  // [n * np + j], see the Fourier deposit
+  FourierSums fourier;
   // Phi-bin integrals of sum_{p in term} N_p at exit inclination theta_r: [j * C + c].
   auto azimuthal = [&](const Term& t, double theta_r, std::vector<double>& nb) {
     nb.assign(static_cast<std::size_t>(np) * C, 0.0);
@@ -343,6 +415,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     // F_n = sum over nodes of mass e^{-i n Phi}, real and imaginary parts apart
     // (plain arithmetic: std::complex's NaN-checking products are 3x slower).
     std::vector<double> f_re(static_cast<std::size_t>(n_fourier + 1) * C, 0.0), f_im(f_re.size(), 0.0);
+    fourier.clear(C);
     for (int p = t.p0; p <= t.p1; ++p) {
       if (p == 0 && r_special) {
         const double sin_r = std::sin(theta_r), cos_r = std::cos(theta_r);
@@ -362,20 +435,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
           att.A(p, nd.gamma, a.data());
           for (int c = 0; c < C; ++c) a[c] *= nd.weight;
           if (n_fourier > 0) {
-            // Accumulate sum_nodes mass e^{-i n Phi}, n = 0..n_fourier.
-            const double e_re = std::cos(nd.phi), e_im = -std::sin(nd.phi);
-            double z_re = 1.0, z_im = 0.0;
-            for (int n = 0; n <= n_fourier; ++n) {
-              double* fr = &f_re[static_cast<std::size_t>(n) * C];
-              double* fi = &f_im[static_cast<std::size_t>(n) * C];
-              for (int c = 0; c < C; ++c) {
-                fr[c] += a[c] * z_re;
-                fi[c] += a[c] * z_im;
-              }
-              const double next_re = z_re * e_re - z_im * e_im;
-              z_im = z_re * e_im + z_im * e_re;
-              z_re = next_re;
-            }
+            fourier.add(nd.phi, a.data());
           } else {
             deposit_gaussian(nd.phi, t.beta, a.data(), C, np, nb);
           }
@@ -383,18 +443,22 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       }
     }
     if (n_fourier > 0) {
+      fourier.coefficients(n_fourier, f_re, f_im);
       // Eq. 11 in Fourier form: the wrapped Gaussian's coefficients are
       // g_n = exp(-n^2 beta^2 / 2), so the bin mass is
       // F_0 dphi / 2pi + (1/pi) Re sum_{n>=1} F_n g_n (e^{i n b} - e^{i n a}) / (i n).
       // The bin factors (e^{i n b} - e^{i n a}) / (i n) depend on neither
       // theta_r nor the channel: tabulated once per call (bin_factor).
-      if (static_cast<int>(bin_factor.size()) < (n_fourier + 1) * np) {
-        bin_factor.assign(static_cast<std::size_t>(n_fourier + 1) * np, 0.0);
+      if (static_cast<int>(bin_factor_re.size()) < (n_fourier + 1) * np) {
+        bin_factor_re.assign(static_cast<std::size_t>(n_fourier + 1) * np, 0.0);
+        bin_factor_im.assign(bin_factor_re.size(), 0.0);
         for (int n = 1; n <= n_fourier; ++n)
           for (int j = 0; j < np; ++j) {
             const double lo = -kPi + j * dphi, hi = lo + dphi;
-            bin_factor[static_cast<std::size_t>(n) * np + j] =
+            const std::complex<double> d =
                 (std::polar(1.0, n * hi) - std::polar(1.0, n * lo)) / std::complex<double>(0.0, n);
+            bin_factor_re[static_cast<std::size_t>(n) * np + j] = d.real();
+            bin_factor_im[static_cast<std::size_t>(n) * np + j] = d.imag();
           }
       }
       for (int n = 1; n <= n_fourier; ++n) {
@@ -404,15 +468,19 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
           f_im[static_cast<std::size_t>(n) * C + c] *= g;
         }
       }
-      for (int j = 0; j < np; ++j) {
-        for (int c = 0; c < C; ++c) {
-          double v = f_re[c] * dphi / kTwoPi;
-          for (int n = 1; n <= n_fourier; ++n) {
-            const std::complex<double> d = bin_factor[static_cast<std::size_t>(n) * np + j];
-            v += f_re[static_cast<std::size_t>(n) * C + c] * d.real() - f_im[static_cast<std::size_t>(n) * C + c] * d.imag();
-          }
-          nb[static_cast<std::size_t>(j) * C + c] += v;
+      // Bin by bin the same sum over n as written above, run with the bins
+      // innermost (contiguous, independent: vectorized) per channel.
+      for (int c = 0; c < C; ++c) {
+        bin_sum.assign(np, f_re[c] * dphi / kTwoPi);
+        for (int n = 1; n <= n_fourier; ++n) {
+          const double fr = f_re[static_cast<std::size_t>(n) * C + c];
+          const double fi = f_im[static_cast<std::size_t>(n) * C + c];
+          const double* d_re = &bin_factor_re[static_cast<std::size_t>(n) * np];
+          const double* d_im = &bin_factor_im[static_cast<std::size_t>(n) * np];
+          double* v = bin_sum.data();
+          for (int j = 0; j < np; ++j) v[j] += fr * d_re[j] - fi * d_im[j];
         }
+        for (int j = 0; j < np; ++j) nb[static_cast<std::size_t>(j) * C + c] += bin_sum[j];
       }
     }
     if (t.residual) {

@@ -55,6 +55,10 @@ namespace fiberlab::analytic {
 // The Marschner 2003 model. Throws fiberlab::Error for parameters it cannot
 // represent (beta_long <= 0, eta <= 1, a <= 0, w_c < 0, no channels).
 std::unique_ptr<Model> make_marschner2003(const ModelParams& params);
+// The same model whose bin_probabilities() evaluates N's phi-bin integrals
+// exactly at every theta_r quadrature node (no interpolation in theta_r):
+// ~10x slower, the reference the interpolation is tested against.
+std::unique_ptr<Model> make_marschner2003_reference(const ModelParams& params);
 
 namespace marschner2003 {
 

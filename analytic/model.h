@@ -57,6 +57,15 @@ struct ModelParams {
   // the root as SPEC's scale_tilt; the model rotates by 2^k of it).
   double beta_m = 0.3, beta_n = 0.3;
   double scale_tilt = 0.0;
+  // Huang et al. 2022 only (huang2022.h): GGX roughness alpha, per-lobe
+  // factors (R, TT, TRT), masking (0 separable, 1 correlated, 2 none), the
+  // flux onto the mesonormal (true) or the projected width, and the number
+  // of points of its quadrature (also uses eccentricity and scale_tilt).
+  double ggx_roughness = 0.3;
+  std::vector<double> lobe_scale{1.0, 1.0, 1.0};
+  int huang_masking = 0;
+  bool mesonormal_flux = true;
+  double quadrature_points = 1048576.0;
 };
 
 // Value of a per-lobe list for lobe p: the last entry applies to every larger p.

@@ -50,7 +50,7 @@ ParamSpec number_param(std::string key, std::string meaning, std::string unit,
                        std::string default_value, std::string allowed, double ModelParams::*field,
                        std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || !ok(x)) fail(key, value, allowed);
@@ -58,14 +58,23 @@ ParamSpec number_param(std::string key, std::string meaning, std::string unit,
   };
   s.show = [field, scale](const ModelParams& p) { return number_text(p.*field / scale); };
   s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", {p.*field}}; };
+  s.get_number = [field, scale](const ModelParams& p) { return p.*field / scale; };
+  s.set_number = [field, scale](ModelParams& p, double x) { p.*field = x * scale; };
   return s;
+}
+
+ParamSpec fittable(ParamSpec spec, double fit_min, double fit_max) {
+  spec.fit_min = fit_min;
+  spec.fit_max = fit_max;
+  spec.free = true;
+  return spec;
 }
 
 ParamSpec list_param(std::string key, std::string meaning, std::string unit,
                      std::string default_value, std::string allowed,
                      std::vector<double> ModelParams::*field, std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     std::vector<double> out;
     std::size_t start = 0;
@@ -89,7 +98,7 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
 ParamSpec integer_param(std::string key, std::string meaning, std::string default_value,
                         int ModelParams::*field, int min_value) {
   const std::string allowed = fmt::format("an integer >= {}", min_value);
-  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, min_value](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || x != std::floor(x) || x < min_value || x > 1e6)
@@ -108,7 +117,7 @@ ParamSpec choice_param(std::string key, std::string meaning, std::string default
                        std::function<int(const ModelParams&)> get) {
   std::string allowed;
   for (const auto& c : choices) allowed += (allowed.empty() ? "" : " | ") + c;
-  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
   s.set = [key, allowed, choices, set](ModelParams& p, const std::string& value) {
     const std::string v = trim(value);
     for (std::size_t i = 0; i < choices.size(); ++i)
@@ -128,6 +137,7 @@ ParamSpec eta_param() {
   ParamSpec s = number_param("eta", "refractive index of the fiber relative to the medium", "", "1.55",
                              "a number > 1", &ModelParams::eta, [](double x) { return x > 1.0; });
   s.from_fiber = "fiber.eta";
+  s.fit_min = 1.0 + 1e-6;
   return s;
 }
 
@@ -136,6 +146,7 @@ ParamSpec sigma_a_param() {
                            "a comma list of numbers >= 0, one per channel", &ModelParams::sigma_a,
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "fiber.sigma_a (or melanin)";
+  s.fit_min = 0.0;
   return s;
 }
 
@@ -151,7 +162,11 @@ ParamSpec beta_long_param(std::string meaning) {
                            "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_long,
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
-  return s;
+  // A fit keeps widths >= 1 deg: the published models' azimuthal
+  // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
+  // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
+  // use resolves narrower lobes. --set still accepts any width >= 0.
+  return fittable(s, 1.0, 90.0);
 }
 
 ParamSpec beta_azim_param(std::string meaning) {
@@ -159,7 +174,11 @@ ParamSpec beta_azim_param(std::string meaning) {
                            "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_azim,
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
-  return s;
+  // A fit keeps widths >= 1 deg: the published models' azimuthal
+  // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
+  // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
+  // use resolves narrower lobes. --set still accepts any width >= 0.
+  return fittable(s, 1.0, 90.0);
 }
 
 ParamSpec alpha_param(std::string meaning) {
@@ -167,13 +186,17 @@ ParamSpec alpha_param(std::string meaning) {
                            "a comma list of degrees, indexed by lobe p", &ModelParams::alpha,
                            [](double) { return true; });
   s.from_fiber = "fiber.scale_tilt (SPEC s7: R -2a, TT +a, TRT +4a, p >= 3: 0)";
-  return s;
+  // Free: a fit moves it through the physical tilt (fit key scale_tilt, the
+  // shift rule), the range of the simulator's scale_tilt (SPEC s11).
+  return fittable(s, -45.0 + 1e-6, 45.0 - 1e-6);
 }
 
 ParamSpec eccentricity_param(std::string allowed, std::function<bool(double)> ok) {
   ParamSpec s = number_param("eccentricity", "minor/major axis ratio of the cross-section", "", "1",
                              std::move(allowed), &ModelParams::eccentricity, std::move(ok));
   s.from_fiber = "fiber.eccentricity";
+  s.fit_min = 1e-3;
+  s.fit_max = 1.0;
   return s;
 }
 

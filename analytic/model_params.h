@@ -10,6 +10,7 @@
 // the model code reads; a table says which of those fields its model uses.
 // A key that is not in the model's table is refused.
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -40,7 +41,26 @@ struct ParamSpec {
   std::function<std::string(const ModelParams&)> show;
   // The current value for files (radians).
   std::function<ParamAttribute(const ModelParams&)> attribute;
+  // Fitting (compare/fit.h). Scalar parameters (number_param) only: the
+  // value as a number in command-line units (degrees), read and written
+  // without the text round trip.
+  std::function<double(const ModelParams&)> get_number;
+  std::function<void(ModelParams&, double)> set_number;
+  // The closed range a fit keeps the value in, in command-line units: the
+  // table's allowed range, an open end moved inside by a small margin
+  // (eta > 1: 1 + 1e-6). For a list, the range of each entry.
+  double fit_min = -std::numeric_limits<double>::infinity();
+  double fit_max = std::numeric_limits<double>::infinity();
+  // A free parameter: part of the model's shape that the fiber's physics
+  // does not fix (roughness widths, scale tilt, ...), as opposed to eta,
+  // sigma_a or the lobe count. `fiberlab atlas` fits every free parameter
+  // of every model (compare/fit.h, free_fit_keys()).
+  bool free = false;
 };
+
+// Sets the fit range and marks the parameter free (table entries read as
+// `fittable(number_param(...), 0, 1)`).
+ParamSpec fittable(ParamSpec spec, double fit_min, double fit_max);
 
 using ParamTable = std::vector<ParamSpec>;
 

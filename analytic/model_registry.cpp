@@ -12,11 +12,12 @@ ModelInfo exact_info();          // smooth_cylinder.cpp
 ModelInfo deon2011_info();       // deon2011.cpp
 ModelInfo marschner2003_info();  // marschner2003.cpp
 ModelInfo chiang2016_info();     // chiang2016.cpp
+ModelInfo huang2022_info();      // huang2022.cpp
 
 const std::vector<ModelInfo>& registered_models() {
   // To add a model: declare its info function above and list it here.
   static const std::vector<ModelInfo> models{exact_info(), deon2011_info(), marschner2003_info(),
-                                             chiang2016_info()};
+                                             chiang2016_info(), huang2022_info()};
   return models;
 }
 

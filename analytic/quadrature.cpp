@@ -1,5 +1,6 @@
 #include "analytic/quadrature.h"
 
+#include <algorithm>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -71,6 +72,41 @@ double gaussian_interval_mass(double a, double b, double mu, double beta) {
   if (za >= 0.0) return 0.5 * (std::erfc(za) - std::erfc(zb));
   if (zb <= 0.0) return 0.5 * (std::erfc(-zb) - std::erfc(-za));
   return 1.0 - 0.5 * (std::erfc(-za) + std::erfc(zb));
+}
+
+}  // namespace fiberlab::analytic
+
+namespace fiberlab::analytic {
+
+ChebyshevPanels::ChebyshevPanels(double lo, double hi, int n_panels, int m)
+    : lo_(lo), width_((hi - lo) / std::max(n_panels, 1)), n_panels_(std::max(n_panels, 1)),
+      m_(std::max(m, 2)), unit_(m_) {
+  for (int k = 0; k < m_; ++k) unit_[k] = 0.5 - 0.5 * std::cos(kPi * k / (m_ - 1));
+}
+
+double ChebyshevPanels::node(int g) const {
+  const int pan = std::min(g / (m_ - 1), n_panels_ - 1);
+  return lo_ + width_ * (pan + unit_[g - pan * (m_ - 1)]);
+}
+
+int ChebyshevPanels::basis(double x, double* l) const {
+  const double u = width_ > 0.0 ? (x - lo_) / width_ : 0.0;
+  const int pan = std::clamp(static_cast<int>(std::floor(u)), 0, n_panels_ - 1);
+  const double t = std::clamp(u - pan, 0.0, 1.0);
+  double den = 0.0;
+  for (int k = 0; k < m_; ++k) {
+    const double d = t - unit_[k];
+    if (d == 0.0) {
+      std::fill(l, l + m_, 0.0);
+      l[k] = 1.0;
+      return pan * (m_ - 1);
+    }
+    // Berrut & Trefethen Eq. 5.4: w_k = (-1)^k, halved at both ends.
+    const double w = ((k % 2) ? -1.0 : 1.0) * ((k == 0 || k == m_ - 1) ? 0.5 : 1.0);
+    den += (l[k] = w / d);
+  }
+  for (int k = 0; k < m_; ++k) l[k] /= den;
+  return pan * (m_ - 1);
 }
 
 }  // namespace fiberlab::analytic

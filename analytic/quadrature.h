@@ -19,3 +19,31 @@ const GaussLegendre& gauss_legendre(int n);
 double gaussian_interval_mass(double a, double b, double mu, double beta);
 
 }  // namespace fiberlab::analytic
+
+namespace fiberlab::analytic {
+
+// Piecewise polynomial interpolation in one variable on [lo, hi] (used to
+// interpolate a model's phi-bin integrals in theta_r between a few exact
+// evaluations): n_panels equal panels, each with the m >= 2
+// Chebyshev-Lobatto points x_k = mid - half cos(pi k / (m - 1)), k = 0..m-1;
+// neighbouring panels share their end point, so there are
+// n_panels (m - 1) + 1 distinct nodes, numbered from lo. The Lagrange basis
+// is evaluated by the barycentric formula (Berrut & Trefethen 2004, SIAM
+// Review 46(3), Eq. 4.2 with the weights of Eq. 5.4), stable for any m.
+class ChebyshevPanels {
+ public:
+  ChebyshevPanels(double lo, double hi, int n_panels, int m);
+  int nodes() const { return n_panels_ * (m_ - 1) + 1; }
+  int per_panel() const { return m_; }
+  double node(int g) const;
+  // The m basis values at x (clamped into [lo, hi]) into l[0..m), for the
+  // nodes first, first + 1, ..., first + m - 1; returns first.
+  int basis(double x, double* l) const;
+
+ private:
+  double lo_, width_;
+  int n_panels_, m_;
+  std::vector<double> unit_;  // Lobatto points on [0, 1]
+};
+
+}  // namespace fiberlab::analytic

@@ -1,4 +1,6 @@
-// Photons per second per core for the three cases of issue 2:
+// Photons per second per core for the three cases of issues 2 and 10 (90 x 180
+// bins, 8 lobes; the same cases as bench/configs/case_{a,b,c}.yaml, which time
+// the whole process):
 //  (a) smooth circle, sigma_a 0;
 //  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
 //  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg;
@@ -25,7 +27,7 @@ Settings bench_case(char which) {
   s.fiber.eta = 1.55;
   s.tally.n_theta = 90;
   s.tally.n_phi = 180;
-  s.tally.lobes = 4;
+  s.tally.lobes = 8;
   if (which == 'a') {
     s.fiber.sigma_a = {0.0};
     s.roughness.model = RoughnessModel::Smooth;
@@ -51,7 +53,7 @@ Settings bench_case(char which) {
 void trace(benchmark::State& state, char which) {
   const Simulation sim(bench_case(which));
   const std::uint64_t batch = which == 'd' ? 2048 : 65536;
-  Tally tally(4, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
+  Tally tally(8, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
   TracerCounters counters;
   std::uint64_t first = 0;
   for (auto _ : state) {

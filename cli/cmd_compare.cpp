@@ -162,7 +162,7 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--set", o->settings,
                   "Model parameter KEY=VALUE (angles in degrees; repeatable; `fiberlab models` lists the keys)");
   cmd->add_option("--fit", o->fit,
-                  "Comma-separated parameters to fit: the model's numeric keys (eta, beta_long, ...), NAME[p] "
+                  "Comma-separated parameters to fit: the model's numeric keys (eta, beta_long, beta_m, ...), NAME[p] "
                   "for one lobe's entry (beta_long[0],alpha[2]), or the physical scale_tilt (shift rule)");
   cmd->add_option("--report", o->report, "Write a report folder (report.md, metrics.csv/json, PNG plots)");
   cmd->add_option("--max-chi2", o->max_chi2,

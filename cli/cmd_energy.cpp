@@ -131,7 +131,7 @@ std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
     return "[" + s + "]";
   };
   const std::size_t K = e.theta_i.size();
-  std::vector<double> th, total, total_err, three, absorbed, truncated, ledger;
+  std::vector<double> th, total, total_err, three, absorbed, truncated, lost, ledger;
   std::string lobes = "[", errors = "[", names = "[";
   for (int l = 0; l < e.lobes; ++l) {
     std::vector<double> v, err;
@@ -151,16 +151,17 @@ std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
     if (e.simulated) {
       absorbed.push_back(e.absorbed[k * e.channels + c]);
       truncated.push_back(e.truncated[k * e.channels + c]);
+      lost.push_back(e.lost[k * e.channels + c]);
       ledger.push_back(e.ledger[k * e.channels + c]);
     }
   }
   return fmt::format(
       "{{\"label\": {}, \"simulated\": {}, \"beta_long_deg\": {}, \"theta_i_deg\": {}, \"lobe_names\": {}], "
       "\"lobes\": {}], \"lobe_errors\": {}], \"total\": {}, \"total_error\": {}, \"three_lobe\": {}, "
-      "\"absorbed\": {}, \"truncated\": {}, \"ledger\": {}}}",
+      "\"absorbed\": {}, \"truncated\": {}, \"lost\": {}, \"ledger\": {}}}",
       compare::json_string(e.label), e.simulated ? "true" : "false",
       e.beta_long >= 0 ? json_number(rad_to_deg(e.beta_long)) : std::string("null"), arr(th), names, lobes,
-      errors, arr(total), arr(total_err), arr(three), arr(absorbed), arr(truncated), arr(ledger));
+      errors, arr(total), arr(total_err), arr(three), arr(absorbed), arr(truncated), arr(lost), arr(ledger));
 }
 
 void energy_command(const EnergyOptions& o, bool photons_given) {
@@ -239,12 +240,12 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
   std::string csv = "source,beta_long_deg,theta_i_deg,channel";
   const int L = curves.front().lobes;
   for (int l = 0; l < L; ++l) csv += fmt::format(",{0},{0}_error", compare::lobe_name(l, L));
-  csv += ",total,total_error,three_lobe,absorbed,truncated,ledger,furnace_departure\n";
+  csv += ",total,total_error,three_lobe,absorbed,truncated,lost,ledger,furnace_departure\n";
   for (std::size_t k = 0; k < theta_i.size(); ++k) {
     fmt::print("\ntheta_i = {:.2f} deg\n  {:<44}", rad_to_deg(theta_i[k]), "source");
     for (int l = 0; l < L; ++l) fmt::print(" {:>9}", compare::lobe_name(l, L));
     fmt::print(" {:>9} {:>9} {:>10}{}\n", "total", "R+TT+TRT", white ? "total-1" : "",
-               simulated ? "  absorbed truncated ledger" : "");
+               simulated ? "  absorbed truncated      lost ledger" : "");
     for (const auto& e : curves) {
       fmt::print("  {:<44}", e.label.substr(0, 44));
       for (int l = 0; l < e.lobes; ++l) fmt::print(" {:9.6f}", e.at(k, l, c));
@@ -252,8 +253,9 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
       fmt::print(" {:9.6f} {:9.6f} {:>10}", total, e.three_lobe(k, c),
                  white ? fmt::format("{:+.2e}", total - 1.0) : std::string());
       if (e.simulated)
-        fmt::print("  {:8.6f} {:9.2e} {:.12f}  (total +- {:.1e})", e.absorbed[k * e.channels + c],
-                   e.truncated[k * e.channels + c], e.ledger[k * e.channels + c], e.total_error(k, c));
+        fmt::print("  {:8.6f} {:9.2e} {:9.6f} {:.12f}  (total +- {:.1e})", e.absorbed[k * e.channels + c],
+                   e.truncated[k * e.channels + c], e.lost[k * e.channels + c],
+                   e.ledger[k * e.channels + c], e.total_error(k, c));
       fmt::print("\n");
       for (int ch = 0; ch < e.channels; ++ch) {
         csv += fmt::format("\"{}\",{},{:.6g},{}", e.label, e.beta_long >= 0 ? fmt::format("{:g}", rad_to_deg(e.beta_long)) : "",
@@ -261,10 +263,11 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
         for (int l = 0; l < e.lobes; ++l) csv += fmt::format(",{:.9g},{:.3g}", e.at(k, l, ch), e.error(k, l, ch));
         csv += fmt::format(",{:.9g},{:.3g},{:.9g}", e.total(k, ch), e.total_error(k, ch), e.three_lobe(k, ch));
         if (e.simulated)
-          csv += fmt::format(",{:.9g},{:.3g},{:.15g}", e.absorbed[k * e.channels + ch],
-                             e.truncated[k * e.channels + ch], e.ledger[k * e.channels + ch]);
+          csv += fmt::format(",{:.9g},{:.3g},{:.9g},{:.15g}", e.absorbed[k * e.channels + ch],
+                             e.truncated[k * e.channels + ch], e.lost[k * e.channels + ch],
+                             e.ledger[k * e.channels + ch]);
         else
-          csv += ",,,";
+          csv += ",,,,";
         csv += white ? fmt::format(",{:.6g}\n", e.total(k, ch) - 1.0) : std::string(",\n");
       }
     }

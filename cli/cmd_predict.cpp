@@ -55,7 +55,7 @@ void predict(const PredictOptions& o) {
     std::copy(p.begin(), p.end(), prob.begin() + static_cast<std::ptrdiff_t>(k * per_k));
   }
 
-  h5::File f = h5::File::create(out.temp_path());
+  h5::File f = h5::File::create(out.temp_path(), out.target());
   write_file_identity(f, "fiber-prediction", utc_timestamp());
   f.set_attr("/", "config_yaml", sim::to_yaml(s));
   write_bins(f, grid);

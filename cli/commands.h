@@ -15,5 +15,6 @@ void add_predict_command(CLI::App& app);
 void add_compare_command(CLI::App& app);
 void add_energy_command(CLI::App& app);
 void add_models_command(CLI::App& app);
+void add_atlas_command(CLI::App& app);
 
 }  // namespace fiberlab::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   fiberlab::cli::add_compare_command(app);
   fiberlab::cli::add_energy_command(app);
   fiberlab::cli::add_models_command(app);
+  fiberlab::cli::add_atlas_command(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

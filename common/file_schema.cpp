@@ -64,9 +64,13 @@ void describe_result_datasets(h5::File& f) {
   describe(f, "/ledger/absorbed", "incidence,channel", "weight", "weight absorbed inside (divide by N)");
   describe(f, "/ledger/truncated", "incidence,channel", "weight",
            "weight still inside when max_segments was reached (divide by N)");
+  describe(f, "/ledger/lost", "incidence,channel", "weight",
+           "weight removed by masking (roughness.masking smith_g1: 1 - G1 at each event, and paths "
+           "killed on the wrong side of the mean surface); 0 otherwise (divide by N)");
   describe(f, "/fiber", "", "eta: 1, eccentricity: 1, scale_tilt: radians, sigma_a: 1/R per channel",
            "the fiber's parameters (attributes)");
-  describe(f, "/roughness", "", "beta_long, beta_azim: radians", "the surface roughness (attributes)");
+  describe(f, "/roughness", "", "beta_long, beta_azim: radians; alpha: 1 (slope)",
+           "the surface roughness (attributes)");
 }
 
 }  // namespace fiberlab

@@ -25,6 +25,8 @@ std::string join_names(const std::vector<std::string>& names);
 // Dimension labels of a histogram dataset ((K, L, n_theta, n_phi, C) and its
 // sub-shapes), as the attribute `dimensions` holds them.
 inline constexpr const char* kHistogramDims = "incidence,lobe,theta,phi,channel";
+// The per-lobe arrays of a fiber-atlas file (compare/atlas_file.h).
+inline constexpr const char* kAtlasDims = "fiber,incidence,lobe,channel";
 
 // Attributes `dimensions` (comma-separated axis names), `units` and
 // `description` on the dataset or group `path`.

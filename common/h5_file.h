@@ -37,6 +37,9 @@ class File {
   // (an exception during the write, e.g. a full disk) is abandoned, its
   // contents dropped. Disk errors are thrown naming the file and errno.
   static File create(const std::string& path);
+  // The same, with errors naming `shown_as` (the target of an AtomicOutput
+  // whose temporary file `path` is) instead of `path`.
+  static File create(const std::string& path, const std::string& shown_as);
   static File open_read(const std::string& path);
   const std::string& path() const { return path_; }
   void close();  // flush and close; throws naming the file (e.g. disk full)
@@ -104,8 +107,10 @@ class File {
   std::string path_;
 };
 
-// Called first in main(): turns HDF5's exit-time cleanup off (it crashes on a
-// file whose close failed on a full disk) and silences its error printing.
+// Called first in main(): turns the HDF5 C library's atexit cleanup off
+// (fiberlab closes every file it writes explicitly; a write that failed drops
+// the file's contents first so that its ids close, see drop_contents in the
+// .cpp) and silences HDF5's error printing.
 void prepare_hdf5();
 
 // Silences HDF5's automatic error stack printing; fiberlab reports its own.

@@ -21,7 +21,7 @@ struct EnergyCurve {
   int lobes = 0, channels = 0;
   std::vector<double> theta_i;          // K, radians
   std::vector<double> lobe, lobe_error; // K x L x C (errors: simulation only, else 0)
-  std::vector<double> absorbed, truncated, ledger;  // K x C (simulation only)
+  std::vector<double> absorbed, truncated, lost, ledger;  // K x C (simulation only)
 
   double at(std::size_t k, int l, int c) const { return lobe[(k * lobes + l) * channels + c]; }
   double error(std::size_t k, int l, int c) const { return lobe_error[(k * lobes + l) * channels + c]; }
@@ -31,8 +31,8 @@ struct EnergyCurve {
 };
 
 // The simulation's ledger: exited per lobe / N (with the standard errors of
-// sim::lobe_energy), absorbed / N, truncated / N, and the ledger sum
-// (exited + absorbed + truncated) / N, which is 1 to rounding.
+// sim::lobe_energy), absorbed / N, truncated / N, lost / N (masking), and the
+// ledger sum (exited + absorbed + truncated + lost) / N, which is 1 to rounding.
 EnergyCurve simulation_energy(const sim::ResultFile& result);
 
 // One model over theta_i (phi_i = 0), integrated on an n_theta x n_phi grid.

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <tuple>
 
 #include "common/error.h"
 #include "common/units.h"
@@ -118,22 +119,79 @@ void set_parameter(analytic::ModelParams& p, const std::string& key, double valu
   (*list)[k.index] = v;
 }
 
+namespace {
+
+// The table entry of a key's name, and whether it is a scalar the table
+// reads and writes itself (number_param: ParamSpec::get_number).
+const analytic::ParamSpec* spec_of(const std::string& model_name, const Key& k) {
+  return analytic::find_param(analytic::model_info(model_name).params, k.name);
+}
+bool table_scalar(const analytic::ParamSpec* spec) { return spec && spec->get_number && spec->set_number; }
+// A per-lobe list whose entry 0 (alpha) is a tilt shift: fitted per lobe or
+// through the physical scale_tilt (a model with a list `alpha`).
+bool has_alpha_list(const std::string& model_name) {
+  const analytic::ParamSpec* a = analytic::find_param(analytic::model_info(model_name).params, "alpha");
+  return a && !table_scalar(a);
+}
+
+}  // namespace
+
+double get_parameter(const std::string& model_name, const analytic::ModelParams& p, const std::string& key) {
+  const Key k = parse_key(key);
+  if (const analytic::ParamSpec* spec = spec_of(model_name, k); table_scalar(spec) && k.index < 0)
+    return spec->get_number(p);
+  return get_parameter(p, key);
+}
+
+void set_parameter(const std::string& model_name, analytic::ModelParams& p, const std::string& key,
+                   double value) {
+  const Key k = parse_key(key);
+  if (const analytic::ParamSpec* spec = spec_of(model_name, k); table_scalar(spec) && k.index < 0)
+    return spec->set_number(p, value);
+  set_parameter(p, key, value);
+}
+
+std::pair<double, double> fit_range(const std::string& model_name, const std::string& key) {
+  const Key k = parse_key(key);
+  if (k.name == "scale_tilt" && has_alpha_list(model_name)) {
+    const analytic::ParamSpec* a = analytic::find_param(analytic::model_info(model_name).params, "alpha");
+    return {a->fit_min, a->fit_max};
+  }
+  const analytic::ParamSpec* spec = spec_of(model_name, k);
+  if (!spec) throw Error(fmt::format("--fit {}: model {} has no such parameter", key, model_name));
+  double lo = spec->fit_min;
+  // set_parameter's floor for widths (d'Eon's delta limits at exactly 0).
+  if (k.name == "beta_long" || k.name == "beta_azim") lo = std::max(lo, 0.05);
+  return {lo, spec->fit_max};
+}
+
+std::vector<std::string> free_fit_keys(const std::string& model_name) {
+  std::vector<std::string> keys;
+  for (const analytic::ParamSpec& s : analytic::model_info(model_name).params) {
+    if (!s.free) continue;
+    // A per-lobe list of tilt shifts moves through the physical tilt (one
+    // number, SPEC s7's rule); any other list as one common value.
+    keys.push_back(s.key == "alpha" && !table_scalar(&s) ? "scale_tilt" : s.key);
+  }
+  return keys;
+}
+
 void check_fit_key(const std::string& model_name, const std::string& key) {
   const Key k = parse_key(key);
   const analytic::ParamTable& table = analytic::model_info(model_name).params;
   std::string fittable;
   for (const analytic::ParamSpec& s : table)
     if (s.unit != "choice" && s.unit != "integer") fittable += (fittable.empty() ? "" : ", ") + s.key;
-  if (analytic::find_param(table, "alpha")) fittable += ", scale_tilt";
-  const bool is_list = k.name == "beta_long" || k.name == "beta_azim" || k.name == "alpha" || k.name == "sigma_a";
+  if (has_alpha_list(model_name)) fittable += ", scale_tilt";
   const analytic::ParamSpec* spec = analytic::find_param(table, k.name);
-  const bool known = k.name == "scale_tilt" ? analytic::find_param(table, "alpha") != nullptr && k.index < 0
+  const bool is_list = spec && !table_scalar(spec);
+  const bool known = k.name == "scale_tilt" ? has_alpha_list(model_name) && k.index < 0
                                             : spec && spec->unit != "choice" && spec->unit != "integer" &&
                                                   (k.index < 0 || is_list);
   if (!known)
     throw Error(fmt::format("--fit {}: model {} cannot fit '{}'; fittable keys: {} (lists per lobe as NAME[p])",
                             key, model_name, key, fittable));
-  if (k.name == "alpha" && k.index < 0)
+  if (k.name == "alpha" && k.index < 0 && is_list)
     throw Error(fmt::format("--fit alpha: one common shift for every lobe moves R the wrong way; fit "
                             "alpha[p] per lobe (e.g. alpha[0],alpha[1]) or the physical scale_tilt"));
 }
@@ -147,12 +205,23 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   const int n = static_cast<int>(keys.size());
   FitResult fr;
   fr.keys = keys;
-  for (const std::string& key : keys) fr.start.push_back(get_parameter(start, key));
+  std::vector<double> lo(n), hi(n);
+  for (int j = 0; j < n; ++j) {
+    std::tie(lo[j], hi[j]) = fit_range(model_name, keys[j]);
+    fr.start.push_back(std::clamp(get_parameter(model_name, start, keys[j]), lo[j], hi[j]));
+  }
+  // Projected Levenberg-Marquardt: every trial point is clamped into the
+  // table's ranges (fit_range), so the model is never asked for a value it
+  // refuses; derivatives at a bound are one-sided.
+  auto project = [&](Eigen::VectorXd x) {
+    for (int j = 0; j < n; ++j) x[j] = std::clamp(x[j], lo[j], hi[j]);
+    return x;
+  };
   const Selection sel = select_bins(result, options);
 
   auto params_at = [&](const Eigen::VectorXd& x) {
     analytic::ModelParams p = start;
-    for (int j = 0; j < n; ++j) set_parameter(p, keys[j], x[j]);
+    for (int j = 0; j < n; ++j) set_parameter(model_name, p, keys[j], x[j]);
     return p;
   };
   auto residuals = [&](const Eigen::VectorXd& x, bool parallel) {
@@ -174,11 +243,12 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
       try {
         const double h = step(j, x[j]);
         Eigen::VectorXd xp = x, xm = x;
-        xp[j] += h;
-        xm[j] -= h;
+        xp[j] = std::min(x[j] + h, hi[j]);
+        xm[j] = std::max(x[j] - h, lo[j]);
         const Eigen::VectorXd rp = residuals(xp, false), rm = residuals(xm, false);
         // set_parameter may clamp (beta floor): use the actual difference.
-        const double dx = get_parameter(params_at(xp), keys[j]) - get_parameter(params_at(xm), keys[j]);
+        const double dx = get_parameter(model_name, params_at(xp), keys[j]) -
+                          get_parameter(model_name, params_at(xm), keys[j]);
         J.col(j) = (rp - rm) / (dx != 0.0 ? dx : 2.0 * h);
       } catch (const std::exception& e) {
 #pragma omp critical
@@ -207,13 +277,27 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   fr.evaluations += 2 * n;
   for (fr.iterations = 0; fr.iterations < max_iterations; ++fr.iterations) {
     const Eigen::MatrixXd A = J.transpose() * J;
-    const Eigen::VectorXd g = J.transpose() * r;
+    Eigen::VectorXd g = J.transpose() * r;
+    // Active set: a parameter at a bound whose descent direction points out
+    // of its range is held there for this iteration (its row and column
+    // decoupled), so the others can still move.
+    std::vector<bool> held(n, false);
+    for (int j = 0; j < n; ++j)
+      held[j] = (x[j] <= lo[j] && g[j] > 0.0) || (x[j] >= hi[j] && g[j] < 0.0);
     bool improved = false;
     for (int tries = 0; tries < 12 && !improved; ++tries) {
       Eigen::MatrixXd Ad = A;
       for (int j = 0; j < n; ++j) Ad(j, j) += lambda * std::max(A(j, j), 1e-12);
-      const Eigen::VectorXd dx = Ad.ldlt().solve(-g);
-      const Eigen::VectorXd xn = x + dx;
+      Eigen::VectorXd gh = g;
+      for (int j = 0; j < n; ++j)
+        if (held[j]) {
+          Ad.row(j).setZero();
+          Ad.col(j).setZero();
+          Ad(j, j) = 1.0;
+          gh[j] = 0.0;
+        }
+      const Eigen::VectorXd xn = project(x + Ad.ldlt().solve(-gh));
+      const Eigen::VectorXd step = xn - x;
       const Eigen::VectorXd rn = residuals(xn, true);
       ++fr.evaluations;
       const double chi2n = rn.squaredNorm();
@@ -229,8 +313,14 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
         // its own noise) or the step is tiny against the parameter.
         bool small_step = true;
         for (int j = 0; j < n; ++j)
-          if (std::fabs(dx[j]) > 1e-6 * std::max(1.0, std::fabs(x[j]))) small_step = false;
-        if (drop < 1e-3 || small_step) fr.converged = true;
+          if (std::fabs(step[j]) > 1e-6 * std::max(1.0, std::fabs(x[j]))) small_step = false;
+        // For a model that does not describe the data (chi2/dof = S >> 1)
+        // the parameters' errors are scaled by sqrt(S), so the chi2 change
+        // that moves them by one error is S, not 1: the same test is then
+        // drop < 1e-3 S (the atlas's fits of wrong models stop there instead
+        // of polishing digits far below their errors).
+        const double unit = std::max(1.0, chi2 / fr.dof);
+        if (drop < 1e-3 * unit || small_step) fr.converged = true;
       } else {
         lambda *= 10.0;
       }
@@ -257,6 +347,8 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     const double e = std::sqrt(std::max(0.0, cov(j, j)));
     fr.error_unscaled.push_back(e);
     fr.error.push_back(e * scale);
+    const double tol = 1e-9 * (1.0 + std::fabs(x[j]));
+    fr.at_bound.push_back(x[j] <= lo[j] + tol || x[j] >= hi[j] - tol);
   }
   fr.params = params_at(x);
   return fr;

@@ -48,6 +48,18 @@ analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
     case sim::RoughnessModel::Smooth: f.roughness = analytic::PhysicalFiber::Roughness::Smooth; break;
     case sim::RoughnessModel::Gaussian: f.roughness = analytic::PhysicalFiber::Roughness::Gaussian; break;
     case sim::RoughnessModel::ExitBlur: f.roughness = analytic::PhysicalFiber::Roughness::ExitBlur; break;
+    case sim::RoughnessModel::Beckmann:
+    case sim::RoughnessModel::GGX: {
+      // A microfacet fiber is handed to the models' defaults as the gaussian
+      // fiber of the same RMS facet slope per axis: Beckmann's slopes are
+      // Normal(0, alpha^2 / 2) per axis, so beta = atan(alpha / sqrt 2). A
+      // nominal starting point only (GGX's slopes have no finite variance; the
+      // calibrated widths are for gaussian facets): fit the widths, or --set them.
+      f.roughness = analytic::PhysicalFiber::Roughness::Gaussian;
+      f.beta_long = {std::atan(s.roughness.alpha_long / std::sqrt(2.0))};
+      f.beta_azim = {std::atan(s.roughness.alpha_azim / std::sqrt(2.0))};
+      return f;
+    }
   }
   f.beta_long = s.roughness.beta_long;
   f.beta_azim = s.roughness.beta_azim;

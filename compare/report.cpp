@@ -46,7 +46,7 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
                         const std::string& model_label, int plot_channel) {
   AtomicOutput out((fs::path(dir) / "report_data.h5").string());
   {
-    h5::File f = h5::File::create(out.temp_path());
+    h5::File f = h5::File::create(out.temp_path(), out.target());
     const std::size_t K = r.configs();
     const hsize_t L = r.lobes, nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
     write_file_identity(f, "fiber-report-data", utc_timestamp());

@@ -2,7 +2,7 @@
 """Plots and the HTML page for `fiberlab compare --report DIR` and
 `fiberlab energy --report DIR`.
 
-Usage: /usr/bin/python3 scripts/plot_report.py compare|energy DIR
+Usage: /usr/bin/python3 scripts/plot_report.py compare|energy|atlas DIR
 
 Reads DIR/report_data.h5 and DIR/metrics.json (compare) or DIR/metrics.json
 (energy), writes PNGs and DIR/report.html into DIR. report.html is one
@@ -41,6 +41,7 @@ degrees ({DIR} = theta30.0_phi0.0, or theta30.0_phiuniform):
                               d'Eon et al. 2011 Fig. 3
   energy_furnace.png          1200 x 400: white fibers only, |total - 1|
                               against theta_i per source (log scale)
+  atlas_*.png                 `fiberlab atlas`: see scripts/plot_atlas.py
 """
 import base64
 import html
@@ -527,7 +528,7 @@ def write_energy_html(d, m, figures):
 
 
 def main():
-    if len(sys.argv) != 3 or sys.argv[1] not in ("compare", "energy"):
+    if len(sys.argv) != 3 or sys.argv[1] not in ("compare", "energy", "atlas"):
         print(__doc__.splitlines()[2])
         return 2
     try:
@@ -542,6 +543,10 @@ def main():
     kind, d = sys.argv[1], sys.argv[2]
     if kind == "compare":
         plot_compare(d, np, plt, h5py)
+    elif kind == "atlas":  # `fiberlab atlas`: scripts/plot_atlas.py
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import plot_atlas
+        plot_atlas.plot_atlas(d, np, plt, h5py, save_png, img, write_html)
     else:
         plot_energy(d, np, plt)
     return 0

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <memory>
 
+#include "common/error.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
@@ -115,7 +116,10 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
                         const Sink& sink, TracerCounters& counters) const {
   std::visit(
       [&](const auto& model) {
-        if (settings_.polarization == Polarization::Stokes)
+        using Model = std::decay_t<decltype(model)>;
+        if constexpr (requires { Model::kScalarOnly; }) {
+          throw Error("internal error: this roughness model runs on the reference tracer only");
+        } else if (settings_.polarization == Polarization::Stokes)
           trace_with<life::StokesLight<Batch>>(model, theta_i, phi_i, first, n, sink, counters);
         else
           trace_with<life::ScalarLight<Batch>>(model, theta_i, phi_i, first, n, sink, counters);
@@ -131,7 +135,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   auto pool_owner = std::make_unique<Pool>();
   Pool& pool = *pool_owner;
   auto done = std::make_unique<FinishedPhotons>();
-  const Source source(settings_.seed, theta_i, phi_i, settings_.source.phi_i_uniform);
+  const Source source(settings_, theta_i, phi_i);
   const EllipseCrossSection& ellipse = config_.ellipse;
   const Eigen::Vector2d beam = ellipse.beam_direction(-direction_from_angles(theta_i, phi_i));
   const Batch iota = lane_index();

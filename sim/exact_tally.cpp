@@ -13,7 +13,8 @@ ExactTally::ExactTally(const TallyShape& s)
       weight_sq_sum(s.bin_cells(), 0),
       exited(static_cast<std::size_t>(s.lobes) * s.channels, 0),
       absorbed(s.channels, 0),
-      truncated(s.channels, 0) {}
+      truncated(s.channels, 0),
+      lost(s.channels, 0) {}
 
 namespace {
 
@@ -39,27 +40,28 @@ ExactTally& ExactTally::operator+=(const ExactTally& o) {
   add_words(exited, o.exited);
   add_words(absorbed, o.absorbed);
   add_words(truncated, o.truncated);
+  add_words(lost, o.lost);
   return *this;
 }
 
 std::vector<ExactTally::Word> ExactTally::words() const {
   std::vector<Word> w;
-  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 2 * absorbed.size());
+  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size());
   w.push_back(photons);
   w.insert(w.end(), count.begin(), count.end());
-  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated})
+  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
     w.insert(w.end(), v->begin(), v->end());
   return w;
 }
 
 void ExactTally::from_words(const std::vector<Word>& w) {
   const std::size_t expected =
-      1 + count.size() + 2 * weight_sum.size() + exited.size() + 2 * absorbed.size();
+      1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size();
   if (w.size() != expected) throw Error("internal error: tally words of the wrong size");
   std::size_t i = 0;
   photons = static_cast<std::uint64_t>(w[i++]);
   for (auto& c : count) c = static_cast<std::uint64_t>(w[i++]);
-  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated})
+  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
     for (auto& x : *v) x = w[i++];
 }
 

@@ -32,12 +32,13 @@ struct ExactTally {
   std::vector<Word> weight_sum, weight_sq_sum;  // [lobe][theta][phi][channel]
   std::vector<Word> exited;                     // [lobe][channel]
   std::vector<Word> absorbed, truncated;        // [channel]
+  std::vector<Word> lost;                       // [channel]: removed by masking (issue 12)
 
   // Exact sum; throws fiberlab::Error when a count would overflow 64 bits.
   ExactTally& operator+=(const ExactTally& other);
 
   // Every number as one flat array of words (photons, count, weight_sum,
-  // weight_sq_sum, exited, absorbed, truncated), for element-wise sums
+  // weight_sq_sum, exited, absorbed, truncated, lost), for element-wise sums
   // across MPI ranks; from_words() is its inverse.
   std::vector<Word> words() const;
   void from_words(const std::vector<Word>& w);

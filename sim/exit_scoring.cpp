@@ -3,6 +3,7 @@
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
+#include <cmath>
 
 #include "common/units.h"
 
@@ -21,7 +22,8 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     const Batch minus_sigma(-sigma_a_[c]);
     double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
     for (int i = 0; i < f.n; i += W)
-      xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)).store_unaligned(w + i);
+      (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
+          .store_unaligned(w + i);
   }
   std::size_t bin[kCap];
   for (int i = 0; i < f.n; ++i) {
@@ -34,7 +36,12 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   for (int i = 0; i < f.n; ++i) {
     for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
     if (f.exited[i]) tally.score_exit(bin[i], weight);
-    else tally.score_truncated(weight);
+    else if (!f.lost[i]) tally.score_truncated(weight);
+  }
+  // Masking's removals (issue 12), absorbed along the path up to each.
+  for (const FinishedPhotons::Loss& l : f.losses) {
+    for (int c = 0; c < channels; ++c) weight[c] = l.loss.weight * std::exp(-sigma_a_[c] * l.loss.path_length);
+    tally.score_lost(weight);
   }
 }
 

@@ -1,7 +1,8 @@
 #pragma once
 // Scoring finished photons into a Tally (SPEC sections 4 and 6): the
 // Beer-Lambert weight exp(-sigma_a[c] l) per channel along the whole internal
-// path, the lobe min(p, L - 1) and the (theta_r, phi_r - phi_i) bin.
+// path (times the photon's masking throughput), the lobe min(p, L - 1) and the
+// (theta_r, phi_r - phi_i) bin; weight removed by masking as the ledger's lost.
 #include <vector>
 
 #include "common/bin_grid.h"

@@ -3,6 +3,7 @@
 // (structure of arrays), so that weights are computed vectorised and the
 // tally's cells fetched ahead, instead of one call per photon.
 #include <cstdint>
+#include <vector>
 
 #include "sim/tracer.h"
 
@@ -12,23 +13,32 @@ struct FinishedPhotons {
   static constexpr int kCapacity = 256;  // a multiple of every SIMD width
   int n = 0;
   alignas(64) double path[kCapacity] = {};  // internal 3D path length
+  alignas(64) double weight[kCapacity] = {};  // throughput before absorption (PhotonOutcome::weight)
   alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
   alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
   std::uint64_t photon[kCapacity];
-  alignas(64) double weight[kCapacity];  // the roughness model's throughput factor (1 by default)
   int segments[kCapacity];
   bool exited[kCapacity];
-  bool lost[kCapacity];  // fate Lost (not exited, not truncated)
+  bool lost[kCapacity];  // killed by masking (its weight is in `losses`)
+  // Weight removed by masking from the block's photons (issue 12; empty
+  // without masking): photon slot, weight, path length at the removal.
+  struct Loss {
+    int slot;
+    WeightLoss loss;
+  };
+  std::vector<Loss> losses;
 
   bool full() const { return n == kCapacity; }
   void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
+    if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
+    for (const WeightLoss& l : o.losses) losses.push_back({n, l});
+    weight[n] = o.weight;
+    lost[n] = o.fate == PhotonFate::Lost;
     photon[n] = index;
     phi_i[n] = incident_phi;
     path[n] = o.path_length;
     segments[n] = o.segments;
     exited[n] = o.fate == PhotonFate::Exited;
-    lost[n] = o.fate == PhotonFate::Lost;
-    weight[n] = o.weight;
     theta[n] = o.theta;
     phi[n] = o.phi;
     dx[n] = o.direction.x();
@@ -40,6 +50,8 @@ struct FinishedPhotons {
     PhotonOutcome o;
     o.fate = exited[i] ? PhotonFate::Exited : lost[i] ? PhotonFate::Lost : PhotonFate::Truncated;
     o.weight = weight[i];
+    for (const Loss& l : losses)
+      if (l.slot == i) o.losses.push_back(l.loss);
     o.direction = Vec3(dx[i], dy[i], dz[i]);
     o.segments = segments[i];
     o.path_length = path[i];

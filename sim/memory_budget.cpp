@@ -56,14 +56,14 @@ MemoryFootprint run_footprint(const Settings& s, int threads) {
       mul(mul(L, static_cast<std::uint64_t>(s.tally.n_theta)), static_cast<std::uint64_t>(s.tally.n_phi));
   const std::uint64_t K = s.incidences().size();
   MemoryFootprint f{};
-  // sim/tally.h: bins x (count, S1[C], S2[C]), exited L x C, absorbed and truncated C.
-  f.per_tally = mul(kFixed, add(mul(bins, 2 * C + 1), add(mul(L, C), 2 * C)));
+  // sim/tally.h: bins x (count, S1[C], S2[C]), exited L x C, absorbed, truncated and lost C.
+  f.per_tally = mul(kFixed, add(mul(bins, 2 * C + 1), add(mul(L, C), 3 * C)));
   f.thread_tallies = mul(f.per_tally, static_cast<std::uint64_t>(std::max(threads, 1)));
   f.result_tallies = mul(f.per_tally, K);
   // sim/result_file.h: weight_sum and weight_sq_sum (C doubles per bin each),
   // count (one uint64 per bin), per incident configuration; plus one
   // configuration's column copied out of a Tally while the result is assembled.
-  const std::uint64_t per_k = mul(8, add(mul(bins, 2 * C + 1), add(mul(L, C), 2 * C)));
+  const std::uint64_t per_k = mul(8, add(mul(bins, 2 * C + 1), add(mul(L, C), 3 * C)));
   f.float_copies = add(mul(per_k, K), mul(8, mul(bins, C)));
   f.total = add(add(f.thread_tallies, f.result_tallies), f.float_copies);
   return f;

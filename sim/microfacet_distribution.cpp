@@ -7,6 +7,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/ggx.h"
 #include "common/units.h"
 
 namespace fiberlab::sim {
@@ -39,22 +40,19 @@ MicrofacetDistribution::MicrofacetDistribution(MicrofacetModel model, double alp
 
 double MicrofacetDistribution::D(const Vec3& m) const {
   const double z = m.z();
+  if (model_ == MicrofacetModel::GGX) return ggx::D(m, ax_, ay_);
   if (z <= 0.0) return 0.0;
   const double r2 = m.x() * m.x() / (ax_ * ax_) + m.y() * m.y() / (ay_ * ay_);
-  if (model_ == MicrofacetModel::GGX) {
-    const double q = r2 + z * z;
-    return 1.0 / (kPi * ax_ * ay_ * q * q);
-  }
   const double z2 = z * z;
   return std::exp(-r2 / z2) / (kPi * ax_ * ay_ * z2 * z2);
 }
 
 double MicrofacetDistribution::Lambda(const Vec3& w) const {
+  if (model_ == MicrofacetModel::GGX) return ggx::Lambda(w, ax_, ay_);
   const double z = w.z();
   const double s = std::sqrt(ax_ * ax_ * w.x() * w.x() + ay_ * ay_ * w.y() * w.y());
   if (s == 0.0) return 0.0;  // w along the normal: nothing masks it
   const double a = z / s;    // 1 / (alpha tan theta) in the stretched configuration
-  if (model_ == MicrofacetModel::GGX) return 0.5 * (-1.0 + std::sqrt(1.0 + 1.0 / (a * a)));
   return 0.5 * (std::erf(a) - 1.0) + std::exp(-a * a) / (2.0 * a * kSqrtPi);
 }
 
@@ -69,21 +67,7 @@ double MicrofacetDistribution::visible_density(const Vec3& w, const Vec3& m) con
 }
 
 Vec3 MicrofacetDistribution::sample_ggx_stretched(const Vec3& w, double u1, double u2) const {
-  // Heitz 2018, section 4 (listing 1): w stretched to the alpha = 1 hemisphere.
-  const Vec3 vh = Vec3(ax_ * w.x(), ay_ * w.y(), w.z()).normalized();
-  const double len2 = vh.x() * vh.x() + vh.y() * vh.y();
-  const Vec3 t1 = len2 > 0.0 ? Vec3(-vh.y(), vh.x(), 0.0) / std::sqrt(len2) : Vec3(1.0, 0.0, 0.0);
-  const Vec3 t2 = vh.cross(t1);
-  // A uniform point of the unit disk, its second coordinate squeezed onto
-  // the part of the projected hemisphere visible from vh.
-  const double r = std::sqrt(u1), phi = kTwoPi * u2;
-  const double p1 = r * std::cos(phi);
-  double p2 = r * std::sin(phi);
-  const double s = 0.5 * (1.0 + vh.z());
-  p2 = (1.0 - s) * std::sqrt(std::max(0.0, 1.0 - p1 * p1)) + s * p2;
-  const Vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0, 1.0 - p1 * p1 - p2 * p2)) * vh;
-  // Unstretch (normals transform with the inverse transpose).
-  return Vec3(ax_ * nh.x(), ay_ * nh.y(), std::max(0.0, nh.z())).normalized();
+  return ggx::sample_visible(w, ax_, ay_, u1, u2);  // Heitz 2018 (common/ggx.h)
 }
 
 void MicrofacetDistribution::sample_beckmann_slopes(double cos_theta, double u1, double u2,

@@ -54,6 +54,7 @@ struct PhotonState {
   T code;          // LaneCode
   LaneRandom<T> rng;
   Light light;
+  LossRecord<T> losses;  // weight removed by the model's event weights
 };
 
 // A photon arriving along d at the entry point p, with its stream.
@@ -61,7 +62,7 @@ template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
                                         const LaneRandom<double>& rng) {
   const Vec3Of<double> dir(d);
-  return {p.x(), p.y(), dir, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, double(kAtBoundary), rng, Light(dir)};
+  return {p.x(), p.y(), dir, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, double(kAtBoundary), rng, Light(dir), {}};
 }
 
 template <class Model, class T>
@@ -96,8 +97,9 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   if constexpr (HasEventWeight<Model, T>) {
     const EventWeight<T> w =
         model.event_weight(EventGeometry<T>{s.d, d, f.m, frame, r.refracted}, act, s.rng);
-    s.weight = select(act, s.weight * w.factor, s.weight);
+    s.losses.add(act & (w.factor < T(1.0)), s.weight * (T(1.0) - w.factor), s.path);
     lost = act & w.lost;
+    s.weight = select(act, select(lost, T(0.0), s.weight * w.factor), s.weight);
   }
   const MaskOf<T> flip = act & r.refracted;
   const MaskOf<T> now_inside = (flip & !inside) | (!flip & inside);

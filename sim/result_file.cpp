@@ -32,6 +32,10 @@ void write_parameters(h5::File& f, const Settings& s) {
   f.set_attr("/roughness", "model", to_string(s.roughness.model));
   f.set_attr("/roughness", "beta_long", s.roughness.beta_long);
   f.set_attr("/roughness", "beta_azim", s.roughness.beta_azim);
+  if (s.roughness.microfacet()) {  // beckmann / ggx (issue 12)
+    f.set_attr("/roughness", "alpha", std::vector<double>{s.roughness.alpha_long, s.roughness.alpha_azim});
+    f.set_attr("/roughness", "masking", to_string(s.roughness.masking));
+  }
   f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
   f.set_attr("/source", "polarization", to_string(s.polarization));
   f.set_attr("/source", "phi_i_uniform", static_cast<std::int64_t>(s.source.phi_i_uniform));
@@ -62,6 +66,7 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
     append(r.exited, t.exited());
     append(r.absorbed, t.absorbed());
     append(r.truncated, t.truncated());
+    append(r.lost, t.lost());
   }
   return r;
 }
@@ -82,7 +87,7 @@ void write_result(const ResultFile& r, const std::string& path,
                   const std::vector<std::string>& inputs) {
   AtomicOutput out(path, inputs);
   {
-    h5::File f = h5::File::create(out.temp_path());
+    h5::File f = h5::File::create(out.temp_path(), out.target());
     write_result_header(f, r);
 
     const hsize_t K = r.configs(), L = r.lobes, C = r.channels;
@@ -96,6 +101,7 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/exited", {K, L, C}, r.exited);
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
+    f.write("/ledger/lost", {K, C}, r.lost);
     // Descriptive attributes (docs/FILE_FORMAT.md): axis names, units, lobe and channel names.
     write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
     describe_bins_and_source(f);

@@ -26,6 +26,7 @@ struct ResultFile {
   std::vector<std::uint64_t> count;     // K x L x n_theta x n_phi
   std::vector<double> exited;           // K x L x C
   std::vector<double> absorbed, truncated;  // K x C
+  std::vector<double> lost;  // K x C: removed by masking (0 unless roughness.masking)
 
   std::size_t configs() const { return photons.size(); }
   std::size_t bin_cells() const {

@@ -88,7 +88,7 @@ class Reader {
   }
 
   // Per incident direction: counts in bins <= photons, and the ledger
-  // exited + absorbed + truncated = photons for every channel.
+  // exited + absorbed + truncated + lost = photons for every channel.
   void check_balance(const ResultFile& r, const Shape& d) const {
     const std::size_t bins_per_k = d.L * d.T * d.P;
     for (std::size_t k = 0; k < d.K; ++k) {
@@ -100,12 +100,12 @@ class Reader {
         fail(fmt::format("/tally/count sums to {} for incident direction {} (must be at most "
                          "/tally/photons[{}] = {})", static_cast<double>(counted), k, k, n));
       for (std::size_t c = 0; c < d.C; ++c) {
-        double total = r.absorbed[k * d.C + c] + r.truncated[k * d.C + c];
+        double total = r.absorbed[k * d.C + c] + r.truncated[k * d.C + c] + r.lost[k * d.C + c];
         for (std::size_t l = 0; l < d.L; ++l) total += r.exited[(k * d.L + l) * d.C + c];
         const double N = static_cast<double>(n);
         if (!(std::fabs(total - N) <= kLedgerTolerance * N))
           fail(fmt::format("/ledger does not balance for incident direction {}, channel {}: "
-                           "exited + absorbed + truncated = {} (must equal /tally/photons[{}] = {})",
+                           "exited + absorbed + truncated + lost = {} (must equal /tally/photons[{}] = {})",
                            k, c, total, k, n));
       }
     }
@@ -169,6 +169,13 @@ ResultFile read_result(const std::string& path) {
   rd.check_sums("/ledger/absorbed", r.absorbed);
   r.truncated = f.read_doubles("/ledger/truncated", {d.K, d.C}, "K x C, " + sizes);
   rd.check_sums("/ledger/truncated", r.truncated);
+  // /ledger/lost (masking, issue 12): files written before it have none, and lost nothing.
+  if (f.exists("/ledger/lost")) {
+    r.lost = f.read_doubles("/ledger/lost", {d.K, d.C}, "K x C, " + sizes);
+    rd.check_sums("/ledger/lost", r.lost);
+  } else {
+    r.lost.assign(d.K * d.C, 0.0);
+  }
   rd.check_balance(r, d);
   return r;
 }

@@ -24,6 +24,10 @@ constexpr DatasetShape kTallyDatasets[] = {
     {"/exact/truncated", true, 2},
 };
 
+// The ledger's `lost` (issue 12: weight removed by masking). Files written
+// before it existed have neither dataset: their lost is 0.
+constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", false, 2}, {"/exact/lost", true, 2}};
+
 h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
   const hsize_t L = s.lobes, T = s.n_theta, P = s.n_phi, C = s.channels;
   h5::Dims dims;
@@ -46,18 +50,20 @@ TallyShape shape_of(const ResultFile& r) {
 ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
                            const DirectionSeeds& direction_seeds)
     : out_(path), photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
-  file_.emplace(h5::File::create(out_.temp_path()));
+  file_.emplace(h5::File::create(out_.temp_path(), out_.target()));
   h5::File& f = *file_;
   write_result_header(f, header);
   f.create_group("/tally");
   f.create_group("/ledger");
   f.create_group("/exact");
   const hsize_t K = photons_.size();
-  for (const DatasetShape& d : kTallyDatasets) {
+  auto create = [&](const DatasetShape& d) {
     const bool integer = d.exact || d.rank == 4;
     f.create_dataset(d.name, dims_of(d, K, shape_),
                      integer ? h5::File::Type::UInt64 : h5::File::Type::Float64);
-  }
+  };
+  for (const DatasetShape& d : kTallyDatasets) create(d);
+  for (const DatasetShape& d : kLostDatasets) create(d);
   if (!direction_seeds.empty()) {
     std::vector<std::uint64_t> rows;
     for (std::size_t k = 0; k < direction_seeds.size(); ++k)
@@ -81,11 +87,13 @@ void ResultWriter::write(std::size_t k, const ExactTally& t) {
   f.write_slab("/ledger/exited", k, ExactTally::to_double(t.exited));
   f.write_slab("/ledger/absorbed", k, ExactTally::to_double(t.absorbed));
   f.write_slab("/ledger/truncated", k, ExactTally::to_double(t.truncated));
+  f.write_slab("/ledger/lost", k, ExactTally::to_double(t.lost));
   f.write_slab("/exact/weight_sum", k, ExactTally::to_pairs(t.weight_sum));
   f.write_slab("/exact/weight_sq_sum", k, ExactTally::to_pairs(t.weight_sq_sum));
   f.write_slab("/exact/exited", k, ExactTally::to_pairs(t.exited));
   f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(t.absorbed));
   f.write_slab("/exact/truncated", k, ExactTally::to_pairs(t.truncated));
+  f.write_slab("/exact/lost", k, ExactTally::to_pairs(t.lost));
 }
 
 void ResultWriter::commit() {
@@ -144,6 +152,11 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
     if (f.dims(d.name) != dims_of(d, K, shape_))
       throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
                               d.name));
+  has_lost_ = f.exists(kLostDatasets[1].name);
+  for (const DatasetShape& d : kLostDatasets)
+    if (has_lost_ && f.dims(d.name) != dims_of(d, K, shape_))
+      throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
+                              d.name));
   direction_seeds_.assign(K, h.seeds);
   if (f.exists("/merge/direction_seeds")) {
     h5::Dims dims;
@@ -167,6 +180,7 @@ ExactTally ResultReader::read(std::size_t k) const {
   t.exited = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/exited", k));
   t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
+  if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
   return t;
 }
 

@@ -6,7 +6,7 @@
 // Besides the float64 datasets of SPEC section 9, files carry the exact sums
 // (fiberlab's own addition; docs in README "The result file"):
 //   /exact/weight_sum, /exact/weight_sq_sum  K x L x n_theta x n_phi x C x 2
-//   /exact/exited  K x L x C x 2,  /exact/absorbed, /exact/truncated  K x C x 2
+//   /exact/exited  K x L x C x 2,  /exact/absorbed, /exact/truncated, /exact/lost  K x C x 2
 // uint64 pairs (high, low) of an unsigned 128-bit integer; the value is
 // integer / 2^60. The float64 datasets are these integers / 2^60 rounded once.
 #include <cstdint>
@@ -66,6 +66,7 @@ class ResultReader {
   ResultFile header_;
   DirectionSeeds direction_seeds_;
   TallyShape shape_;
+  bool has_lost_ = false;  // /exact/lost (absent in files written before it: lost 0)
 };
 
 }  // namespace fiberlab::sim

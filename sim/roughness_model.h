@@ -42,8 +42,19 @@
 // sim/roughness_models.h (the variant and make_roughness). Both tracers, the
 // batched one's lane management, Fresnel, Stokes light, tilt, the
 // consistency rule and truncation then apply to it unchanged.
+#include <vector>
+
 #include "sim/lanes.h"
 #include "sim/random.h"
+
+namespace fiberlab::sim {
+// Weight removed from a photon by a roughness model's event weight (masking),
+// and the internal path length it had travelled then: channel c lost weight *
+// exp(-sigma_a[c] * path_length).
+struct WeightLoss {
+  double weight, path_length;
+};
+}  // namespace fiberlab::sim
 
 namespace fiberlab::sim::life {
 
@@ -85,6 +96,20 @@ template <class T>
 struct EventWeight {
   T factor;        // multiplies the photon's throughput weight
   MaskOf<T> lost;  // the path ends here (fate Lost, its weight booked as lost)
+};
+
+// The losses a photon records (one photon: a list; a vector of lanes: none,
+// the batched life runs no model with event weights yet).
+template <class T>
+struct LossRecord {
+  void add(const MaskOf<T>&, const T&, const T&) {}
+};
+template <>
+struct LossRecord<double> {
+  std::vector<WeightLoss> list;
+  void add(bool m, double weight, double path) {
+    if (m) list.push_back({weight, path});
+  }
 };
 
 // Work counters of the life, per lane (summed at the end).

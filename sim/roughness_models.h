@@ -7,17 +7,20 @@
 
 #include "sim/exit_blur.h"
 #include "sim/roughness_gaussian.h"
+#include "sim/roughness_microfacet.h"
 #include "sim/roughness_smooth.h"
 #include "sim/settings.h"
 
 namespace fiberlab::sim {
 
-using AnyRoughness = std::variant<life::SmoothRoughness, life::GaussianRoughness, ExitBlurRoughness>;
+using AnyRoughness = std::variant<life::SmoothRoughness, life::GaussianRoughness, ExitBlurRoughness,
+                                  MicrofacetLifeModel>;
 
 // The roughness model the tracers apply: gaussian with beta_long = beta_azim
 // = 0 is the smooth model, fallback included (SPEC section 3).
 inline AnyRoughness make_roughness(const Settings& s) {
   const RoughnessSettings& r = s.roughness;
+  if (r.microfacet()) return MicrofacetLifeModel(s);
   switch (r.model) {
     case RoughnessModel::Smooth:
       return life::SmoothRoughness(s);

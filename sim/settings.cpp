@@ -37,7 +37,9 @@ constexpr std::uint64_t kIntMax = std::numeric_limits<int>::max();
 constexpr std::uint64_t kU64Max = std::numeric_limits<std::uint64_t>::max();
 constexpr std::size_t kMaxConfigBytes = std::size_t{16} << 20;  // 16 MiB
 
-const char* const kModels[] = {"smooth", "gaussian", "exit_blur"};
+const char* const kModels[] = {"smooth", "gaussian", "exit_blur", "beckmann", "ggx"};
+const char* const kMaskings[] = {"none", "smith_g1"};
+const char* const kHSampling[] = {"stratified", "independent"};
 const char* const kPolarizations[] = {"scalar", "stokes"};
 const char* const kThetaBins[] = {"uniform", "equal_area"};
 
@@ -318,6 +320,7 @@ const Rule kNonNegative{"must be a finite number >= 0", [](double x) { return x 
 const Rule kSigmaA{"must be a finite number >= 0, or a list of 1 to 64 such numbers",
                    [](double x) { return x >= 0.0; }};
 const Rule kBeta{"must be in [0, 90] degrees", [](double x) { return x >= 0.0 && x <= 90.0; }};
+const Rule kAlpha{"must be in (0, 10]", [](double x) { return x > 0.0 && x <= 10.0; }};
 const Rule kThetaI{"must be in (-90, 90) degrees", [](double x) { return std::fabs(x) < 90.0; }};
 const Rule kPositive{"must be > 0", [](double x) { return x > 0.0; }};
 const Rule kAnyAngle{"must be a finite angle in degrees, a list, or uniform",
@@ -363,10 +366,45 @@ void read_fiber(const Reader& r, const YAML::Node& parent, FiberSettings& f) {
   }
 }
 
+// alpha of a microfacet model: a number (isotropic) or [longitudinal, azimuthal].
+void read_alpha(const Reader& r, const YAML::Node& n, RoughnessSettings& g) {
+  const std::string path = "roughness.alpha";
+  const Rule rule{kAlpha.text + "; a number, or a list [longitudinal, azimuthal]", kAlpha.ok};
+  const std::vector<double> alpha = r.numbers(n, path, rule, true);
+  if (alpha.size() > 2)
+    r.bad(path, n, fmt::format("has {} entries", alpha.size()),
+          "must be a number or a list of two: [longitudinal, azimuthal], each in (0, 10]");
+  g.alpha_long = alpha.front();
+  g.alpha_azim = alpha.back();
+}
+
 void read_roughness(const Reader& r, const YAML::Node& parent, RoughnessSettings& g) {
-  const YAML::Node n =
-      r.section(parent["roughness"], "roughness", {"model", "beta_long", "beta_azim"});
+  const YAML::Node n = r.section(parent["roughness"], "roughness",
+                                 {"model", "beta_long", "beta_azim", "alpha", "masking"});
   if (n["model"]) g.model = static_cast<RoughnessModel>(r.word(n["model"], "roughness.model", kModels));
+  const std::string model = to_string(g.model);
+  if (g.microfacet()) {
+    // Microfacet models take alpha (and masking); the beta keys belong to the others.
+    for (const char* key : {"beta_long", "beta_azim"})
+      if (n[key])
+        r.bad(std::string("roughness.") + key, n[key], "is not allowed for model " + model,
+              "models beckmann and ggx take alpha; beta_long and beta_azim belong to smooth, "
+              "gaussian and exit_blur");
+    if (!n["alpha"])
+      r.fail(fmt::format("roughness.alpha is missing (model {} needs alpha in (0, 10]: a number, "
+                         "or a list [longitudinal, azimuthal])", model));
+    read_alpha(r, n["alpha"], g);
+    if (n["masking"])
+      g.masking = static_cast<Masking>(r.word(n["masking"], "roughness.masking", kMaskings));
+    return;
+  }
+  if (n["alpha"])
+    r.bad("roughness.alpha", n["alpha"], "is not allowed for model " + model,
+          "alpha is the roughness of models beckmann and ggx");
+  if (n["masking"] &&
+      r.word(n["masking"], "roughness.masking", kMaskings) != static_cast<int>(Masking::None))
+    r.bad("roughness.masking", n["masking"], "is not allowed for model " + model,
+          "masking applies to models beckmann and ggx; the other models lose nothing");
   // One beta for gaussian; a list indexed by p is meaningful only for
   // exit_blur (and accepted, unused, for smooth).
   const bool lists = g.model != RoughnessModel::Gaussian;
@@ -406,7 +444,7 @@ std::vector<double> read_theta_range(const Reader& r, const YAML::Node& n) {
 }
 
 void read_source(const Reader& r, const YAML::Node& parent, SourceSettings& s) {
-  const YAML::Node n = r.section(parent["source"], "source", {"theta_i", "phi_i"});
+  const YAML::Node n = r.section(parent["source"], "source", {"theta_i", "phi_i", "h_sampling"});
   if (const YAML::Node t = n["theta_i"]) {
     const Rule rule{kThetaI.text + "; a number, a list, or {from, to, step}", kThetaI.ok};
     s.theta_i = to_radians(t.IsMap() ? read_theta_range(r, t)
@@ -416,6 +454,7 @@ void read_source(const Reader& r, const YAML::Node& parent, SourceSettings& s) {
     s.phi_i_uniform = p.IsScalar() && p.Scalar() == "uniform";
     if (!s.phi_i_uniform) s.phi_i = to_radians(r.numbers(p, "source.phi_i", kAnyAngle, true));
   }
+  if (n["h_sampling"]) s.h_stratified = r.word(n["h_sampling"], "source.h_sampling", kHSampling) == 0;
 }
 
 void read_tally(const Reader& r, const YAML::Node& parent, TallySettings& t) {
@@ -475,6 +514,19 @@ std::string betas_text(const std::vector<double>& betas) {
   return betas.size() == 1 ? degrees_text(betas.front()) : list_text(betas, degrees_text);
 }
 
+// The roughness block's lines after `model:`: alpha and masking for the
+// microfacet models, beta_long and beta_azim for the others.
+std::string roughness_parameters_text(const RoughnessSettings& g) {
+  if (g.microfacet()) {
+    const std::string alpha =
+        g.alpha_long == g.alpha_azim ? number_text(g.alpha_long)
+                                     : list_text({g.alpha_long, g.alpha_azim}, number_text);
+    return fmt::format("  alpha: {}\n  masking: {}\n", alpha, to_string(g.masking));
+  }
+  return fmt::format("  beta_long: {}\n  beta_azim: {}\n", betas_text(g.beta_long),
+                     betas_text(g.beta_azim));
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- public API
@@ -511,10 +563,15 @@ Settings load_settings(const std::string& path) {
   if (!in) throw Error(path + ": cannot read config file: " + std::strerror(errno));
   // Read at most kMaxConfigBytes + 1: a stream that never ends (/dev/zero, a
   // FIFO) is refused instead of filling memory.
-  std::string text(kMaxConfigBytes + 1, '\0');
-  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  // (Read in pieces: a buffer of the whole bound, zeroed, cost 16 MiB of page
+  // faults per run.)
+  std::string text;
+  char piece[65536];
+  while (text.size() <= kMaxConfigBytes && in) {
+    in.read(piece, sizeof piece);
+    text.append(piece, static_cast<std::size_t>(in.gcount()));
+  }
   if (in.bad()) throw Error(path + ": cannot read config file: read error");
-  text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxConfigBytes)
     throw Error(fmt::format("{}: config file is larger than {} MiB (a config is a few hundred "
                             "bytes; is this the right file?)", path, kMaxConfigBytes >> 20));
@@ -550,11 +607,11 @@ std::string to_yaml(const Settings& s) {
       "  {}\n"
       "roughness:\n"
       "  model: {}\n"
-      "  beta_long: {}\n"
-      "  beta_azim: {}\n"
+      "{}"
       "source:\n"
       "  theta_i: {}\n"
       "  phi_i: {}\n"
+      "  h_sampling: {}\n"
       "tally:\n"
       "  n_theta: {}\n"
       "  n_phi: {}\n"
@@ -565,8 +622,9 @@ std::string to_yaml(const Settings& s) {
       "polarization: {}\n",
       s.photons, s.seed, quoted(s.output), number_text(f.eta), number_text(f.eccentricity),
       degrees_text(f.scale_tilt), absorption, to_string(s.roughness.model),
-      betas_text(s.roughness.beta_long), betas_text(s.roughness.beta_azim),
-      list_text(s.source.theta_i, degrees_text), phi_i, s.tally.n_theta, s.tally.n_phi,
+      roughness_parameters_text(s.roughness),
+      list_text(s.source.theta_i, degrees_text), phi_i, kHSampling[s.source.h_stratified ? 0 : 1],
+      s.tally.n_theta, s.tally.n_phi,
       kThetaBins[s.tally.theta_bins == ThetaBinning::Uniform ? 0 : 1], s.tally.lobes,
       s.max_segments, s.max_events_per_point, to_string(s.polarization));
 }
@@ -581,6 +639,8 @@ std::vector<double> sigma_a_from_melanin(double eumelanin, double pheomelanin) {
 }
 
 std::string to_string(RoughnessModel m) { return kModels[static_cast<int>(m)]; }
+
+std::string to_string(Masking m) { return kMaskings[static_cast<int>(m)]; }
 
 std::string to_string(Polarization p) { return kPolarizations[static_cast<int>(p)]; }
 

@@ -11,7 +11,14 @@
 
 namespace fiberlab::sim {
 
-enum class RoughnessModel { Smooth, Gaussian, ExitBlur };
+// Beckmann and GGX: microfacet distributions of normals about the tilted
+// normal, sampled as visible normals (sim/microfacet_roughness.h; issue 12).
+enum class RoughnessModel { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
+// `roughness.masking` of the microfacet models: `smith_g1` multiplies the
+// photon's weight by Smith's G1 of each scattered direction and kills paths
+// that leave on the wrong side of the mean surface (Huang et al. 2022's
+// ground truth); the removed weight is the ledger's `lost`.
+enum class Masking { None, SmithG1 };
 enum class Polarization { Scalar, Stokes };
 
 struct FiberSettings {
@@ -31,6 +38,12 @@ struct RoughnessSettings {
   // applying to every larger p. smooth: ignored (kept as given).
   std::vector<double> beta_long{0.0};
   std::vector<double> beta_azim{0.0};
+  // beckmann / ggx (0 for the other models): the microfacet roughness alpha
+  // along the fiber axis (longitudinal) and about it (azimuthal), each > 0.
+  double alpha_long = 0.0, alpha_azim = 0.0;
+  Masking masking = Masking::None;  // beckmann / ggx only
+
+  bool microfacet() const { return model == RoughnessModel::Beckmann || model == RoughnessModel::GGX; }
 
   // beta for lobe p of a list indexed by p (last entry for larger p).
   static double for_lobe(const std::vector<double>& betas, int p) {
@@ -44,6 +57,9 @@ struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
   bool phi_i_uniform = false;        // a randomly rotated fiber
   std::vector<double> phi_i{0.0};    // radians (unused when uniform)
+  // Impact parameters h stratified by photon index (sim/source.h), or each
+  // photon's h independent. Either way every h is uniform in [-1, 1).
+  bool h_stratified = true;
 
   friend bool operator==(const SourceSettings&, const SourceSettings&) = default;
 };
@@ -102,6 +118,7 @@ std::string to_yaml(const Settings& s);
 std::vector<double> sigma_a_from_melanin(double eumelanin, double pheomelanin);
 
 std::string to_string(RoughnessModel m);
+std::string to_string(Masking m);
 std::string to_string(Polarization p);
 
 }  // namespace fiberlab::sim

@@ -103,17 +103,36 @@ std::uint64_t Simulation::Runner::photons_done() const {
   return n;
 }
 
-// Traces this rank's chunks of photons [first, end) of direction k: chunk j
-// of the round goes to rank j mod size, threads take a rank's chunks in
-// order. A lone process stops early on a signal, after a prefix of the
-// round's chunks; returns the end of what was traced.
+// Traces this rank's chunks of photons [first, end) of direction k: rank r
+// takes a contiguous share of the round's chunks, and its threads take runs
+// of consecutive chunks from it in order (guided: long runs first, single
+// chunks at the end, so threads finish together). A run is one call of the
+// tracer, whose pool of lanes then drains once per run rather than once per
+// chunk (the drain, where a few light-guided photons hold a vector for up to
+// max_segments steps, was most of a chunk's vector iterations). Which thread
+// or rank traces a photon changes no bit of the sums. A lone process stops
+// early on a signal, after a prefix of the round's chunks; returns the end of
+// what was traced.
 std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first, std::uint64_t end) {
   const std::uint64_t chunks = (end - first) / kChunk + ((end - first) % kChunk != 0);
   const std::uint64_t rank = group_.rank(), size = group_.size();
-  const std::uint64_t mine = rank < chunks ? (chunks - rank + size - 1) / size : 0;
+  const std::uint64_t c0 = chunks * rank / size, mine = chunks * (rank + 1) / size - c0;
   const bool may_stop_early = size == 1;
+  const std::uint64_t threads = static_cast<std::uint64_t>(threads_);
   std::atomic<std::uint64_t> next{0};
   std::atomic<bool> failed{false};
+  // The next run of chunks [i, i + n) of this rank's share (n = 0: none left).
+  auto take_run = [&](std::uint64_t& n) {
+    std::uint64_t i = next.load();
+    do {
+      if (i >= mine) {
+        n = 0;
+        return i;
+      }
+      n = std::clamp<std::uint64_t>((mine - i) / (2 * threads), 1, kMaxRunChunks);
+    } while (!next.compare_exchange_weak(i, i + n));
+    return i;
+  };
 #pragma omp parallel num_threads(threads_)
   {
     TracerCounters counters;
@@ -124,10 +143,11 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
       Tally& tally = *mine_tally;
       while (!failed.load(std::memory_order_relaxed)) {
         if (may_stop_early && interrupt_requested()) break;
-        const std::uint64_t i = next.fetch_add(1);
-        if (i >= mine) break;
-        const std::uint64_t a = first + (rank + i * size) * kChunk;
-        const std::uint64_t n = std::min(kChunk, end - a);
+        std::uint64_t n_chunks = 0;
+        const std::uint64_t i = take_run(n_chunks);
+        if (n_chunks == 0) break;
+        const std::uint64_t a = first + (c0 + i) * kChunk;
+        const std::uint64_t n = std::min(n_chunks * kChunk, end - a);
         sim_.trace_photons(k, a, n, tally, counters, &progress_done_, size);
       }
     } catch (...) {
@@ -144,18 +164,25 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
   return std::min(end, first + std::min(next.load(), mine) * kChunk);
 }
 
-// Adds every rank's unflushed sums of direction k into rank 0's state.
+// Adds every rank's unflushed sums of direction k into rank 0's state. The
+// threads' tallies are cleared, not freed: they serve the next round and
+// direction without being allocated and faulted in again.
 void Simulation::Runner::flush(std::size_t k) {
-  const TallyShape shape = sim_.tally_shape();
-  Tally sum(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
-  for (std::unique_ptr<Tally>& t : thread_tallies_) {
-    if (t) sum.add(*t);
-    t.reset();
-  }
   if (group_.size() == 1) {
-    state_.tallies[k].add(sum);
+    for (std::unique_ptr<Tally>& t : thread_tallies_)
+      if (t) {
+        state_.tallies[k].add(*t);
+        t->clear();
+      }
     return;
   }
+  const TallyShape shape = sim_.tally_shape();
+  Tally sum(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
+  for (std::unique_ptr<Tally>& t : thread_tallies_)
+    if (t) {
+      sum.add(*t);
+      t->clear();
+    }
   std::vector<ExactTally::Word> words = sum.exact().words();
   group_.sum_to_root(words);
   if (group_.is_root()) {
@@ -274,7 +301,8 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      use_batch_tracer_(true),  // the batched life serves scalar and Stokes light
+      // The microfacet models (issue 12) run on the reference tracer for now.
+      use_batch_tracer_(!settings_.roughness.microfacet()),  // scalar and Stokes light
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {
@@ -297,7 +325,7 @@ void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t
   if (use_batch_tracer_) {
     batch_tracer_.trace(inc.theta_i, inc.phi_i, first, n, score, counters);
   } else {
-    const Source source(settings_.seed, inc.theta_i, inc.phi_i, settings_.source.phi_i_uniform);
+    const Source source(settings_, inc.theta_i, inc.phi_i);
     auto done = std::make_unique<FinishedPhotons>();
     for (std::uint64_t i = first; i < first + n; ++i) {
       LaunchedPhoton p = source.launch(i);

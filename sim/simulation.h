@@ -60,6 +60,9 @@ class Simulation {
   // waits for the slowest (light-guided) photon of each call, and 256-photon
   // chunks ran at half the speed. Progress is counted per photon instead.
   static constexpr std::uint64_t kChunk = 4096;
+  // A thread traces up to kMaxRunChunks consecutive chunks in one call (a
+  // signal waits for the run: 64 Ki photons, a few hundredths of a second).
+  static constexpr std::uint64_t kMaxRunChunks = 16;
   // --target-error is judged after every kTargetBatch photons of a direction
   // (and at its last photon): a fixed schedule, so the stopping point depends
   // only on the seed and config, never on timing, threads or ranks.
@@ -83,7 +86,8 @@ class Simulation {
   RunOutcome run(RunProgress& state, const RunControl& control, RunStatistics* stats = nullptr) const;
 
   // Traces photons [first, first + n) of incident configuration k into `tally`
-  // (with the batched tracer for scalar light, the reference tracer otherwise).
+  // (with the batched tracer for scalar light, the reference tracer for Stokes
+  // light and the microfacet roughness models).
   // `traced`, when given, grows by `per_photon` as each photon is scored (progress).
   void trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n, Tally& tally,
                      TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,

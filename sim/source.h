@@ -2,11 +2,29 @@
 // The source (SPEC section 5): a collimated beam along -wi. Each photon gets
 // its own random stream, its incident azimuth (drawn when the fiber is
 // randomly rotated) and its impact parameter h uniform in [-1, 1).
+//
+// Stratified h (the default; SPEC section 5 allows it: it changes the
+// variance, never the expectation). Photons are taken in blocks of kStrata
+// consecutive indices from photon 0; in a block that lies wholly within the
+// run's photons, photon i draws its h in the i mod kStrata-th of kStrata
+// equal strata of [-1, 1). Every h is still uniform in [-1, 1) in law, each
+// full block samples h once per stratum, and the photons of a last partial
+// block (photons not a multiple of kStrata) draw h independently, as without
+// stratification. The stratum depends only on the photon index, so threads,
+// ranks, chunks and checkpoints change nothing.
+//
+// Standard errors stay honest: the tally's estimator sqrt((S2/N - P^2)/(N-1))
+// assumes independent photons. With one photon per stratum its expectation
+// is (sigma^2 - V)/(N - 1) where sigma^2 is a photon's variance without
+// strata and V the stratified estimator's variance; since V <= sigma^2/N
+// (proportional allocation removes the between-strata part), the reported
+// error is at least the true one: conservative, never optimistic.
 #include <cstdint>
 
 #include "common/fiber_frame.h"
 #include "common/units.h"
 #include "sim/random.h"
+#include "sim/settings.h"
 
 namespace fiberlab::sim {
 
@@ -22,11 +40,20 @@ struct LaunchedPhoton {
 // each photon draws its own azimuth first.
 class Source {
  public:
-  // phi_i is ignored (and may be NaN) when phi_i_uniform.
-  Source(std::uint64_t seed, double theta_i, double phi_i, bool phi_i_uniform)
+  static constexpr std::uint64_t kStrata = 4096;  // 2^12
+
+  // phi_i is ignored (and may be NaN) when phi_i_uniform. `photons`: the
+  // run's photons of this direction, for stratified h (0: h independent).
+  Source(std::uint64_t seed, double theta_i, double phi_i, bool phi_i_uniform,
+         std::uint64_t stratified_photons = 0)
       : key_(PhotonRandom::stream_key(seed, theta_i, phi_i_uniform ? NAN : phi_i)),
         theta_i_(theta_i), phi_i_(phi_i_uniform ? 0.0 : phi_i), uniform_(phi_i_uniform),
-        wi_(direction_from_angles(theta_i_, phi_i_)) {}
+        wi_(direction_from_angles(theta_i_, phi_i_)),
+        stratified_end_(stratified_photons / kStrata * kStrata) {}
+  // The run's source for one incident direction, as its settings say.
+  Source(const Settings& s, double theta_i, double phi_i)
+      : Source(s.seed, theta_i, phi_i, s.source.phi_i_uniform,
+               s.source.h_stratified ? s.photons : 0) {}
 
   bool fixed_direction() const { return !uniform_; }
   std::uint64_t stream_key() const { return key_; }
@@ -39,8 +66,18 @@ class Source {
       phi_i = kTwoPi * rng.uniform() - kPi;
       wi = direction_from_angles(theta_i_, phi_i);
     }
-    const double h = 2.0 * rng.uniform() - 1.0;
+    const double h = impact_parameter(photon, rng.uniform());
     return {rng, phi_i, wi, h};
+  }
+
+  // h of `photon` from its uniform draw u (a multiple of 2^-53 in [0, 1), as
+  // PhotonRandom::uniform gives): 2u - 1 exactly when independent; when
+  // stratified, the stratum's 12 bits followed by u's first 41 bits, so h is
+  // exact, uniform in its stratum and never 1.
+  double impact_parameter(std::uint64_t photon, double u) const {
+    std::uint64_t x = static_cast<std::uint64_t>(u * 0x1.0p53);  // 53 random bits
+    if (photon < stratified_end_) x = ((photon % kStrata) << 41) | (x >> 12);
+    return static_cast<double>(x) * 0x1.0p-52 - 1.0;
   }
 
  private:
@@ -48,6 +85,7 @@ class Source {
   double theta_i_, phi_i_;
   bool uniform_;
   Vec3 wi_;
+  std::uint64_t stratified_end_;  // photons [0, stratified_end_) are in full blocks
 };
 
 inline LaunchedPhoton launch_photon(std::uint64_t seed, std::uint64_t photon, double theta_i,

@@ -5,14 +5,22 @@
 namespace fiberlab::sim {
 
 Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
-    : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels) {
-  const std::size_t bins = static_cast<std::size_t>(lobes) * n_theta * n_phi;
-  bins_.assign(bins * block(), 0);
+    : lobes_(lobes), n_theta_(n_theta), n_phi_(n_phi), channels_(channels),
+      memory_(bins() * block() * sizeof(Fixed)), touched_(pages(), 0) {
   truncated_.assign(channels, 0);
+  lost_.assign(channels, 0);
+}
+
+Tally::Tally(const Tally& o) : Tally(o.lobes_, o.n_theta_, o.n_phi_, o.channels_) { add(o); }
+
+Tally& Tally::operator=(const Tally& o) {
+  if (this != &o) *this = Tally(o);
+  return *this;
 }
 
 void Tally::score_exit(std::size_t bin, const double* weight) {
-  Fixed* cell = &bins_[bin * block()];
+  touched_[bin / kPageBins] = 1;
+  Fixed* cell = cells() + bin * block();
   ++cell[0];
   Fixed* s1 = cell + 1;
   Fixed* s2 = cell + 1 + channels_;
@@ -22,22 +30,50 @@ void Tally::score_exit(std::size_t bin, const double* weight) {
   }
 }
 
+void Tally::clear() {
+  Fixed* cell = cells();
+  for (std::size_t p = 0; p < touched_.size(); ++p) {
+    if (!touched_[p]) continue;
+    std::fill(cell + page_begin(p), cell + page_end(p), Fixed{0});
+    touched_[p] = 0;
+  }
+  photons_ = 0;
+  std::fill(truncated_.begin(), truncated_.end(), Fixed{0});
+  std::fill(lost_.begin(), lost_.end(), Fixed{0});
+}
+
 void Tally::score_truncated(const double* weight) {
   for (int c = 0; c < channels_; ++c) truncated_[c] += to_fixed(weight[c]);
 }
 
+void Tally::score_lost(const double* weight) {
+  for (int c = 0; c < channels_; ++c) lost_[c] += to_fixed(weight[c]);
+}
+
 void Tally::add(const Tally& o) {
+  if (!(o.shape() == shape())) throw Error("internal error: adding a tally of another shape");
   photons_ += o.photons_;
-  for (std::size_t i = 0; i < bins_.size(); ++i) bins_[i] += o.bins_[i];
-  for (int c = 0; c < channels_; ++c) truncated_[c] += o.truncated_[c];
+  Fixed* to = cells();
+  const Fixed* from = o.cells();
+  for (std::size_t p = 0; p < touched_.size(); ++p) {
+    if (!o.touched_[p]) continue;
+    touched_[p] = 1;
+    for (std::size_t i = page_begin(p); i < page_end(p); ++i) to[i] += from[i];
+  }
+  for (int c = 0; c < channels_; ++c) {
+    truncated_[c] += o.truncated_[c];
+    lost_[c] += o.lost_[c];
+  }
 }
 
 ExactTally Tally::exact() const {
   ExactTally e(shape());
   e.photons = photons_;
   const std::size_t C = channels_;
+  const Fixed* cells = this->cells();
   for (std::size_t b = 0; b < e.count.size(); ++b) {
-    const Fixed* cell = &bins_[b * block()];
+    if (!touched_[b / kPageBins]) continue;  // zero, as e starts
+    const Fixed* cell = cells + b * block();
     e.count[b] = static_cast<std::uint64_t>(cell[0]);
     for (std::size_t c = 0; c < C; ++c) {
       e.weight_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
@@ -50,9 +86,10 @@ ExactTally Tally::exact() const {
   for (std::size_t c = 0; c < C; ++c) {
     Fixed absorbed = static_cast<Fixed>(photons_) << 60;
     for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
-    absorbed -= truncated_[c];
+    absorbed -= truncated_[c] + lost_[c];
     e.absorbed[c] = static_cast<ExactTally::Word>(absorbed);
     e.truncated[c] = static_cast<ExactTally::Word>(truncated_[c]);
+    e.lost[c] = static_cast<ExactTally::Word>(lost_[c]);
   }
   return e;
 }
@@ -62,15 +99,23 @@ void Tally::add(const ExactTally& e) {
   photons_ += e.photons;
   const std::size_t C = channels_;
   for (std::size_t b = 0; b < e.count.size(); ++b) {
-    Fixed* cell = &bins_[b * block()];
+    bool any = e.count[b] != 0;
+    for (std::size_t c = 0; c < C && !any; ++c)
+      any = e.weight_sum[b * C + c] != 0 || e.weight_sq_sum[b * C + c] != 0;
+    if (!any) continue;
+    touched_[b / kPageBins] = 1;
+    Fixed* cell = cells() + b * block();
     cell[0] += e.count[b];
     for (std::size_t c = 0; c < C; ++c) {
       cell[1 + c] += static_cast<Fixed>(e.weight_sum[b * C + c]);
       cell[1 + C + c] += static_cast<Fixed>(e.weight_sq_sum[b * C + c]);
     }
   }
-  // exited and absorbed follow from the bins, photons and truncated.
-  for (std::size_t c = 0; c < C; ++c) truncated_[c] += static_cast<Fixed>(e.truncated[c]);
+  // exited and absorbed follow from the bins, photons, truncated and lost.
+  for (std::size_t c = 0; c < C; ++c) {
+    truncated_[c] += static_cast<Fixed>(e.truncated[c]);
+    lost_[c] += static_cast<Fixed>(e.lost[c]);
+  }
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
@@ -80,11 +125,12 @@ std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
 }
 
 std::vector<double> Tally::column(int offset) const {
-  const std::size_t bins = bins_.size() / block();
-  std::vector<double> out(bins * channels_);
-  for (std::size_t b = 0; b < bins; ++b)
+  std::vector<double> out(bins() * channels_, 0.0);
+  for (std::size_t b = 0; b < bins(); ++b) {
+    if (!touched_[b / kPageBins]) continue;
     for (int c = 0; c < channels_; ++c)
-      out[b * channels_ + c] = static_cast<double>(bins_[b * block() + offset + c]) / kScale;
+      out[b * channels_ + c] = static_cast<double>(cells()[b * block() + offset + c]) / kScale;
+  }
   return out;
 }
 
@@ -92,21 +138,22 @@ std::vector<double> Tally::weight_sum() const { return column(1); }
 std::vector<double> Tally::weight_sq_sum() const { return column(1 + channels_); }
 
 std::vector<std::uint64_t> Tally::count() const {
-  const std::size_t bins = bins_.size() / block();
-  std::vector<std::uint64_t> out(bins);
-  for (std::size_t b = 0; b < bins; ++b) out[b] = static_cast<std::uint64_t>(bins_[b * block()]);
+  std::vector<std::uint64_t> out(bins(), 0);
+  for (std::size_t b = 0; b < bins(); ++b)
+    if (touched_[b / kPageBins]) out[b] = static_cast<std::uint64_t>(cells()[b * block()]);
   return out;
 }
 // The ledger (SPEC section 4) from the bins: exited is the sum of S1 over a
 // lobe's bins, and every photon launched left a weight w that exited or was
-// truncated and 1 - w absorbed. Integer sums: exactly what per-photon
-// counters would hold.
+// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed.
+// Integer sums: exactly what per-photon counters would hold.
 std::vector<Tally::Fixed> Tally::exited_fixed() const {
   std::vector<Fixed> out(static_cast<std::size_t>(lobes_) * channels_, 0);
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;
   for (int l = 0; l < lobes_; ++l)
     for (std::size_t b = 0; b < per_lobe; ++b) {
-      const Fixed* s1 = &bins_[(l * per_lobe + b) * block() + 1];
+      if (!touched_[(l * per_lobe + b) / kPageBins]) continue;
+      const Fixed* s1 = cells() + (l * per_lobe + b) * block() + 1;
       for (int c = 0; c < channels_; ++c) out[static_cast<std::size_t>(l) * channels_ + c] += s1[c];
     }
   return out;
@@ -119,10 +166,11 @@ std::vector<double> Tally::absorbed() const {
   std::vector<Fixed> absorbed(channels_, static_cast<Fixed>(photons_) << 60);
   for (int c = 0; c < channels_; ++c) {
     for (int l = 0; l < lobes_; ++l) absorbed[c] -= exited[static_cast<std::size_t>(l) * channels_ + c];
-    absorbed[c] -= truncated_[c];
+    absorbed[c] -= truncated_[c] + lost_[c];
   }
   return to_double(absorbed);
 }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
+std::vector<double> Tally::lost() const { return to_double(lost_); }
 
 }  // namespace fiberlab::sim

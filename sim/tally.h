@@ -7,11 +7,18 @@
 // 2^60): integer addition is associative, so the totals are bit-identical
 // whatever the number of threads or the order in which photons are added.
 // The rounding of one weight is below 1e-18, far below any statistical error.
+//
+// The cells start as untouched zero pages (sim/zeroed_memory.h) and the tally
+// remembers which pages of bins it wrote: adding, clearing, copying and
+// exporting a tally visit only those, so a thread's tally costs what it holds
+// (a 90 x 180 x 8-lobe, 3-channel tally is 14.5 MB; a run touches 1-40% of it).
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
 #include "common/bin_grid.h"
 #include "sim/exact_tally.h"
+#include "sim/zeroed_memory.h"
 
 namespace fiberlab::sim {
 
@@ -21,6 +28,10 @@ class Tally {
   static constexpr double kScale = 0x1.0p60;
 
   Tally(int lobes, int n_theta, int n_phi, int channels);
+  Tally(const Tally& o);
+  Tally& operator=(const Tally& o);
+  Tally(Tally&&) noexcept = default;
+  Tally& operator=(Tally&&) noexcept = default;
 
   int lobes() const { return lobes_; }
   int n_theta() const { return n_theta_; }
@@ -33,19 +44,25 @@ class Tally {
     score_exit(bin_index(lobe, i_theta, i_phi), weight);
   }
   void score_exit(std::size_t bin, const double* weight);
+  // Every sum back to zero (only the touched pages are written): a thread's
+  // tally is reused across rounds and incident directions.
+  void clear();
   std::size_t bin_index(int lobe, int i_theta, int i_phi) const {
     return (static_cast<std::size_t>(lobe) * n_theta_ + i_theta) * n_phi_ + i_phi;
   }
   // Asks for a bin's cells ahead of score_exit (they are far apart in memory).
   void prefetch(std::size_t bin) const {
-    const Fixed* cell = &bins_[bin * block()];
+    const Fixed* cell = cells() + bin * block();
     __builtin_prefetch(cell, 1);
     __builtin_prefetch(reinterpret_cast<const char*>(cell + block()) - 1, 1);
   }
   // A photon still inside when it was stopped, with weight[c] left.
   void score_truncated(const double* weight);
-  // Every launched photon must have been scored (exited or truncated): what
-  // is absorbed is derived from that (launched - exited - truncated, exact).
+  // Weight weight[c] removed from a photon by masking (roughness.masking:
+  // smith_g1), or the whole weight of a path it killed: the ledger's `lost`.
+  void score_lost(const double* weight);
+  // Every launched photon must have been scored (exited, truncated, lost): what
+  // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
   void add(const Tally& other);  // exact: integer sums
   // The same sums as exact integers in file order (checkpoints, MPI, merge),
@@ -62,8 +79,17 @@ class Tally {
   std::vector<double> exited() const;     // [lobe][channel]
   std::vector<double> absorbed() const;   // [channel]
   std::vector<double> truncated() const;  // [channel]
+  std::vector<double> lost() const;       // [channel]
 
  private:
+  // Bins are tracked in pages of kPageBins consecutive bins.
+  static constexpr std::size_t kPageBins = 64;
+  std::size_t bins() const { return static_cast<std::size_t>(lobes_) * n_theta_ * n_phi_; }
+  std::size_t pages() const { return (bins() + kPageBins - 1) / kPageBins; }
+  // Cells [first, end) of page p.
+  std::size_t page_begin(std::size_t p) const { return p * kPageBins * block(); }
+  std::size_t page_end(std::size_t p) const { return std::min((p + 1) * kPageBins, bins()) * block(); }
+  Fixed* cells() const { return static_cast<Fixed*>(memory_.data()); }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
@@ -74,8 +100,10 @@ class Tally {
   int lobes_, n_theta_, n_phi_, channels_;
   std::uint64_t photons_ = 0;
   std::vector<Fixed> exited_fixed() const;  // [lobe][channel]: sums of S1
-  std::vector<Fixed> bins_;  // [bin][count, S1[C], S2[C]]
+  ZeroedMemory memory_;                 // cells(): [bin][count, S1[C], S2[C]]
+  std::vector<std::uint8_t> touched_;   // [page]: 1 once a cell of the page was written
   std::vector<Fixed> truncated_;
+  std::vector<Fixed> lost_;
 };
 
 }  // namespace fiberlab::sim

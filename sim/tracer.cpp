@@ -27,6 +27,7 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   if (counters) counters->add(counts);
   PhotonOutcome out = finished_outcome(model, static_cast<int>(s.code), s.d.to_vec3(),
                                        static_cast<int>(s.segments), s.path, s.weight, rng);
+  out.losses = std::move(s.losses.list);
   if (out.fate == PhotonFate::Exited) {
     out.theta = inclination(out.direction);
     out.phi = azimuth(out.direction);

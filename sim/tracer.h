@@ -2,6 +2,8 @@
 // The reference tracer: one photon's life (sim/photon_life.h) at a time, the
 // scalar instantiation of the same steps the batched tracer runs on SIMD
 // vectors of photons (sim/batch_tracer.h).
+#include <vector>
+
 #include "common/fiber_frame.h"
 #include "sim/photon_life.h"
 #include "sim/random.h"
@@ -18,8 +20,11 @@ struct PhotonOutcome {
   Vec3 direction = Vec3::Zero();  // exit direction wr (when Exited)
   int segments = 0;               // internal straight segments: the lobe index p
   double path_length = 0.0;       // total 3D length inside, in units of R
-  double weight = 1.0;            // the roughness model's throughput factor
   double theta = 0.0, phi = 0.0;  // inclination and azimuth of `direction` (when Exited)
+  // The throughput before absorption: the product of the masking factors (1
+  // without masking, 0 when Lost). Channel c carries weight exp(-sigma_a[c] l).
+  double weight = 1.0;
+  std::vector<WeightLoss> losses;  // what masking removed, in order (empty without masking)
 };
 
 // Work counters, for benchmarks and notes.

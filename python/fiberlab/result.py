@@ -18,11 +18,14 @@ from .progress import ProgressLine
 @dataclasses.dataclass(frozen=True)
 class LobeEnergy:
     """Fraction of the launched photons' weight per lobe (the ledger), with
-    standard errors: mean and std_err (K, L, C); absorbed and truncated (K, C)."""
+    standard errors: mean and std_err (K, L, C); absorbed, truncated and lost
+    (K, C). lost is the weight removed by masking (roughness.masking:
+    smith_g1), 0 otherwise; mean.sum(axis=1) + absorbed + truncated + lost = 1."""
     mean: np.ndarray
     std_err: np.ndarray
     absorbed: np.ndarray
     truncated: np.ndarray
+    lost: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)
@@ -153,7 +156,7 @@ class Result:
 
     @functools.cached_property
     def energy(self):
-        """Lobe energies with standard errors, absorbed and truncated fractions."""
+        """Lobe energies with standard errors, absorbed, truncated and lost fractions."""
         return LobeEnergy(**self._file.energy())
 
     @functools.cached_property

@@ -51,7 +51,7 @@ def test_estimators_equal_the_files_s1_s2(smooth_result, tmp_path):
 
 def test_ledger_balances(smooth_result):
     e = smooth_result.energy
-    np.testing.assert_allclose(e.mean.sum(axis=1) + e.absorbed + e.truncated, 1.0, rtol=1e-12)
+    np.testing.assert_allclose(e.mean.sum(axis=1) + e.absorbed + e.truncated + e.lost, 1.0, rtol=1e-12)
 
 
 def test_load_round_trips(smooth_result, tmp_path):

@@ -18,8 +18,8 @@ import h5py
 import numpy as np
 
 ARRAYS = ["tally/photons", "tally/weight_sum", "tally/weight_sq_sum", "tally/count",
-          "ledger/exited", "ledger/absorbed", "ledger/truncated", "exact/weight_sum",
-          "exact/weight_sq_sum", "exact/exited", "exact/absorbed", "exact/truncated"]
+          "ledger/exited", "ledger/absorbed", "ledger/truncated", "ledger/lost", "exact/weight_sum",
+          "exact/weight_sq_sum", "exact/exited", "exact/absorbed", "exact/truncated", "exact/lost"]
 
 CONFIG = """photons: {photons}
 seed: 5

@@ -351,6 +351,9 @@ TEST_F(Hostile, DiskFullLeavesNothingAndDoesNotCrash) {
   const Outcome o = fiberlab("run " + path("c.yaml") + " --quiet -o " + (small / "r.h5").string());
   EXPECT_EQ(o.status, 2) << o.err;  // not 139 (HDF5 crashed at exit)
   EXPECT_NE(o.err.find("No space left on device"), std::string::npos) << o.err;
+  // The message names the target the user gave, not the temporary file.
+  EXPECT_NE(o.err.find((small / "r.h5").string() + ": "), std::string::npos) << o.err;
+  EXPECT_EQ(o.err.find(".tmp-"), std::string::npos) << o.err;
   EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
   EXPECT_TRUE(fs::is_empty(small)) << "left behind in the full folder";
   umount(small.c_str());

@@ -11,6 +11,7 @@
 #include "sim/exact_tally.h"
 #include "sim/result_stream.h"
 #include "tests/sim/sim_test_support.h"
+#include "tests/unique_temp_dir.h"
 
 namespace fiberlab::sim {
 namespace {
@@ -50,8 +51,7 @@ TEST(CheckpointResume, StoppedSavedReadAndContinuedEqualsOneGo) {
   ASSERT_EQ(first.run(state, control), RunOutcome::Finished);
   state.done.assign(state.done.size(), 0);  // not finished at s.photons
 
-  const auto dir = std::filesystem::temp_directory_path() / "fiberlab_test_checkpoint";
-  std::filesystem::create_directories(dir);
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_checkpoint");
   const std::string path = (dir / "run.checkpoint.h5").string();
   write_checkpoint(path, whole, state, 0.0);
   Checkpoint saved = read_checkpoint(path, true);
@@ -68,8 +68,7 @@ TEST(CheckpointResume, StoppedSavedReadAndContinuedEqualsOneGo) {
 TEST(CheckpointResume, CheckpointOfAnotherConfigIsRefused) {
   const Settings s = small_rough();
   const Simulation sim(s);
-  const auto dir = std::filesystem::temp_directory_path() / "fiberlab_test_checkpoint_cfg";
-  std::filesystem::create_directories(dir);
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_checkpoint_cfg");
   const std::string path = (dir / "c.checkpoint.h5").string();
   write_checkpoint(path, sim, sim.start(), 0.0);
   const Checkpoint c = read_checkpoint(path, false);

@@ -10,6 +10,7 @@
 #include "sim/result_stream.h"
 
 #include "tests/sim/sim_test_support.h"
+#include "tests/unique_temp_dir.h"
 
 namespace fiberlab::sim {
 namespace {
@@ -68,8 +69,7 @@ TEST(Reproducibility, DifferentSeedsDiffer) {
 
 TEST(Reproducibility, MergeOfTwoSeedsIsTheExactSumAndRoundTripsThroughHdf5) {
   Settings s = rough_absorbing();
-  const auto dir = std::filesystem::temp_directory_path() / "fiberlab_test_merge";
-  std::filesystem::create_directories(dir);
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_merge");
   const std::string pa = (dir / "a.h5").string(), pb = (dir / "b.h5").string();
   const std::string pm = (dir / "m.h5").string(), other_path = (dir / "o.h5").string();
   auto run_to = [](const Settings& settings, const std::string& path) {

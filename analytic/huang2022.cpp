@@ -1,0 +1,622 @@
+#include "analytic/huang2022.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+
+#include "analytic/deon2011.h"
+#include "analytic/model_params.h"
+#include "analytic/model_registry.h"
+#include "analytic/physical_defaults.h"
+#include "common/error.h"
+#include "common/fresnel.h"
+#include "common/ggx.h"
+#include "common/units.h"
+
+namespace fiberlab::analytic {
+
+namespace {
+
+constexpr int kResidualP = 3;              // every order p >= 3 in one lobe (Cycles' TRRT+)
+constexpr double kMinDensityRoughness = 1e-3;  // density(): Cycles' clamp of the roughness
+constexpr int kArcNodes = 4096;            // density(): midpoint nodes over the arc (R)
+constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta in theta_r
+
+// ---- The point set ---------------------------------------------------------------
+// Halton's point set: coordinate k of point i is the radical inverse of i in
+// the k-th prime base. Deterministic; its one-dimensional projections are
+// stratified, the first (base 2) exactly for N a power of 2.
+constexpr unsigned kBases[9] = {2, 3, 5, 7, 11, 13, 17, 19, 23};
+
+double radical_inverse(std::uint64_t i, unsigned base) {
+  const double inv = 1.0 / base;
+  double f = inv, r = 0.0;
+  while (i > 0) {
+    r += static_cast<double>(i % base) * f;
+    i /= base;
+    f *= inv;
+  }
+  return r;
+}
+
+// Coordinates: 0 the entry angle, 1-2 / 3-4 / 5-6 the microfacet normals of
+// interfaces 1 / 2 / 3, 7-8 the residual's spread.
+struct Point {
+  double u[9];
+};
+Point point(std::uint64_t i, long n) {
+  Point p;
+  p.u[0] = radical_inverse(i, 2) + 0.5 / static_cast<double>(n);  // midpoints in dimension 0
+  if (p.u[0] >= 1.0) p.u[0] -= 1.0;
+  for (int k = 1; k < 9; ++k) p.u[k] = radical_inverse(i, kBases[k]);
+  return p;
+}
+
+// ---- Geometry (SPEC s2) ----------------------------------------------------------
+// A boundary point of the ellipse (semi-axes rv, rw) with its outward macro
+// normal n0 and the tilted mesonormal ns = cos(tilt) n0 - sin(tilt) u.
+struct Hit {
+  double pv, pw;
+  Vec3 n0, ns;
+};
+
+class Fiber {
+ public:
+  Fiber(double eccentricity, double tilt)
+      : rv_(1.0 / std::sqrt(eccentricity)), rw_(std::sqrt(eccentricity)),
+        ct_(std::cos(tilt)), st_(std::sin(tilt)) {}
+
+  Hit hit(double pv, double pw) const {
+    Hit h{pv, pw, Vec3(0.0, pv / (rv_ * rv_), pw / (rw_ * rw_)).normalized(), Vec3()};
+    h.ns = ct_ * h.n0 - st_ * Vec3(1.0, 0.0, 0.0);
+    return h;
+  }
+  // The point a photon travelling along d meets at circle-space angle g in
+  // (-pi/2, pi/2) (impact h = sin g across the projected width): the ellipse
+  // is the unit circle scaled by (rv, rw), which keeps impact fractions.
+  Hit entry(const Vec3& d, double g) const {
+    const double bv = d.y() / rv_, bw = d.z() / rw_, n = std::hypot(bv, bw);
+    const double gv = bv / n, gw = bw / n;  // beam direction in circle space
+    const double qv = std::sin(g) * -gw - std::cos(g) * gv, qw = std::sin(g) * gv - std::cos(g) * gw;
+    return hit(rv_ * qv, rw_ * qw);
+  }
+  // From boundary point `from` along d inside: the next boundary point and
+  // the 3D length travelled (the far root of the ellipse's quadratic, whose
+  // constant term is 0 on the boundary). Returns false if d runs along u.
+  bool next(const Hit& from, const Vec3& d, Hit& to, double& length) const {
+    const double a = d.y() * d.y() / (rv_ * rv_) + d.z() * d.z() / (rw_ * rw_);
+    const double b = 2.0 * (from.pv * d.y() / (rv_ * rv_) + from.pw * d.z() / (rw_ * rw_));
+    if (!(a > 0.0)) return false;
+    length = std::max(0.0, -b / a);
+    double pv = from.pv + length * d.y(), pw = from.pw + length * d.z();
+    const double s = std::sqrt(pv * pv / (rv_ * rv_) + pw * pw / (rw_ * rw_));
+    to = hit(pv / s, pw / s);
+    return true;
+  }
+  // Width of the cross-section's projection across the beam direction (v, w).
+  double projected_width(double bv, double bw) const {
+    const double n = std::hypot(bv, bw);
+    return 2.0 * std::sqrt(rv_ * rv_ * bw * bw + rw_ * rw_ * bv * bv) / n;
+  }
+  // Point of the boundary at parameter t (v = rv cos t, w = rw sin t) and
+  // the arc length per dt there.
+  Hit at(double t) const { return hit(rv_ * std::cos(t), rw_ * std::sin(t)); }
+  double arc_per_dt(double t) const {
+    return std::hypot(rv_ * std::sin(t), rw_ * std::cos(t));
+  }
+
+ private:
+  double rv_, rw_, ct_, st_;
+};
+
+Vec3 reflect(const Vec3& d, const Vec3& m) { return d - 2.0 * d.dot(m) * m; }
+
+// Snell about m (d.m < 0) with eta_rel = n_t / n_i; false under total
+// internal reflection.
+bool refract(const Vec3& d, const Vec3& m, double eta_rel, Vec3& t) {
+  const double ci = -d.dot(m);
+  const double s2 = (1.0 - ci * ci) / (eta_rel * eta_rel);
+  if (s2 >= 1.0) return false;
+  t = d / eta_rel + (ci / eta_rel - std::sqrt(1.0 - s2)) * m;
+  return true;
+}
+
+// ---- The microfacet interface ----------------------------------------------------
+class Surface {
+ public:
+  Surface(double alpha, HuangMasking masking) : a_(alpha), masking_(masking) {}
+  double alpha() const { return a_; }
+  // Smith's Lambda of a direction at |cos| c to the mesonormal (isotropic GGX).
+  double lambda(double c) const {
+    if (a_ == 0.0) return 0.0;
+    c = std::min(1.0, std::abs(c));
+    return ggx::Lambda(Vec3(std::sqrt(1.0 - c * c), 0.0, c), a_, a_);
+  }
+  // Weight of the leaving direction given the normals were drawn from the
+  // arriving direction's VNDF (which holds G1 of the arrival): separable
+  // G1(o); correlated G2 / G1(i) = (1 + L_i) / (1 + L_i + L_o); none 1.
+  double leaving(double cos_in, double cos_out) const {
+    if (masking_ == HuangMasking::None || a_ == 0.0) return 1.0;
+    const double lo = lambda(cos_out);
+    if (masking_ == HuangMasking::Separable) return 1.0 / (1.0 + lo);
+    const double li = lambda(cos_in);
+    return (1.0 + li) / (1.0 + li + lo);
+  }
+  // A microfacet normal seen from w (w.nf > 0) for the point (u1, u2).
+  Vec3 normal(const Vec3& nf, const Vec3& w, double u1, double u2) const {
+    if (a_ == 0.0) return nf;
+    const Vec3 x = tangent(nf), y = nf.cross(x);
+    const Vec3 wl(w.dot(x), w.dot(y), w.dot(nf));
+    const Vec3 m = ggx::sample_visible(wl, a_, a_, u1, u2);
+    return m.x() * x + m.y() * y + m.z() * nf;
+  }
+  // The VNDF D_w(m) = G1(w) max(0, w.m) D(m) / (w.nf) per steradian of m.
+  double visible_density(const Vec3& nf, const Vec3& w, const Vec3& m) const {
+    const double wn = w.dot(nf), wm = w.dot(m), c = m.dot(nf);
+    if (!(wn > 0.0) || !(wm > 0.0) || !(c > 0.0)) return 0.0;
+    const double D = ggx::D(Vec3(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c), a_, a_);
+    return D * wm / wn / (1.0 + lambda(wn));
+  }
+
+ private:
+  static Vec3 tangent(const Vec3& n) {
+    Vec3 t = Vec3(1.0, 0.0, 0.0) - n.x() * n;  // the fiber axis in n's tangent plane
+    if (t.squaredNorm() < 1e-20) t = Vec3(0.0, 1.0, 0.0) - n.y() * n;
+    return t.normalized();
+  }
+  double a_;
+  HuangMasking masking_;
+};
+
+// ---- Paths -----------------------------------------------------------------------
+// What a traced point reports. Weights are per channel (w[0..C)).
+struct Sink {
+  virtual ~Sink() = default;
+  virtual void exit(int p, const Vec3& o, const double* w) = 0;
+  virtual void residual(const double* w, double u1, double u2) = 0;
+  virtual void lost(bool masked, const double* w) = 0;
+  virtual void incident(double w) = 0;
+  // Arrival inside at interface `p + 1` (after p + 1 segments) with travel
+  // direction d; return false to stop there (density() takes over).
+  virtual bool arrive(int, const Hit&, const Vec3&, const double*) { return true; }
+};
+
+class Paths {
+ public:
+  Paths(const Huang2022Params& p, double theta_i, double phi_i)
+      : p_(p), fiber_(p.eccentricity, p.tilt), surface_(p.roughness, p.masking),
+        wi_(direction_from_angles(theta_i, phi_i)), C_(static_cast<int>(p.sigma_a.size())) {}
+
+  const Fiber& fiber() const { return fiber_; }
+  const Surface& surface() const { return surface_; }
+  const Vec3& wi() const { return wi_; }
+  int channels() const { return C_; }
+  double scale(int p) const { return p < kResidualP ? for_lobe(p_.lobe_scale, p) : 1.0; }
+  const Huang2022Params& params() const { return p_; }
+
+  // One point of the set, weight `base` (its share of the incident beam).
+  void trace(const Point& pt, double base, Sink& sink) const {
+    const double g = (pt.u[0] - 0.5) * kPi;
+    const Vec3 d0 = -wi_;
+    const Hit h = fiber_.entry(d0, g);
+    const double macro = wi_.dot(h.n0), meso = wi_.dot(h.ns);
+    // Share of the beam at this point: cos(g) dg / 2 of the projected width;
+    // the paper's flux over the mesonormal scales it by (wi.ns)/(wi.n0).
+    double w0 = base * 0.5 * kPi * std::cos(g);
+    if (p_.mesonormal_flux) w0 *= std::max(0.0, meso) / macro;
+    std::vector<double> w(C_, w0);
+    sink.incident(w0);
+    if (!(macro > 0.0) || w0 == 0.0) return;
+    if (!(meso > 0.0)) return sink.lost(false, w.data());  // macro flux only: no visible scale
+    const Vec3 m = surface_.normal(h.ns, wi_, pt.u[1], pt.u[2]);
+    const double ci = wi_.dot(m);
+    const double F = fresnel_dielectric(ci, p_.eta);
+    // R: reflection about m.
+    branch(0, d0, reflect(d0, m), h, +1, F, w, sink, [&](const Vec3& o, const double* wr) {
+      sink.exit(0, o, wr);
+    });
+    // T: into the fiber.
+    Vec3 t;
+    if (!refract(d0, m, p_.eta, t)) return;
+    branch(0, d0, t, h, -1, 1.0 - F, w, sink, [&](const Vec3& dt, const double* wt) {
+      inside(pt, 1, h, dt, wt, sink, nullptr, 1.0);
+    });
+  }
+
+ private:
+  // An event's outcome o (+1: stays on the arriving side, -1: crosses) with
+  // probability `prob`: checks it leaves on its side of the mesonormal and
+  // the macro normal (else stopped), applies the leaving masking, continues.
+  // `side` of the arrival: the facing normals are side * ns, side * n0 with
+  // side = +1 outside (arriving along d0 from outside) and -1 inside.
+  template <class Next>
+  void branch(int inside_events, const Vec3& d, const Vec3& o, const Hit& h, int cross,
+              double prob, const std::vector<double>& w, Sink& sink, Next next) const {
+    const double side = inside_events == 0 ? 1.0 : -1.0;
+    const Vec3 nf = side * h.ns, nm = side * h.n0;
+    std::vector<double> wo(C_), lost(C_);
+    const double on = o.dot(nf) * cross, om = o.dot(nm) * cross;
+    if (!(on > 0.0) || !(om > 0.0)) {
+      for (int c = 0; c < C_; ++c) lost[c] = w[c] * prob;
+      if (prob > 0.0) sink.lost(false, lost.data());
+      return;
+    }
+    const double g = surface_.leaving(-d.dot(nf), on);
+    for (int c = 0; c < C_; ++c) {
+      wo[c] = w[c] * prob * g;
+      lost[c] = w[c] * prob * (1.0 - g);
+    }
+    if (g < 1.0) sink.lost(true, lost.data());
+    if (prob > 0.0) next(o, wo.data());
+  }
+
+  // Segment k (1 or 2) from `from` along d with weight w, then the event at
+  // its end. For k = 2: a1 the first segment's transmittance, t2 the Fresnel
+  // transmittance of interface 2 (both for the residual).
+  void inside(const Point& pt, int k, const Hit& from, const Vec3& d, const double* w, Sink& sink,
+              const std::vector<double>* a1, double t2) const {
+    Hit h;
+    double len;
+    std::vector<double> wa(w, w + C_), a(C_);
+    if (!fiber_.next(from, d, h, len)) return sink.lost(false, wa.data());
+    for (int c = 0; c < C_; ++c) {
+      a[c] = std::exp(-p_.sigma_a[c] * len);  // the chord's 3D length (SPEC s4)
+      wa[c] *= a[c];
+    }
+    if (!sink.arrive(k - 1, h, d, wa.data())) return;
+    const Vec3 nf = -h.ns;
+    const Vec3 wv = -d;
+    if (!(wv.dot(nf) > 0.0)) return sink.lost(false, wa.data());  // the scale faces away
+    const Vec3 m = surface_.normal(nf, wv, pt.u[2 * k + 1], pt.u[2 * k + 2]);
+    const double F = fresnel_dielectric(wv.dot(m), 1.0 / p_.eta);
+    // Out: order p = k.
+    Vec3 t;
+    if (refract(d, m, 1.0 / p_.eta, t)) {
+      branch(1, d, t, h, -1, 1.0 - F, wa, sink, [&](const Vec3& o, const double* wo) {
+        sink.exit(k, o, wo);
+      });
+    }
+    // Internal reflection: order k + 1 and beyond.
+    const Vec3 r = reflect(d, m);
+    if (k == 1) {
+      branch(1, d, r, h, +1, F, wa, sink, [&](const Vec3& dr, const double* wr) {
+        inside(pt, 2, h, dr, wr, sink, &a, 1.0 - F);
+      });
+      return;
+    }
+    // k == 2: Cycles' residual for every p >= 3 from the weight reflected
+    // here: the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)).
+    branch(1, d, r, h, +1, F, wa, sink, [&](const Vec3&, const double* wr) {
+      const double t_avg = std::max(1e-5, 0.5 * (t2 + (1.0 - F)));
+      std::vector<double> e(C_);
+      for (int c = 0; c < C_; ++c) {
+        const double a_avg = std::sqrt((*a1)[c] * a[c]);
+        e[c] = wr[c] * a_avg * t_avg / (1.0 - a_avg * (1.0 - t_avg));
+      }
+      sink.residual(e.data(), pt.u[7], pt.u[8]);
+    });
+  }
+
+  const Huang2022Params& p_;
+  Fiber fiber_;
+  Surface surface_;
+  Vec3 wi_;
+  int C_;
+};
+
+// Runs every point of an n-point set through the paths.
+void integrate(const Paths& paths, long n, Sink& sink) {
+  const double base = 1.0 / static_cast<double>(n);
+  for (long i = 0; i < n; ++i) paths.trace(point(static_cast<std::uint64_t>(i), n), base, sink);
+}
+
+// The residual's inclination for the point (u1, u2): a von Mises-Fisher
+// spread (kappa = 1/v) of the specular direction at inclination -theta_i,
+// whose theta-marginal is d'Eon's M_p(v) (SPEC s3).
+double residual_theta(double theta_i, double v, double u1, double u2) {
+  if (v < kDeltaV) return -theta_i;
+  const double c = std::clamp(1.0 + v * std::log(u1 + (1.0 - u1) * std::exp(-2.0 / v)), -1.0, 1.0);
+  const double s = std::sqrt(std::max(0.0, 1.0 - c * c)), b = kTwoPi * u2;
+  // About the centre (sin(-theta_i), cos(theta_i), 0): the u component.
+  const double ui = -std::sin(theta_i), ci = std::cos(theta_i);
+  return std::asin(std::clamp(c * ui + s * std::cos(b) * ci, -1.0, 1.0));
+}
+
+int lobe_index(int p, int lobes) { return lobe_of(std::min(p, kResidualP), lobes); }
+
+}  // namespace
+
+Huang2022::Huang2022(Huang2022Params params) : params_(std::move(params)) {
+  auto bad = [](const std::string& what) { throw Error("huang2022: " + what); };
+  const Huang2022Params& p = params_;
+  if (!(p.eta > 1.0) || !std::isfinite(p.eta)) bad(fmt::format("eta = {} must be > 1", p.eta));
+  if (!(p.roughness >= 0.0 && p.roughness <= 1.0))
+    bad(fmt::format("roughness = {} must be in [0, 1]", p.roughness));
+  if (!(std::abs(p.tilt) < kPi / 4)) bad(fmt::format("tilt = {} deg must be in (-45, 45)", rad_to_deg(p.tilt)));
+  if (!(p.eccentricity > 0.0 && p.eccentricity <= 1.0))
+    bad(fmt::format("eccentricity = {} must be in (0, 1]", p.eccentricity));
+  if (p.lobes < 1 || p.lobes > 4)
+    bad(fmt::format("lobes = {} must be 1..4 (every order p >= 3 is one residual lobe)", p.lobes));
+  if (p.sigma_a.empty() || p.sigma_a.size() > 8) bad("sigma_a needs 1 to 8 channels");
+  for (double s : p.sigma_a)
+    if (!(s >= 0.0) || !std::isfinite(s)) bad(fmt::format("sigma_a = {} must be finite and >= 0", s));
+  if (p.lobe_scale.empty()) bad("lobe_scale needs at least one value");
+  for (double s : p.lobe_scale)
+    if (!(s >= 0.0) || !std::isfinite(s)) bad(fmt::format("lobe_scale = {} must be finite and >= 0", s));
+  if (p.quadrature_points < 1024 || p.quadrature_points > (1L << 30))
+    bad(fmt::format("quadrature_points = {} must be in [1024, 2^30]", p.quadrature_points));
+}
+
+namespace {
+
+// Bin probabilities: each exit lands in one bin; the residual in one theta
+// bin, spread evenly over phi.
+class BinSink : public Sink {
+ public:
+  BinSink(const Paths& paths, const BinGrid& grid, double theta_i, double phi_i, std::vector<double>& out)
+      : paths_(paths), grid_(grid), theta_i_(theta_i), phi_i_(phi_i), out_(out),
+        C_(paths.channels()), L_(paths.params().lobes), v_(4.0 * paths.params().roughness) {}
+  void exit(int p, const Vec3& o, const double* w) override {
+    const int i = grid_.theta_bin(inclination(o)), j = grid_.phi_bin(wrap_angle(azimuth(o) - phi_i_));
+    double* b = bin(lobe_index(p, L_), i, j);
+    const double s = paths_.scale(p);
+    for (int c = 0; c < C_; ++c) b[c] += s * w[c];
+  }
+  void residual(const double* w, double u1, double u2) override {
+    const int i = grid_.theta_bin(residual_theta(theta_i_, v_, u1, u2));
+    const int np = grid_.n_phi();
+    for (int j = 0; j < np; ++j) {
+      double* b = bin(lobe_index(kResidualP, L_), i, j);
+      for (int c = 0; c < C_; ++c) b[c] += w[c] / np;
+    }
+  }
+  void lost(bool, const double*) override {}
+  void incident(double) override {}
+
+ private:
+  double* bin(int lobe, int i, int j) {
+    return &out_[((static_cast<std::size_t>(lobe) * grid_.n_theta() + i) * grid_.n_phi() + j) * C_];
+  }
+  const Paths& paths_;
+  const BinGrid& grid_;
+  double theta_i_, phi_i_;
+  std::vector<double>& out_;
+  int C_, L_;
+  double v_;
+};
+
+class EnergySink : public Sink {
+ public:
+  EnergySink(const Paths& paths, HuangEnergies& e) : paths_(paths), e_(e), C_(paths.channels()) {
+    e_.lobe.assign(static_cast<std::size_t>(paths.params().lobes) * C_, 0.0);
+    e_.masked.assign(C_, 0.0);
+    e_.stopped.assign(C_, 0.0);
+    e_.incident = 0.0;
+  }
+  void exit(int p, const Vec3&, const double* w) override { add(p, w, paths_.scale(p)); }
+  void residual(const double* w, double, double) override { add(kResidualP, w, 1.0); }
+  void lost(bool masked, const double* w) override {
+    for (int c = 0; c < C_; ++c) (masked ? e_.masked : e_.stopped)[c] += w[c];
+  }
+  void incident(double w) override { e_.incident += w; }
+
+ private:
+  void add(int p, const double* w, double s) {
+    double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
+    for (int c = 0; c < C_; ++c) l[c] += s * w[c];
+  }
+  const Paths& paths_;
+  HuangEnergies& e_;
+  int C_;
+};
+
+// density() for TT (stop_at 0) and TRT (stop_at 1): at that arrival the last
+// interface is evaluated towards wr (the paper's last-interface evaluation):
+// the VNDF density of the half vector of refraction m = (wr - eta d)/|.|
+// times the Jacobian d(omega_m)/d(omega_r) = |wr.m| / (eta (w.m) + wr.m)^2
+// (Walter et al. 2007, Eq. 17 with eta_o = 1), (1 - F) and the masking.
+class LastInterfaceSink : public Sink {
+ public:
+  LastInterfaceSink(const Paths& paths, int stop_at, const Vec3& wr, std::vector<double>& out)
+      : paths_(paths), stop_at_(stop_at), wr_(wr), out_(out) {}
+  void exit(int, const Vec3&, const double*) override {}
+  void residual(const double*, double, double) override {}
+  void lost(bool, const double*) override {}
+  void incident(double) override {}
+  bool arrive(int k, const Hit& h, const Vec3& d, const double* w) override {
+    if (k < stop_at_) return true;
+    const double eta = paths_.params().eta;
+    const Vec3 nf = -h.ns, wv = -d;
+    const double wn = wv.dot(nf), on = wr_.dot(nf);
+    if (!(wn > 0.0) || !(on < 0.0) || !(wr_.dot(h.n0) > 0.0)) return false;
+    const Vec3 m = (wr_ - eta * d).normalized();
+    const double om = wr_.dot(m), wm = wv.dot(m);
+    if (!(om < 0.0) || !(wm > 0.0)) return false;
+    const double F = fresnel_dielectric(wm, 1.0 / eta);
+    if (F >= 1.0) return false;
+    const double jac = -om / ((eta * wm + om) * (eta * wm + om));
+    const double f = (1.0 - F) * paths_.surface().visible_density(nf, wv, m) * jac *
+                     paths_.surface().leaving(wn, on);
+    for (std::size_t c = 0; c < out_.size(); ++c) out_[c] += f * w[c];
+    return false;
+  }
+
+ private:
+  const Paths& paths_;
+  int stop_at_;
+  Vec3 wr_;
+  std::vector<double>& out_;
+};
+
+// S_R(wi, wr) of the paper's R lobe: 1/(W cos theta_i) times the integral
+// over the arc lit by wi and seen from wr of F(wi.h) D(h) G2 / 4 dl.
+double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
+  const Fiber& fb = paths.fiber();
+  const Surface& sf = paths.surface();
+  const Huang2022Params& p = paths.params();
+  const Vec3 hv = (wi + wr).normalized();
+  const double F = fresnel_dielectric(wi.dot(hv), p.eta);
+  const double dt = kTwoPi / kArcNodes;
+  double sum = 0.0;
+  for (int k = 0; k < kArcNodes; ++k) {
+    const double t = (k + 0.5) * dt;
+    const Hit h = fb.at(t);
+    const double in = wi.dot(h.ns), out = wr.dot(h.ns), c = hv.dot(h.ns);
+    if (!(wi.dot(h.n0) > 0.0) || !(wr.dot(h.n0) > 0.0) || !(in > 0.0) || !(out > 0.0) || !(c > 0.0))
+      continue;
+    const double D = ggx::D(Vec3(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c), sf.alpha(), sf.alpha());
+    const double G = sf.leaving(in, out) / (1.0 + sf.lambda(in));
+    const double flux = p.mesonormal_flux ? 1.0 : wi.dot(h.n0) / in;
+    sum += F * D * G / 4.0 * flux * fb.arc_per_dt(t) * dt;
+  }
+  const double cos_i = std::sqrt(wi.y() * wi.y() + wi.z() * wi.z());
+  return sum / (fb.projected_width(wi.y(), wi.z()) * cos_i);
+}
+
+}  // namespace
+
+std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double theta_i, double phi_i) const {
+  const int C = static_cast<int>(params_.sigma_a.size());
+  std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
+  const Paths paths(params_, theta_i, phi_i);
+  BinSink sink(paths, grid, theta_i, phi_i, out);
+  integrate(paths, params_.quadrature_points, sink);
+  return out;
+}
+
+HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
+  HuangEnergies e;
+  const Paths paths(params_, theta_i, phi_i);
+  EnergySink sink(paths, e);
+  integrate(paths, params_.quadrature_points, sink);
+  return e;
+}
+
+void Huang2022::density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
+                        std::vector<double>& out) const {
+  const int C = static_cast<int>(params_.sigma_a.size()), L = params_.lobes;
+  out.assign(C, 0.0);
+  Huang2022Params q = params_;
+  q.roughness = std::max(q.roughness, kMinDensityRoughness);
+  const Paths paths(q, theta_i, phi_i);
+  const Vec3 wi = paths.wi(), wr = direction_from_angles(theta_r, phi_i + phi);
+  std::vector<double> s(C);
+  for (int p = 0; p <= kResidualP; ++p) {
+    if (lobe_index(p, L) != lobe) continue;
+    std::fill(s.begin(), s.end(), 0.0);
+    if (p == 0) {
+      std::fill(s.begin(), s.end(), r_lobe(paths, wi, wr));
+    } else if (p < kResidualP) {
+      LastInterfaceSink sink(paths, p - 1, wr, s);
+      integrate(paths, density_points_, sink);
+    } else {
+      // The residual: its energy times M_p(v = 4 alpha) / (2 pi) (Cycles).
+      HuangEnergies e;
+      EnergySink sink(paths, e);
+      integrate(paths, density_points_, sink);
+      const double m = std::exp(deon2011::log_M_p(4.0 * q.roughness, theta_i, theta_r)) / kTwoPi;
+      for (int c = 0; c < C; ++c) s[c] = e.lobe[static_cast<std::size_t>(lobe) * C + c] * m;
+    }
+    const double scale = paths.scale(p) * std::cos(theta_r);
+    for (int c = 0; c < C; ++c) out[c] += scale * s[c];
+  }
+}
+
+std::unique_ptr<Model> make_huang2022(const Huang2022Params& params) {
+  return std::make_unique<Huang2022>(params);
+}
+
+std::unique_ptr<Model> make_huang2022(const ModelParams& mp) {
+  Huang2022Params p;
+  p.eta = mp.eta;
+  p.sigma_a = mp.sigma_a;
+  p.roughness = mp.ggx_roughness;
+  p.tilt = mp.scale_tilt;
+  p.eccentricity = mp.eccentricity;
+  p.lobe_scale = mp.lobe_scale;
+  p.masking = static_cast<HuangMasking>(mp.huang_masking);
+  p.mesonormal_flux = mp.mesonormal_flux;
+  p.lobes = mp.lobes;
+  p.quadrature_points = static_cast<long>(mp.quadrature_points);
+  return std::make_unique<Huang2022>(p);
+}
+
+namespace {
+
+std::vector<std::string> huang_approximations(const ModelParams& p) {
+  std::vector<std::string> a = {
+      "far field: Cycles' wi read as our wi (the light); S normalised by the light's projected width",
+      "TT, TRT: the paper's sampled microfacet normals as a fixed Halton point set (deterministic quadrature)",
+      "p >= 3: Cycles' residual (geometric series from the TRT path, M_p with v = 4 alpha, uniform in phi)",
+      "no GGX glass albedo correction (Cycles' energy_scale table)"};
+  if (p.mesonormal_flux)
+    a.push_back("flux onto the mesonormal (wi.ns): not the projected width's once tilted (paper, Cycles' eval)");
+  if (p.huang_masking == static_cast<int>(HuangMasking::Correlated))
+    a.push_back("masking: height-correlated G2 (Cycles' code)");
+  return a;
+}
+
+}  // namespace
+
+ModelInfo huang2022_info() {
+  ModelInfo m;
+  m.name = "huang2022";
+  m.reference =
+      "Huang, Hullin, Hanika 2022, A Microfacet-based Hair Scattering Model (Cycles' Principled Hair "
+      "Huang), far field";
+  ParamSpec roughness = number_param("roughness", "GGX microfacet roughness alpha about the mesonormal (0: smooth)",
+                                     "", "0.3", "a number in [0, 1]", &ModelParams::ggx_roughness,
+                                     [](double x) { return x >= 0.0 && x <= 1.0; });
+  roughness.from_fiber = "roughness (smooth: 0; gaussian: sqrt(2) tan(beta_long), approximate)";
+  ParamSpec tilt = number_param("tilt",
+                                "cuticle scale tilt of the mesonormal, > 0 towards the root as fiber.scale_tilt "
+                                "(Cycles' Huang Tilt)",
+                                "deg", "0", "degrees in (-45, 45)", &ModelParams::scale_tilt,
+                                [](double x) { return std::abs(x) < 45.0; });
+  tilt.from_fiber = "fiber.scale_tilt";
+  ParamSpec ecc = eccentricity_param("a number in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; });
+  ecc.meaning = "minor/major axis ratio of the ellipse (Cycles' aspect ratio)";
+  ecc.default_value = "1";
+  ParamSpec scale = list_param("lobe_scale", "factors of the R, TT, TRT lobes (Cycles' modulation; 1 = physical)",
+                               "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &ModelParams::lobe_scale,
+                               [](double x) { return x >= 0.0; });
+  ParamSpec masking = choice_param(
+      "masking",
+      "Smith masking: separable G1(i) G1(o) (the paper's ground truth, simulator smith_g1); correlated "
+      "1/(1 + L_i + L_o) (Cycles); none (no masking of leaving light)",
+      "separable", {"separable", "correlated", "none"},
+      [](ModelParams& p, int i) { p.huang_masking = i; }, [](const ModelParams& p) { return p.huang_masking; });
+  ParamSpec flux = choice_param(
+      "flux", "light reaching the arc: mesonormal (wi.ns) dl (paper, Cycles' eval) or macro (wi.n0) dl",
+      "mesonormal", {"mesonormal", "macro"},
+      [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
+      [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });
+  ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
+                                  "integer", "1048576", "an integer in [1024, 1073741824]",
+                                  &ModelParams::quadrature_points, [](double x) {
+                                    return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
+                                  });
+  m.params = {eta_param(), sigma_a_param(), roughness, tilt, ecc, scale, masking, flux, lobes_param(), points};
+  m.make = [](const ModelParams& p) { return make_huang2022(p); };
+  m.approximations = huang_approximations;
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+    apply_fiber_basics(f, p);
+    p.eccentricity = f.eccentricity;
+    p.scale_tilt = f.scale_tilt;
+    switch (f.roughness) {
+      case PhysicalFiber::Roughness::Smooth: p.ggx_roughness = 0.0; break;
+      case PhysicalFiber::Roughness::Gaussian:
+        // Equal density at the mean normal: a Gaussian tilt of sd beta per
+        // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+        p.ggx_roughness = std::min(1.0, std::sqrt(2.0) * std::tan(for_lobe(f.beta_long, 0)));
+        break;
+      case PhysicalFiber::Roughness::ExitBlur:
+        throw Error("model huang2022: an exit_blur fiber has no microfacets; set --set roughness=A");
+    }
+  };
+  return m;
+}
+
+}  // namespace fiberlab::analytic

@@ -1,0 +1,157 @@
+#pragma once
+// Huang, Hullin, Hanika 2022, "A Microfacet-based Hair Scattering Model"
+// (Computer Graphics Forum 41(4), EGSR 2022), the model behind Cycles'
+// Principled Hair "Huang" (intern/cycles/kernel/closure/
+// bsdf_principled_hair_huang.h), as a far-field scattering function of a
+// fixed light (fiberlab's frame, SPEC s1 and s7).
+//
+// The fiber (paper section 3; Cycles' setup): an infinite cylinder whose
+// cross-section is an ellipse, its surface covered by cuticle scales whose
+// mean normal (the paper's mesonormal) is the ellipse's outward normal n0
+// tilted along the fiber, and on that the rough surface of a GGX microfacet
+// distribution about the mesonormal (isotropic roughness alpha). Every
+// interface event is a single-scattering microfacet event: the normal m is
+// one that the arriving direction sees (the GGX distribution of visible
+// normals, VNDF), the light reflects with Fresnel F(eta, angle to m) and
+// refracts with 1 - F (Snell about m), and Smith's masking of the leaving
+// direction weights the result; paths that leave on the wrong side of the
+// mesonormal or of the macro normal are not continued (the model's loss,
+// together with the masking).
+//
+// In fiberlab's frame (SPEC s1, s2): the fiber axis is u; the ellipse has
+// semi-axes r_v = 1/sqrt(e), r_w = sqrt(e), e = `eccentricity` = minor/major
+// (Cycles' "aspect ratio" b <= 1; Cycles rescales its ellipse to the major
+// axis 1 and normalises by its projected radius, which is the same model:
+// the scattering function depends only on b, absorption lengths here are in
+// units of the equivalent circle's radius, SPEC s2). The mesonormal is
+// SPEC's tilted normal n_s = cos(tilt) n0 - sin(tilt) u, for hits from
+// outside and inside alike: `tilt` > 0 is SPEC's scale_tilt > 0 (scales
+// towards the root, R moves to theta_r < -theta_i). Cycles negates its
+// user-facing tilt internally "to keep it consistent with principled hair"
+// and builds the entry mesonormal with axis component sin(-tilt); its Y axis
+// is the curve tangent (root -> tip), so Cycles' Huang "Tilt" input is this
+// `tilt`.
+//
+// Frames: Cycles evaluates f(wi, wo) with the projected width and the
+// integration range over h taken on its wi side (projected_area =
+// cos theta(wi) dh), samples the first interfaces' microfacets from wi and
+// evaluates the last interface towards wo. That is a light entering along
+// -wi and leaving along wo: Cycles' wi plays our wi (the direction to the
+// light), as the far field of a fixed light needs, and the prediction is
+//   p(theta_r, phi) = S(wi, wr) cos(theta_r)   per d(theta_r) d(phi),
+// with S normalised by the light's projected width W(wi) cos(theta_i).
+//
+// What follows the paper and what Cycles (equation numbers are not quoted:
+// the paper was learnt through its Cycles implementation and abstract):
+// - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
+//   integral over the lit arc of F(wi.h) D(h) G2(wi, wr) / 4 dl, h the half
+//   vector, D and G about the mesonormal, the arc length dl of the ellipse;
+//   density() evaluates this integral (paper; Cycles' eval_r).
+// - TT, TRT (paper: the first interfaces' microfacets sampled from their
+//   VNDF, the last interface evaluated towards wr; Cycles' eval_residual
+//   does this with Monte Carlo normals inside a Simpson rule over the arc):
+//   here the sampled normals are a fixed low-discrepancy point set (Halton,
+//   bases 2, 3, 5, ...) mapped through Heitz 2018's VNDF map: a
+//   deterministic quadrature of the same integral (same output every run),
+//   not a random estimate. The chord inside is the ellipse's exact chord
+//   (3D length, absorption exp(-sigma_a l)).
+// - Masking: `masking=separable` G2 = G1(wi) G1(wo) per interface, the
+//   paper's ground truth's "weight times G1" (and the simulator's
+//   `masking: smith_g1`); `masking=correlated` the height-correlated
+//   G2 = 1 / (1 + Lambda_i + Lambda_o) that Cycles' code uses (bsdf_G, and
+//   bsdf_Go = G2 / G1(wi) for the sampled interfaces); `masking=none` G = 1
+//   (a limit for tests).
+// - p >= 3 (Cycles, not the paper's three lobes): Cycles' residual after
+//   Chiang et al. 2016: the weight reflected at the third interface times
+//   the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)),
+//   A_avg = sqrt(A_t A_tr) (the two chords' transmittances), T_avg =
+//   max(1e-5, (T_2 + T_3)/2) (Fresnel transmittances at interfaces 2, 3),
+//   spread by d'Eon's M_p with v = 4 alpha (Cycles' choice) about
+//   theta_r = -theta_i and uniformly in phi.
+// - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
+//   1 = the physical model); the residual is not scaled (as in Cycles).
+// - Left out (Cycles): the GGX glass albedo correction (energy_scale, a
+//   tabulated multiple-scattering compensation Cycles applies per
+//   interface): not in the paper, not reproducible without its table; the
+//   near field (a pixel's part of the width): fiberlab predicts far-field bins.
+//
+// Bin probabilities are the exact push-forward of the same quadrature: every
+// point of the point set (h uniform over the projected width, the
+// microfacet normals of up to three interfaces, two more coordinates for the
+// residual's von Mises-Fisher spread, whose theta-marginal is M_p: SPEC s3)
+// is one path whose exit direction lands in one bin, with weight 1/N times
+// its Fresnel, masking and absorption factors. Each lobe's total is
+// therefore the model's energy up to the quadrature error, and alpha = 0 is
+// the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
+// smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
+// `quadrature_points` (about 1 s per incidence for 2^20 points).
+#include <memory>
+#include <vector>
+
+#include "analytic/model.h"
+#include "common/fiber_frame.h"
+
+namespace fiberlab::analytic {
+
+enum class HuangMasking { Separable, Correlated, None };
+
+struct Huang2022Params {
+  double eta = 1.55;                       // > 1
+  std::vector<double> sigma_a{0.0};        // 1/R per channel, >= 0
+  double roughness = 0.3;                  // GGX alpha in [0, 1]; 0 = smooth
+  double tilt = 0.0;                       // radians, SPEC's scale_tilt sign
+  double eccentricity = 1.0;               // minor/major in (0, 1]
+  std::vector<double> lobe_scale{1.0, 1.0, 1.0};  // R, TT, TRT (>= 0)
+  HuangMasking masking = HuangMasking::Separable;
+  // true (the paper, Cycles' eval): the light reaching an arc element is
+  // (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
+  // projected width's (every photon that meets the fiber scatters; Cycles'
+  // sampler). They differ by up to tan(tilt) tan(theta_i) (see below).
+  bool mesonormal_flux = true;
+  int lobes = 4;                           // 1..4 (p >= 3 is one residual lobe)
+  long quadrature_points = 1L << 20;       // >= 1024
+};
+
+// The energy a path integration gives, per channel c: lobe energies
+// lobe[l * C + c], the weight removed by masking and by paths stopped on the
+// wrong side, and the weight absorbed (orders p <= 2 exactly; for p >= 3 the
+// residual's geometric series). With sigma_a = 0: sum(lobe) + masked +
+// stopped = incident (every path's weight is one of these).
+struct HuangEnergies {
+  std::vector<double> lobe;
+  std::vector<double> masked, stopped;
+  double incident = 0.0;  // the light reaching the fiber (1 unless mesonormal_flux and tilt)
+};
+
+class Huang2022 : public Model {
+ public:
+  // Throws fiberlab::Error naming the parameter and its allowed range.
+  explicit Huang2022(Huang2022Params params);
+  std::string name() const override { return "huang2022"; }
+  int lobes() const override { return params_.lobes; }
+  // The paper's form: R by its integral over the arc (roughness floored at
+  // 1e-3, as Cycles clamps it: a smooth lobe has no pointwise density), TT
+  // and TRT with the last interface evaluated towards wr and the first ones
+  // by the point set (2^16 points), the residual as M_p / (2 pi).
+  void density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
+               std::vector<double>& out) const override;
+  std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
+                                        double phi_i) const override;
+  // Lobe energies and losses by the same point set as bin_probabilities().
+  HuangEnergies energies(double theta_i, double phi_i) const;
+  const Huang2022Params& params() const { return params_; }
+  // Points of density()'s set for the interfaces before the last (tests).
+  void set_density_points(long n) { density_points_ = n; }
+
+ private:
+  Huang2022Params params_;
+  long density_points_ = 1L << 16;
+};
+
+std::unique_ptr<Model> make_huang2022(const Huang2022Params& params);
+// From ModelParams: eta, sigma_a, eccentricity, scale_tilt (its table calls
+// it `tilt`), ggx_roughness (`roughness`), lobe_scale, huang_masking,
+// quadrature_points, lobes.
+std::unique_ptr<Model> make_huang2022(const ModelParams& params);
+
+}  // namespace fiberlab::analytic

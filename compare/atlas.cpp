@@ -1,0 +1,147 @@
+#include "compare/atlas.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "analytic/model_registry.h"
+#include "common/error.h"
+#include "common/interrupt.h"
+#include "compare/models.h"
+#include "sim/result_file.h"
+#include "sim/simulation.h"
+
+namespace fiberlab::compare {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+void check_interrupt() {
+  if (interrupt_requested()) throw AtlasInterrupted{interrupt_signal()};
+}
+
+void say(const AtlasControl& c, const std::string& line) {
+  if (c.progress) c.progress(line);
+}
+
+sim::ResultFile simulate(const sim::Settings& s, const AtlasControl& control) {
+  const sim::Simulation simulation(s);
+  sim::RunProgress state = simulation.start();
+  sim::RunControl rc;
+  rc.threads = control.threads;
+  if (control.progress) {
+    auto last = std::make_shared<Clock::time_point>(Clock::now());
+    rc.progress = [last, &control](std::uint64_t done, std::uint64_t total) {
+      if (seconds_since(*last) < 2.0 && done != total) return;
+      *last = Clock::now();
+      control.progress(fmt::format("  simulating: {} / {} photons", done, total));
+    };
+  }
+  if (simulation.run(state, rc) == sim::RunOutcome::Interrupted) throw AtlasInterrupted{interrupt_signal()};
+  return sim::make_result(s, simulation.grid(), state.tallies);
+}
+
+std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::string& name,
+                                        const analytic::ModelParams& p) {
+  const auto model = compare::make_model(name, p);
+  return compare(r, predict_result(*model, r), p.alpha);
+}
+
+AtlasModelResult evaluate_model(const AtlasConfig& config, const sim::ResultFile& r, const std::string& name,
+                                const AtlasControl& control) {
+  const auto t0 = Clock::now();
+  AtlasModelResult m;
+  m.model = name;
+  analytic::ModelParams p;
+  try {
+    p = params_for(r.settings, ModelSpec{name, {}, name}, {});
+    compare::make_model(name, p);  // the model's own checks
+  } catch (const Error& e) {
+    m.status = std::string("not applicable: ") + e.what();
+    say(control, fmt::format("  {}: {}", name, m.status));
+    return m;
+  }
+  m.applicable = true;
+  m.params_before = analytic::describe_params(name, p);
+  m.before = judge_model(r, name, p);
+  const std::vector<std::string> keys = free_fit_keys(name);
+  if (keys.empty()) {
+    m.status = "not fitted: its parameter table marks no parameter free";
+  } else if (config.max_iterations == 0) {
+    m.status = "not fitted: fit.max_iterations = 0";
+  } else {
+    check_interrupt();
+    try {
+      m.fit = fit_model(r, name, p, keys, Options{}, config.max_iterations, [&](const std::string& line) {
+        check_interrupt();
+        say(control, "  " + name + " " + line);
+      });
+      m.fitted = true;
+      m.status = m.fit.converged ? "fitted" : "fitted (not converged)";
+      m.params_after = analytic::describe_params(name, m.fit.params);
+      m.after = judge_model(r, name, m.fit.params);
+    } catch (const Error& e) {
+      m.status = std::string("fit failed: ") + e.what();
+    }
+  }
+  m.seconds = seconds_since(t0);
+  say(control, fmt::format("  {}: {} ({:.1f} s)", name, m.status, m.seconds));
+  return m;
+}
+
+}  // namespace
+
+AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t index, const AtlasControl& control) {
+  check_interrupt();
+  AtlasFiberResult out;
+  out.fiber = config.fibers.at(index);
+  say(control, fmt::format("fiber {} / {}: {}", index + 1, config.fibers.size(), out.fiber.label));
+  const auto t0 = Clock::now();
+  const sim::ResultFile r = simulate(out.fiber.settings, control);
+  out.sim_seconds = seconds_since(t0);
+  out.theta_i = r.theta_i;
+  out.lobes = r.lobes;
+  out.channels = r.channels;
+  out.photons = r.photons.empty() ? 0 : r.photons[0];
+  for (std::size_t k = 0; k < r.configs(); ++k)
+    for (int l = 0; l < r.lobes; ++l)
+      for (int c = 0; c < r.channels; ++c) {
+        const sim::Estimate e = sim::lobe_energy(r, k, l, c);
+        out.sim_energy.push_back(e.mean);
+        out.sim_error.push_back(e.std_error);
+      }
+  say(control, fmt::format("  simulated in {:.1f} s", out.sim_seconds));
+  const auto t1 = Clock::now();
+  for (const std::string& name : config.models) {
+    check_interrupt();
+    out.models.push_back(evaluate_model(config, r, name, control));
+  }
+  out.fit_seconds = seconds_since(t1);
+  return out;
+}
+
+AtlasLobeSummary summarize_lobe(const AtlasModelResult& m, int lobe) {
+  AtlasLobeSummary s;
+  auto add = [&](const std::vector<LobeComparison>& list, double& chi2, int& dof, double& max_abs, bool before) {
+    for (const LobeComparison& c : list) {
+      if (c.lobe != lobe) continue;
+      const double err = std::fabs(c.model_energy - c.sim_energy);
+      max_abs = std::max(max_abs, err);
+      if (before && c.sim_energy > 0.0 && c.judged)
+        s.max_rel_energy_error = std::max(s.max_rel_energy_error, err / c.sim_energy);
+      if (!c.judged) continue;
+      s.judged = true;
+      chi2 += c.bins.chi2;
+      dof += c.bins.dof;
+    }
+  };
+  add(m.before, s.chi2_before, s.dof_before, s.max_abs_energy_error, true);
+  add(m.after, s.chi2_after, s.dof_after, s.max_abs_energy_error_after, false);
+  return s;
+}
+
+}  // namespace fiberlab::compare

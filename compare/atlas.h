@@ -1,0 +1,75 @@
+#pragma once
+// `fiberlab atlas`: how wrong each registered model is for each physical
+// fiber of a sweep (compare/atlas_config.h), per lobe, before and after
+// fitting the model's free parameters (compare/fit.h, free_fit_keys()).
+//
+// Per fiber: one simulation (every theta_i of the sweep) run in process;
+// then for every model of the config (every registered model by default,
+// so a model added to analytic/model_registry appears here by itself):
+// - its parameters for the fiber (the model's physical defaults,
+//   ModelInfo::from_fiber); a model that refuses the fiber (e.g. a circular
+//   model on an elliptical one) is recorded as not applicable, with why;
+// - the comparison of compare/comparison.h with those ("before");
+// - one joint fit of every free parameter over all theta_i and channels
+//   (a model's parameters describe the fiber, not a lighting direction), and
+//   the comparison again ("after"). A model whose table marks no parameter
+//   free (exact) has no "after".
+// The statistics are compare/'s own; the atlas adds none.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "compare/atlas_config.h"
+#include "compare/comparison.h"
+#include "compare/fit.h"
+
+namespace fiberlab::compare {
+
+struct AtlasModelResult {
+  std::string model;
+  std::string status;  // "fitted", "not fitted: ...", "not applicable: ..."
+  bool applicable = false, fitted = false;
+  std::string params_before, params_after;  // "key=value ..." (command-line units)
+  std::vector<LobeComparison> before, after;  // per (k, lobe, channel), compare()'s order
+  FitResult fit;       // keys empty when not fitted
+  double seconds = 0.0;
+};
+
+struct AtlasFiberResult {
+  AtlasFiber fiber;
+  std::vector<double> theta_i;        // radians, K
+  int lobes = 0, channels = 0;
+  std::vector<double> sim_energy, sim_error;  // K x L x C (the ledger's lobe energies)
+  std::uint64_t photons = 0;          // per incident direction
+  double sim_seconds = 0.0, fit_seconds = 0.0;
+  std::vector<AtlasModelResult> models;
+};
+
+// Thrown when SIGINT/SIGTERM stopped the sweep (no output is written).
+struct AtlasInterrupted {
+  int signal = 0;
+};
+
+struct AtlasControl {
+  int threads = 0;  // <= 0: OpenMP's default
+  // One line at a time for stderr (fiber started, simulation progress, fit
+  // iterations); may be empty.
+  std::function<void(const std::string&)> progress;
+};
+
+// Simulates and judges one fiber. Throws AtlasInterrupted on a signal
+// (install_interrupt_handlers() must have been called by the command).
+AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t fiber, const AtlasControl& control);
+
+// Summary per fiber, model and lobe, over every theta_i and channel.
+struct AtlasLobeSummary {
+  double max_abs_energy_error = 0.0;     // max |E_model - E_sim| (fraction of incident light)
+  double max_rel_energy_error = 0.0;     // max |E_model - E_sim| / E_sim over judged entries
+  double chi2_before = 0.0, chi2_after = 0.0;
+  int dof_before = 0, dof_after = 0;
+  double max_abs_energy_error_after = 0.0;
+  bool judged = false;
+};
+AtlasLobeSummary summarize_lobe(const AtlasModelResult& m, int lobe);
+
+}  // namespace fiberlab::compare

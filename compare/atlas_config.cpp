@@ -1,0 +1,261 @@
+#include "compare/atlas_config.h"
+
+#include <fmt/core.h>
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+
+#include "analytic/model_registry.h"
+#include "common/error.h"
+#include "common/units.h"
+
+namespace fiberlab::compare {
+
+namespace {
+
+constexpr std::size_t kMaxConfigBytes = 1 << 20;
+constexpr std::size_t kMaxFibers = 10000;
+
+// One-line errors naming the file and the entry.
+struct Reader {
+  std::string origin;
+  [[noreturn]] void fail(const std::string& what) const {
+    std::string line = origin + ": " + what;
+    for (char& c : line)
+      if (c == '\n' || c == '\r') c = ' ';
+    throw Error(line);
+  }
+};
+
+std::string show(const YAML::Node& n) {
+  if (!n.IsDefined() || n.IsNull()) return "(nothing)";
+  YAML::Emitter e;
+  e.SetMapFormat(YAML::Flow);
+  e.SetSeqFormat(YAML::Flow);
+  e << n;
+  return e.c_str();
+}
+
+void only_keys(const Reader& r, const YAML::Node& map, const std::string& path,
+               const std::set<std::string>& allowed) {
+  if (!map.IsMap()) r.fail(fmt::format("{} = {} must be a mapping", path.empty() ? "the config" : path, show(map)));
+  std::string list;
+  for (const auto& a : allowed) list += (list.empty() ? "" : ", ") + a;
+  for (const auto& kv : map) {
+    const std::string key = kv.first.Scalar();
+    if (!allowed.count(key))
+      r.fail(fmt::format("unknown key {}{} (allowed: {})", path.empty() ? "" : path + ".", key, list));
+  }
+}
+
+double number(const Reader& r, const YAML::Node& n, const std::string& path) {
+  double x = 0.0;
+  if (!n.IsScalar() || !YAML::convert<double>::decode(n, x) || !std::isfinite(x))
+    r.fail(fmt::format("{} = {} must be a finite number", path, show(n)));
+  return x;
+}
+
+std::uint64_t integer(const Reader& r, const YAML::Node& n, const std::string& path, double lo, double hi) {
+  const double x = number(r, n, path);
+  if (x != std::floor(x) || x < lo || x > hi)
+    r.fail(fmt::format("{} = {} must be an integer in [{:g}, {:g}]", path, show(n), lo, hi));
+  return static_cast<std::uint64_t>(x);
+}
+
+// A non-empty list (a single value is a list of one).
+std::vector<YAML::Node> items(const Reader& r, const YAML::Node& n, const std::string& path) {
+  std::vector<YAML::Node> out;
+  if (!n.IsDefined() || n.IsNull()) r.fail(fmt::format("{} is missing (a non-empty list)", path));
+  if (n.IsSequence()) {
+    for (const auto& x : n) out.push_back(x);
+  } else {
+    out.push_back(n);
+  }
+  if (out.empty()) r.fail(fmt::format("{} is empty (give at least one entry)", path));
+  return out;
+}
+
+std::vector<double> numbers(const Reader& r, const YAML::Node& n, const std::string& path) {
+  std::vector<double> out;
+  const auto list = items(r, n, path);
+  for (std::size_t i = 0; i < list.size(); ++i) out.push_back(number(r, list[i], fmt::format("{}[{}]", path, i)));
+  return out;
+}
+
+// The size of a roughness entry for tables and figures: beta_long (degrees)
+// for gaussian / exit_blur, alpha for microfacet models, 0 for smooth.
+void roughness_size(const YAML::Node& entry, AtlasFiber& f) {
+  f.roughness_model = entry["model"] && entry["model"].IsScalar() ? entry["model"].Scalar() : "gaussian";
+  f.roughness = 0.0;
+  for (const char* key : {"alpha", "beta_long", "beta"}) {
+    const YAML::Node v = entry[key];
+    if (!v) continue;
+    const YAML::Node first = v.IsSequence() && v.size() > 0 ? v[0] : v;
+    double x = 0.0;
+    if (first.IsScalar() && YAML::convert<double>::decode(first, x)) f.roughness = x;
+    f.roughness_unit = std::string(key) == "alpha" ? "" : "deg";
+    break;
+  }
+}
+
+std::string absorption_label(const Reader& r, const YAML::Node& entry, const std::string& path) {
+  only_keys(r, entry, path, {"sigma_a", "melanin"});
+  if (entry["sigma_a"] && entry["melanin"]) r.fail(path + " gives both sigma_a and melanin (give one)");
+  if (entry["sigma_a"]) {
+    std::string s;
+    for (double x : numbers(r, entry["sigma_a"], path + ".sigma_a")) s += (s.empty() ? "" : ",") + fmt::format("{:g}", x);
+    return "sigma_a=" + s;
+  }
+  if (entry["melanin"]) {
+    const YAML::Node m = entry["melanin"];
+    only_keys(r, m, path + ".melanin", {"eumelanin", "pheomelanin"});
+    return fmt::format("melanin {:g}/{:g}", m["eumelanin"] ? number(r, m["eumelanin"], path + ".melanin.eumelanin") : 0.0,
+                       m["pheomelanin"] ? number(r, m["pheomelanin"], path + ".melanin.pheomelanin") : 0.0);
+  }
+  r.fail(path + " gives neither sigma_a nor melanin (give one)");
+}
+
+bool is_microfacet(const std::string& model) { return model == "beckmann" || model == "ggx"; }
+
+// The simulator config of one fiber, parsed by the simulator's own parser.
+sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML::Node& roughness,
+                             const YAML::Node& absorption, double tilt, double eccentricity,
+                             const YAML::Node& theta_i, const std::string& where, const std::string& model) {
+  YAML::Node c;
+  c["photons"] = top["photons"];
+  c["seed"] = top["seed"] ? top["seed"] : YAML::Node(1);
+  c["output"] = "atlas_fiber.h5";  // never written: the atlas simulates in process
+  YAML::Node fiber;
+  fiber["eta"] = top["eta"] ? top["eta"] : YAML::Node(1.55);
+  fiber["eccentricity"] = eccentricity;
+  fiber["scale_tilt"] = tilt;
+  for (const auto& kv : absorption) fiber[kv.first.Scalar()] = kv.second;
+  c["fiber"] = fiber;
+  c["roughness"] = roughness;
+  YAML::Node source;
+  source["theta_i"] = theta_i;
+  source["phi_i"] = 0.0;
+  c["source"] = source;
+  if (top["tally"]) c["tally"] = top["tally"];
+  YAML::Emitter e;
+  e << c;
+  try {
+    return sim::parse_settings_yaml(e.c_str(), "fiber");
+  } catch (const Error& err) {
+    if (is_microfacet(model))
+      r.fail(fmt::format("{}: roughness model {} is not yet in this simulator (issue 12 part 1; allowed "
+                         "now: smooth | gaussian | exit_blur); the simulator said: {}",
+                         where, model, err.what()));
+    r.fail(fmt::format("{}: {}", where, err.what()));
+  }
+}
+
+std::vector<std::string> read_models(const Reader& r, const YAML::Node& n) {
+  const std::vector<std::string> all = analytic::model_names();
+  if (!n || (n.IsScalar() && n.Scalar() == "all")) return all;
+  std::set<std::string> wanted;
+  const auto list = items(r, n, "models");
+  for (std::size_t i = 0; i < list.size(); ++i) {
+    const std::string name = list[i].IsScalar() ? list[i].Scalar() : show(list[i]);
+    bool known = false;
+    for (const auto& m : all) known = known || m == name;
+    if (!known) {
+      std::string allowed = "all";
+      for (const auto& m : all) allowed += " | " + m;
+      r.fail(fmt::format("models[{}] = {} is not a registered model (allowed: {})", i, name, allowed));
+    }
+    wanted.insert(name);
+  }
+  std::vector<std::string> out;
+  for (const auto& m : all)
+    if (wanted.count(m)) out.push_back(m);
+  return out;
+}
+
+}  // namespace
+
+AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin) {
+  const Reader r{origin};
+  YAML::Node top;
+  try {
+    top = YAML::Load(yaml_text);
+  } catch (const YAML::Exception& e) {
+    r.fail(fmt::format("malformed YAML at line {}: {}", e.mark.line + 1, e.msg));
+  }
+  if (!top.IsDefined() || top.IsNull()) r.fail("the config is empty (see configs/atlas_small.yaml)");
+  only_keys(r, top, "", {"photons", "seed", "eta", "tally", "sweep", "models", "fit"});
+  if (!top["photons"]) r.fail("photons is missing (photons per fiber and incident direction, an integer >= 1)");
+  integer(r, top["photons"], "photons", 1, 1e12);
+  if (!top["sweep"]) r.fail("sweep is missing (roughness, absorption, scale_tilt, eccentricity, theta_i lists)");
+  const YAML::Node sweep = top["sweep"];
+  only_keys(r, sweep, "sweep", {"roughness", "absorption", "scale_tilt", "eccentricity", "theta_i"});
+
+  AtlasConfig c;
+  c.path = origin;
+  c.yaml = yaml_text;
+  c.models = read_models(r, top["models"]);
+  if (const YAML::Node fit = top["fit"]) {
+    only_keys(r, fit, "fit", {"max_iterations"});
+    if (fit["max_iterations"])
+      c.max_iterations = static_cast<int>(integer(r, fit["max_iterations"], "fit.max_iterations", 0, 1000));
+  }
+  const auto roughness = items(r, sweep["roughness"], "sweep.roughness");
+  const auto absorption = sweep["absorption"] ? items(r, sweep["absorption"], "sweep.absorption")
+                                              : std::vector<YAML::Node>{YAML::Load("{sigma_a: 0.0}")};
+  const auto tilts = sweep["scale_tilt"] ? numbers(r, sweep["scale_tilt"], "sweep.scale_tilt") : std::vector<double>{0.0};
+  const auto eccs =
+      sweep["eccentricity"] ? numbers(r, sweep["eccentricity"], "sweep.eccentricity") : std::vector<double>{1.0};
+  const YAML::Node theta_node = sweep["theta_i"];
+  const auto theta = numbers(r, theta_node, "sweep.theta_i");
+  for (double t : theta) c.theta_i.push_back(deg_to_rad(t));
+  std::vector<std::string> absorption_labels;
+  for (std::size_t a = 0; a < absorption.size(); ++a)
+    absorption_labels.push_back(absorption_label(r, absorption[a], fmt::format("sweep.absorption[{}]", a)));
+  for (std::size_t g = 0; g < roughness.size(); ++g)
+    if (!roughness[g].IsMap()) r.fail(fmt::format("sweep.roughness[{}] = {} must be a roughness block such as "
+                                                  "{{model: gaussian, beta_long: 5}}", g, show(roughness[g])));
+  if (roughness.size() * absorption.size() * tilts.size() * eccs.size() > kMaxFibers)
+    r.fail(fmt::format("the sweep has more than {} fibers (shorten its lists)", kMaxFibers));
+
+  for (std::size_t g = 0; g < roughness.size(); ++g)
+    for (std::size_t a = 0; a < absorption.size(); ++a)
+      for (std::size_t t = 0; t < tilts.size(); ++t)
+        for (std::size_t e = 0; e < eccs.size(); ++e) {
+          AtlasFiber f;
+          roughness_size(roughness[g], f);
+          const std::string where =
+              fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e);
+          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], theta_node, where,
+                                      f.roughness_model);
+          f.roughness_index = static_cast<int>(g);
+          f.absorption_index = static_cast<int>(a);
+          f.tilt_index = static_cast<int>(t);
+          f.eccentricity_index = static_cast<int>(e);
+          f.absorption_label = absorption_labels[a];
+          const std::string size = f.roughness_model == "smooth" ? ""
+                                   : f.roughness_unit == "deg" ? fmt::format(" {:g} deg", f.roughness)
+                                                               : fmt::format(" alpha {:g}", f.roughness);
+          f.label = fmt::format("{}{}, {}, tilt {:g}, e {:g}", f.roughness_model, size, f.absorption_label,
+                                tilts[t], eccs[e]);
+          c.fibers.push_back(std::move(f));
+        }
+  return c;
+}
+
+AtlasConfig load_atlas_config(const std::string& path) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) throw Error(path + ": cannot read atlas config: it is a directory");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error(path + ": cannot read atlas config: no such readable file");
+  std::string text(kMaxConfigBytes + 1, '\0');
+  in.read(text.data(), static_cast<std::streamsize>(text.size()));
+  if (in.bad()) throw Error(path + ": cannot read atlas config: read error");
+  text.resize(static_cast<std::size_t>(in.gcount()));
+  if (text.size() > kMaxConfigBytes) throw Error(path + ": atlas config is larger than 1 MiB");
+  return parse_atlas_config(text, path);
+}
+
+}  // namespace fiberlab::compare

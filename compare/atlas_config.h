@@ -1,0 +1,58 @@
+#pragma once
+// The configuration of `fiberlab atlas` (configs/atlas.yaml is the shipped
+// example; configs/README.md describes every key): which physical fibers to
+// simulate and which models to fit to each.
+//
+//   photons: 200000       # per fiber and incident direction
+//   seed: 1               # every fiber's simulation uses it
+//   eta: 1.55
+//   tally: {n_theta: 36, n_phi: 72, lobes: 4}
+//   sweep:                # every combination of these lists is one fiber
+//     roughness:          # each entry a simulator roughness block (SPEC s3 / s11)
+//       - {model: gaussian, beta_long: 5}
+//       - {model: ggx, alpha: 0.1}       # once the simulator has microfacet roughness
+//     absorption:         # each entry {sigma_a: X or [X, ...]} or {melanin: {eumelanin, pheomelanin}}
+//       - {sigma_a: 0.0}
+//     scale_tilt: [0, 3]  # degrees
+//     eccentricity: [1.0]
+//     theta_i: [0, 30, 60]  # degrees: the incident directions of every fiber
+//   models: all           # or a list of registered model names
+//   fit: {max_iterations: 20}
+//
+// Each fiber is checked by the simulator's own config parser (the entry is
+// written as a simulator config and parsed back), so a roughness model the
+// simulator learns later is accepted here without change. Everything is
+// checked before anything runs: a bad value is one line naming the file, the
+// entry and what is allowed (fiberlab::Error, exit status 2).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sim/settings.h"
+
+namespace fiberlab::compare {
+
+// One physical fiber of the sweep.
+struct AtlasFiber {
+  sim::Settings settings;       // what the simulator traces (every theta_i)
+  std::string label;            // "gaussian 5 deg, sigma_a=0, tilt 3, e 1"
+  std::string roughness_model;  // the simulator's roughness model name
+  double roughness = 0.0;       // its size: beta_long (deg) or alpha; 0 for smooth
+  std::string roughness_unit;   // "deg" (beta) or "" (alpha)
+  int roughness_index = 0, absorption_index = 0, tilt_index = 0, eccentricity_index = 0;
+  std::string absorption_label; // "sigma_a=0.2" or "melanin 0.8/0.1"
+};
+
+struct AtlasConfig {
+  std::string path, yaml;       // the file and its text (stored in the output)
+  std::vector<AtlasFiber> fibers;
+  std::vector<std::string> models;  // registered names, in registry order
+  int max_iterations = 20;
+  std::vector<double> theta_i;  // radians
+};
+
+// Parses and checks the atlas config text; `origin` names it in errors.
+AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin);
+AtlasConfig load_atlas_config(const std::string& path);
+
+}  // namespace fiberlab::compare

@@ -1,0 +1,224 @@
+#include "compare/atlas_file.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/atomic_output.h"
+#include "common/error.h"
+#include "common/file_schema.h"
+#include "common/h5_file.h"
+#include "common/result_layout.h"
+#include "common/units.h"
+
+namespace fiberlab::compare {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string joined(const std::vector<std::string>& lines) {
+  std::string s;
+  for (std::size_t i = 0; i < lines.size(); ++i) s += (i ? "\n" : "") + lines[i];
+  return s;
+}
+
+// Sizes shared by every array.
+struct Shape {
+  hsize_t F, K, L, C;
+  std::size_t at(std::size_t f, std::size_t k, int l, int c) const { return ((f * K + k) * L + l) * C + c; }
+  h5::Dims dims() const { return {F, K, L, C}; }
+};
+
+void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResult>& fibers) {
+  f.create_group("fibers");
+  std::vector<double> roughness, tilt, ecc, sim_s, fit_s, e(s.F * s.K * s.L * s.C, kNaN), se = e;
+  std::vector<std::uint64_t> gi, ai, channels, photons;
+  std::vector<std::string> labels, models, absorption;
+  for (std::size_t i = 0; i < fibers.size(); ++i) {
+    const AtlasFiberResult& r = fibers[i];
+    roughness.push_back(r.fiber.roughness);
+    tilt.push_back(r.fiber.settings.fiber.scale_tilt);
+    ecc.push_back(r.fiber.settings.fiber.eccentricity);
+    sim_s.push_back(r.sim_seconds);
+    fit_s.push_back(r.fit_seconds);
+    gi.push_back(r.fiber.roughness_index);
+    ai.push_back(r.fiber.absorption_index);
+    channels.push_back(r.channels);
+    photons.push_back(r.photons);
+    labels.push_back(r.fiber.label);
+    models.push_back(r.fiber.roughness_model);
+    absorption.push_back(r.fiber.absorption_label);
+    for (std::size_t k = 0; k < s.K; ++k)
+      for (int l = 0; l < r.lobes; ++l)
+        for (int c = 0; c < r.channels; ++c) {
+          const std::size_t src = (k * r.lobes + l) * r.channels + c;
+          e[s.at(i, k, l, c)] = r.sim_energy[src];
+          se[s.at(i, k, l, c)] = r.sim_error[src];
+        }
+  }
+  f.write("fibers/roughness", {s.F}, roughness);
+  f.write("fibers/roughness_index", {s.F}, gi);
+  f.write("fibers/absorption_index", {s.F}, ai);
+  f.write("fibers/scale_tilt", {s.F}, tilt);
+  f.write("fibers/eccentricity", {s.F}, ecc);
+  f.write("fibers/channels", {s.F}, channels);
+  f.write("fibers/photons", {s.F}, photons);
+  f.write("fibers/sim_seconds", {s.F}, sim_s);
+  f.write("fibers/fit_seconds", {s.F}, fit_s);
+  f.write("fibers/sim_energy", s.dims(), e);
+  f.write("fibers/sim_energy_error", s.dims(), se);
+  f.set_attr("/fibers", "labels", joined(labels));
+  f.set_attr("/fibers", "roughness_models", joined(models));
+  f.set_attr("/fibers", "absorption", joined(absorption));
+  describe(f, "/fibers/roughness", "fiber", "degrees (beta) or unitless (alpha)",
+           "roughness size: beta_long for gaussian/exit_blur, alpha for microfacet models, 0 smooth");
+  describe(f, "/fibers/roughness_index", "fiber", "index", "entry of sweep.roughness");
+  describe(f, "/fibers/absorption_index", "fiber", "index", "entry of sweep.absorption");
+  describe(f, "/fibers/scale_tilt", "fiber", "radians", "cuticle scale tilt, towards the root");
+  describe(f, "/fibers/eccentricity", "fiber", "", "minor/major axis ratio");
+  describe(f, "/fibers/channels", "fiber", "channels", "channels of this fiber (later channels are NaN)");
+  describe(f, "/fibers/photons", "fiber", "photons", "photons per incident direction");
+  describe(f, "/fibers/sim_seconds", "fiber", "seconds", "wall time of the simulation");
+  describe(f, "/fibers/fit_seconds", "fiber", "seconds", "wall time of every model's comparison and fit");
+  describe(f, "/fibers/sim_energy", kAtlasDims, "fraction of incident light",
+           "simulated lobe energy (ledger)");
+  describe(f, "/fibers/sim_energy_error", kAtlasDims, "fraction of incident light",
+           "standard error of sim_energy");
+}
+
+void write_model(h5::File& f, const Shape& s, const std::string& name, const std::vector<AtlasFiberResult>& fibers,
+                 std::size_t m) {
+  const std::string g = "models/" + name;
+  f.create_group(g);
+  std::vector<std::string> keys;
+  for (const auto& r : fibers)
+    if (r.models[m].fitted) {
+      keys = r.models[m].fit.keys;
+      break;
+    }
+  const hsize_t P = keys.size();
+  const std::size_t n = s.F * s.K * s.L * s.C;
+  std::vector<double> eb(n, kNaN), ea(n, kNaN), cb(n, kNaN), ca(n, kNaN), db(n, kNaN), da(n, kNaN), judged(n, kNaN);
+  std::vector<double> value(s.F * P, kNaN), error(s.F * P, kNaN), unscaled(s.F * P, kNaN), start(s.F * P, kNaN),
+      bound(s.F * P, kNaN), chi2_start(s.F, kNaN), chi2(s.F, kNaN), dof(s.F, kNaN), iterations(s.F, kNaN),
+      seconds(s.F, kNaN);
+  std::vector<std::uint64_t> applicable(s.F, 0), fitted(s.F, 0), converged(s.F, 0);
+  std::vector<std::string> status, before, after;
+  for (std::size_t i = 0; i < fibers.size(); ++i) {
+    const AtlasModelResult& r = fibers[i].models[m];
+    status.push_back(r.status);
+    before.push_back(r.params_before);
+    after.push_back(r.params_after);
+    applicable[i] = r.applicable;
+    fitted[i] = r.fitted;
+    seconds[i] = r.seconds;
+    auto fill = [&](const std::vector<LobeComparison>& list, std::vector<double>& energy, std::vector<double>& c2,
+                    std::vector<double>& d, bool mark_judged) {
+      for (const LobeComparison& c : list) {
+        const std::size_t at = s.at(i, c.k, c.lobe, c.channel);
+        energy[at] = c.model_energy;
+        c2[at] = c.bins.chi2;
+        d[at] = c.bins.dof;
+        if (mark_judged) judged[at] = c.judged ? 1.0 : 0.0;
+      }
+    };
+    fill(r.before, eb, cb, db, true);
+    fill(r.after, ea, ca, da, false);
+    if (r.fitted) {
+      for (hsize_t j = 0; j < P && j < r.fit.keys.size(); ++j) {
+        value[i * P + j] = r.fit.value[j];
+        error[i * P + j] = r.fit.error[j];
+        unscaled[i * P + j] = r.fit.error_unscaled[j];
+        start[i * P + j] = r.fit.start[j];
+        bound[i * P + j] = r.fit.at_bound[j] ? 1.0 : 0.0;
+      }
+      chi2_start[i] = r.fit.chi2_start;
+      chi2[i] = r.fit.chi2;
+      dof[i] = r.fit.dof;
+      iterations[i] = r.fit.iterations;
+      converged[i] = r.fit.converged;
+    }
+  }
+  std::string key_text;
+  for (const auto& k : keys) key_text += (key_text.empty() ? "" : ",") + k;
+  f.set_attr("/" + g, "fit_keys", key_text);
+  f.set_attr("/" + g, "status", joined(status));
+  f.set_attr("/" + g, "params_before", joined(before));
+  f.set_attr("/" + g, "params_after", joined(after));
+  f.write(g + "/applicable", {s.F}, applicable);
+  f.write(g + "/fitted", {s.F}, fitted);
+  f.write(g + "/converged", {s.F}, converged);
+  f.write(g + "/seconds", {s.F}, seconds);
+  f.write(g + "/model_energy_before", s.dims(), eb);
+  f.write(g + "/model_energy_after", s.dims(), ea);
+  f.write(g + "/chi2_before", s.dims(), cb);
+  f.write(g + "/dof_before", s.dims(), db);
+  f.write(g + "/chi2_after", s.dims(), ca);
+  f.write(g + "/dof_after", s.dims(), da);
+  f.write(g + "/judged", s.dims(), judged);
+  f.write(g + "/fit_start", {s.F, P}, start);
+  f.write(g + "/fit_value", {s.F, P}, value);
+  f.write(g + "/fit_error", {s.F, P}, error);
+  f.write(g + "/fit_error_unscaled", {s.F, P}, unscaled);
+  f.write(g + "/fit_at_bound", {s.F, P}, bound);
+  f.write(g + "/fit_chi2_start", {s.F}, chi2_start);
+  f.write(g + "/fit_chi2", {s.F}, chi2);
+  f.write(g + "/fit_dof", {s.F}, dof);
+  f.write(g + "/fit_iterations", {s.F}, iterations);
+  const std::string dims4 = kAtlasDims;
+  describe(f, "/" + g + "/applicable", "fiber", "0/1", "1: the model accepted the fiber (status says why not)");
+  describe(f, "/" + g + "/fitted", "fiber", "0/1", "1: the free parameters were fitted");
+  describe(f, "/" + g + "/converged", "fiber", "0/1", "1: the fit converged");
+  describe(f, "/" + g + "/seconds", "fiber", "seconds", "wall time of this model's comparison and fit");
+  describe(f, "/" + g + "/model_energy_before", dims4, "fraction of incident light",
+           "the model's lobe energy with its physical defaults (NaN: not applicable)");
+  describe(f, "/" + g + "/model_energy_after", dims4, "fraction of incident light",
+           "the model's lobe energy with the fitted parameters (NaN: not fitted)");
+  describe(f, "/" + g + "/chi2_before", dims4, "", "chi-square of the bins (compare/comparison.h), physical defaults");
+  describe(f, "/" + g + "/dof_before", dims4, "", "its degrees of freedom");
+  describe(f, "/" + g + "/chi2_after", dims4, "", "chi-square of the bins with the fitted parameters");
+  describe(f, "/" + g + "/dof_after", dims4, "", "its degrees of freedom");
+  describe(f, "/" + g + "/judged", dims4, "0/1", "1: the lobe has enough energy to be judged");
+  describe(f, "/" + g + "/fit_start", "fiber,fit_key", "the key's unit (degrees for angles)",
+           "start value of each fit key (attribute fit_keys)");
+  describe(f, "/" + g + "/fit_value", "fiber,fit_key", "the key's unit (degrees for angles)", "fitted value");
+  describe(f, "/" + g + "/fit_error", "fiber,fit_key", "the key's unit",
+           "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
+  describe(f, "/" + g + "/fit_error_unscaled", "fiber,fit_key", "the key's unit", "sqrt(diag((J^T W J)^-1))");
+  describe(f, "/" + g + "/fit_at_bound", "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
+  describe(f, "/" + g + "/fit_chi2_start", "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
+  describe(f, "/" + g + "/fit_chi2", "fiber", "", "the fit's chi-square at the minimum");
+  describe(f, "/" + g + "/fit_dof", "fiber", "", "residuals minus fitted parameters");
+  describe(f, "/" + g + "/fit_iterations", "fiber", "", "Levenberg-Marquardt iterations");
+}
+
+}  // namespace
+
+void write_atlas_file(const std::string& path, const AtlasConfig& config,
+                      const std::vector<AtlasFiberResult>& fibers) {
+  if (fibers.empty()) throw Error("atlas: no fiber was simulated");
+  Shape s{fibers.size(), config.theta_i.size(), static_cast<hsize_t>(fibers[0].lobes), 1};
+  for (const auto& r : fibers) s.C = std::max<hsize_t>(s.C, r.channels);
+  AtomicOutput out(path);
+  {
+    h5::File f = h5::File::create(out.temp_path());
+    write_file_identity(f, "fiber-atlas", utc_timestamp());
+    f.set_attr("/", "config_yaml", config.yaml);
+    std::string models;
+    for (const auto& m : config.models) models += (models.empty() ? "" : ",") + m;
+    f.set_attr("/", "models", models);
+    f.set_attr("/", "lobe_names", join_names(lobe_names(static_cast<int>(s.L))));
+    f.write("theta_i", {s.K}, config.theta_i);
+    describe(f, "/theta_i", "incidence", "radians", "incident inclinations, the same for every fiber");
+    write_fibers(f, s, fibers);
+    f.create_group("models");
+    for (std::size_t m = 0; m < config.models.size(); ++m) write_model(f, s, config.models[m], fibers, m);
+    f.close();
+  }
+  out.commit();
+}
+
+}  // namespace fiberlab::compare

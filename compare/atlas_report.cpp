@@ -1,0 +1,136 @@
+#include "compare/atlas_report.h"
+
+#include <fmt/core.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "common/file_schema.h"
+#include "compare/atlas_file.h"
+#include "compare/report.h"
+
+namespace fiberlab::compare {
+
+namespace {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return std::nan("");
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+std::string num(double x, const char* spec = "{:.3g}") {
+  return std::isfinite(x) ? fmt::format(fmt::runtime(spec), x) : std::string("-");
+}
+
+double per_dof(double chi2, int dof) { return dof > 0 ? chi2 / dof : std::nan(""); }
+
+std::string fitted_params(const AtlasModelResult& m) {
+  if (!m.fitted) return m.status;
+  std::string s;
+  for (std::size_t j = 0; j < m.fit.keys.size(); ++j)
+    s += fmt::format("{}{} = {:.4g} ± {:.2g}{}", j ? ", " : "", m.fit.keys[j], m.fit.value[j], m.fit.error[j],
+                     m.fit.at_bound[j] ? " (at bound)" : "");
+  return s;
+}
+
+int lobe_count(const std::vector<AtlasFiberResult>& fibers) { return fibers.empty() ? 0 : fibers[0].lobes; }
+
+}  // namespace
+
+std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+  const int L = lobe_count(fibers);
+  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | after fit |\n"
+                  "|---|---|---|---|---|---|---|\n";
+  for (std::size_t m = 0; m < config.models.size(); ++m)
+    for (int l = 0; l < L; ++l) {
+      std::vector<double> eb, ea, cb, ca;
+      int applicable = 0;
+      for (const auto& f : fibers) {
+        const AtlasModelResult& r = f.models[m];
+        if (!r.applicable) continue;
+        ++applicable;
+        const AtlasLobeSummary sum = summarize_lobe(r, l);
+        eb.push_back(sum.max_abs_energy_error);
+        if (r.fitted) ea.push_back(sum.max_abs_energy_error_after);
+        if (sum.dof_before > 0) cb.push_back(per_dof(sum.chi2_before, sum.dof_before));
+        if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
+      }
+      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable, lobe_name(l, L),
+                       num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"), num(median(cb)), num(median(ca)));
+    }
+  return s;
+}
+
+std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+  const int L = lobe_count(fibers);
+  std::string s = "| fiber | model | fitted parameters (or why not) |";
+  std::string rule = "|---|---|---|";
+  for (int l = 0; l < L; ++l) {
+    s += fmt::format(" {}: max\\|ΔE\\| | {}: χ²/dof |", lobe_name(l, L), lobe_name(l, L));
+    rule += "---|---|";
+  }
+  s += "\n" + rule + "\n";
+  for (std::size_t i = 0; i < fibers.size(); ++i)
+    for (std::size_t m = 0; m < config.models.size(); ++m) {
+      const AtlasModelResult& r = fibers[i].models[m];
+      s += fmt::format("| {}. {} | {} | {} |", i + 1, fibers[i].fiber.label, r.model, fitted_params(r));
+      for (int l = 0; l < L; ++l) {
+        if (!r.applicable) {
+          s += " - | - |";
+          continue;
+        }
+        const AtlasLobeSummary sum = summarize_lobe(r, l);
+        if (r.fitted)
+          s += fmt::format(" {} → {} | {} → {} |", num(sum.max_abs_energy_error, "{:.4f}"),
+                           num(sum.max_abs_energy_error_after, "{:.4f}"), num(per_dof(sum.chi2_before, sum.dof_before)),
+                           num(per_dof(sum.chi2_after, sum.dof_after)));
+        else
+          s += fmt::format(" {} | {} |", num(sum.max_abs_energy_error, "{:.4f}"),
+                           num(per_dof(sum.chi2_before, sum.dof_before)));
+      }
+      s += "\n";
+    }
+  return s;
+}
+
+std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
+                               const std::vector<AtlasFiberResult>& fibers, const std::string& command) {
+  make_report_dir(dir);
+  write_atlas_file((std::filesystem::path(dir) / "report_data.h5").string(), config, fibers);
+  double sim_s = 0.0, fit_s = 0.0;
+  for (const auto& f : fibers) {
+    sim_s += f.sim_seconds;
+    fit_s += f.fit_seconds;
+  }
+  const std::string headline = atlas_headline_markdown(config, fibers);
+  const std::string table = atlas_table_markdown(config, fibers);
+  std::string md = fmt::format(
+      "# fiberlab atlas: {}\n\nCommand: `{}`. Data: `{}` (format fiber-atlas, docs/FILE_FORMAT.md).\n\n"
+      "{} fibers x {} incident directions, {} photons per fiber and direction; simulation {:.0f} s, "
+      "comparisons and fits {:.0f} s ({:.1f} s per fiber).\n\n"
+      "ΔE: |E_model - E_sim| of a lobe (fraction of the incident light), the largest over theta_i and "
+      "channels. χ²/dof: the bins' chi-square (compare/comparison.h) summed over theta_i and channels. "
+      "\"before\": the model's physical defaults for the fiber; \"after\": its free parameters fitted jointly "
+      "over every theta_i (compare/fit.h).\n\n## Per model and lobe (median over fibers)\n\n{}\n"
+      "## Per fiber\n\n{}\n",
+      config.path, command, atlas_path, fibers.size(), config.theta_i.size(),
+      fibers.empty() ? 0 : fibers[0].photons, sim_s, fit_s,
+      fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(), headline, table);
+  // The tables for the page (scripts/plot_atlas.py turns them into HTML).
+  write_text(dir, "atlas_tables.md",
+             "## Per model and lobe (median over fibers)\n\n" + headline + "\n## Per fiber\n\n" + table);
+  const PlotOutcome plots = make_plots("atlas", dir);
+  if (!plots.pngs.empty()) {
+    md += "## Figures\n\n";
+    for (const auto& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
+  }
+  if (!plots.ran) md += plots.message + "\n";
+  write_text(dir, "report.md", md);
+  return fmt::format("report: {}/report.md{}{}\n", dir, plots.html ? ", " + dir + "/report.html" : "",
+                     plots.ran ? "" : " (" + plots.message + ")");
+}
+
+}  // namespace fiberlab::compare

@@ -1,0 +1,339 @@
+// Huang, Hullin, Hanika 2022 (analytic/huang2022.h) against oracles: the
+// exact smooth cylinder (SPEC s7/s8) at zero and small roughness, per lobe
+// and per phi bin; the white furnace, whose only losses are the masking and
+// paths stopped on the wrong side (the stopped part vanishing as the
+// roughness does); the incident flux onto the tilted mesonormal at normal
+// incidence (cos tilt, in closed form); mirror symmetries; the sign of the
+// tilt; the paper's pointwise density (R by its arc integral, TT with the
+// last interface evaluated analytically) against the push-forward bins.
+// Each test names the mutation of the model it was checked to catch.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numeric>
+
+#include "analytic/huang2022.h"
+#include "analytic/model_registry.h"
+#include "analytic/quadrature.h"
+#include "analytic/smooth_cylinder.h"
+#include "common/bin_grid.h"
+#include "common/error.h"
+#include "common/fiber_frame.h"
+#include "common/fresnel.h"
+#include "common/units.h"
+
+using namespace fiberlab;
+using namespace fiberlab::analytic;
+
+namespace {
+
+Huang2022Params fiber(double roughness, long points = 1L << 16) {
+  Huang2022Params p;
+  p.sigma_a = {0.0};
+  p.roughness = roughness;
+  p.quadrature_points = points;
+  return p;
+}
+
+double sum(const std::vector<double>& v) { return std::accumulate(v.begin(), v.end(), 0.0); }
+
+// SPEC s8: smooth circle, eta 1.55, sigma_a 0: R, TT, TRT, p >= 3.
+struct Known {
+  double theta_deg, e[4];
+};
+const Known kKnown[] = {{0.0, {0.07496, 0.86179, 0.05567, 0.00758}},
+                        {60.0, {0.17347, 0.69735, 0.10201, 0.02717}},
+                        {80.0, {0.48968, 0.27305, 0.12312, 0.11415}}};
+
+// Sum over theta of the bins of one lobe and channel, per phi bin.
+std::vector<double> phi_marginal(const std::vector<double>& b, const BinGrid& g, int lobe, int C, int c) {
+  std::vector<double> m(g.n_phi(), 0.0);
+  for (int i = 0; i < g.n_theta(); ++i)
+    for (int j = 0; j < g.n_phi(); ++j)
+      m[j] += b[((static_cast<std::size_t>(lobe) * g.n_theta() + i) * g.n_phi() + j) * C + c];
+  return m;
+}
+
+}  // namespace
+
+// Oracle: SPEC s8's lobe energies of the smooth cylinder. Roughness 0 with
+// no tilt is that cylinder (orders p >= 3: with sigma_a = 0 the residual
+// carries all the light that reaches the third interface's reflection).
+// Mutations caught: eta instead of 1/eta at the inner interfaces (TT, TRT
+// off by > 0.1); the entry weight without cos(g) (every lobe off);
+// refraction weight F instead of 1 - F.
+TEST(Huang2022, SmoothLimitIsTheExactCylinder) {
+  for (const Known& k : kKnown) {
+    const Huang2022 model(fiber(0.0));
+    const HuangEnergies e = model.energies(deg_to_rad(k.theta_deg), 0.0);
+    for (int l = 0; l < 4; ++l) EXPECT_NEAR(e.lobe[l], k.e[l], 2e-5) << k.theta_deg << " lobe " << l;
+    EXPECT_NEAR(e.incident, 1.0, 1e-9);  // the midpoint rule of cos over the entry angle
+    EXPECT_NEAR(e.masked[0] + e.stopped[0], 0.0, 1e-12);
+  }
+}
+
+// Oracle: the same energies, approached continuously: the distance to the
+// smooth cylinder shrinks with the GGX roughness (1e-2, 1e-3, 1e-4) and at
+// 1e-4 every lobe is within 2e-3 of SPEC s8 (GGX's long tails make 1e-2
+// already move 2% of TT near the critical angle at 60 deg, 1e-3 still 1% of
+// p >= 3 at 80 deg: real, not quadrature), with a masking loss below 1e-3.
+// Mutations caught: as the smooth limit's.
+TEST(Huang2022, SmallRoughnessApproachesTheExactCylinder) {
+  for (const Known& k : kKnown) {
+    double previous = 1.0;
+    for (double alpha : {1e-2, 1e-3, 1e-4}) {
+      const Huang2022 model(fiber(alpha));
+      const HuangEnergies e = model.energies(deg_to_rad(k.theta_deg), 0.0);
+      double distance = 0.0;
+      for (int l = 0; l < 4; ++l) {
+        distance += std::abs(e.lobe[l] - k.e[l]);
+        if (alpha <= 1e-4) EXPECT_NEAR(e.lobe[l], k.e[l], 2e-3) << k.theta_deg << " lobe " << l;
+      }
+      EXPECT_LT(distance, previous) << k.theta_deg << " alpha " << alpha;
+      previous = distance;
+      if (alpha <= 1e-3) EXPECT_LT(e.masked[0], 1e-3);
+    }
+  }
+}
+
+// Oracle: the exact cylinder's phi distribution (smooth_cylinder_prediction,
+// bins split at the roots), per bin, for R, TT and TRT at roughness 0, with
+// absorption (chord, SPEC s7), at theta_i = 35 deg; and every exit lies in
+// the theta bin of the specular cone -theta_i.
+// Mutations caught: absorption over the 2D chord instead of the 3D length
+// (TT off by > 1e-3); the residual's series with T_avg and 1 - T_avg swapped
+// (p >= 3 with absorption off). (The relative azimuth's sign is invisible on
+// a circle: tests/compare/test_huang2022_vs_simulation.cpp catches it.)
+TEST(Huang2022, SmoothLimitPhiBinsAreTheExactCylinders) {
+  const double ti = deg_to_rad(35.0);
+  Huang2022Params p = fiber(0.0, 1L << 18);
+  p.sigma_a = {0.3, 1.0};
+  const Huang2022 model(p);
+  const BinGrid g = BinGrid::make(9, 36, ThetaBinning::Uniform);
+  const std::vector<double> b = model.bin_probabilities(g, ti, 0.4);
+  const SmoothCylinderPrediction exact =
+      smooth_cylinder_prediction(1.55, ti, p.sigma_a, Absorption::Chord, 4, 36);
+  for (int lobe = 0; lobe < 3; ++lobe)
+    for (int c = 0; c < 2; ++c) {
+      const std::vector<double> m = phi_marginal(b, g, lobe, 2, c);
+      for (int j = 0; j < 36; ++j)
+        EXPECT_NEAR(m[j], exact.phi_bins[(static_cast<std::size_t>(lobe) * 36 + j) * 2 + c], 2e-4)
+            << "lobe " << lobe << " channel " << c << " bin " << j;
+    }
+  // p >= 3: Cycles' geometric series is exact on the smooth circle, with absorption too.
+  for (int c = 0; c < 2; ++c) {
+    const std::vector<double> m = phi_marginal(b, g, 3, 2, c);
+    EXPECT_NEAR(sum(m), exact.energy[3 * 2 + c], 2e-5) << "channel " << c;
+  }
+  const int spec = g.theta_bin(-ti);
+  double off = 0.0;
+  for (int lobe = 0; lobe < 4; ++lobe)
+    for (int i = 0; i < 9; ++i)
+      for (int j = 0; j < 36; ++j)
+        if (i != spec) off += b[((static_cast<std::size_t>(lobe) * 9 + i) * 36 + j) * 2];
+  EXPECT_EQ(off, 0.0);
+}
+
+// Oracle: energy conservation of the microfacet events (each VNDF-sampled
+// event splits its weight into F and 1 - F exactly): with no absorption,
+// lobes + masked + stopped = incident = 1 (no tilt) to rounding, for every
+// roughness, on circular and elliptical fibers; with masking=none the only
+// loss is `stopped` (paths leaving on the wrong side of a normal), which is
+// small and vanishes with the roughness; with the masking on, the loss
+// grows with the roughness (the paper's G1: energy <= 1).
+// Mutations caught: refraction weight F instead of 1 - F (ledger off);
+// eta instead of 1/eta at the inner interfaces.
+TEST(Huang2022, WhiteFurnaceLosesOnlyToMaskingAndStoppedPaths) {
+  for (double e : {1.0, 0.7}) {
+    double previous_loss = 0.0;
+    for (double alpha : {0.05, 0.2, 0.5}) {
+      for (HuangMasking mk : {HuangMasking::None, HuangMasking::Separable, HuangMasking::Correlated}) {
+        Huang2022Params p = fiber(alpha);
+        p.eccentricity = e;
+        p.masking = mk;
+        const HuangEnergies en = Huang2022(p).energies(deg_to_rad(40.0), deg_to_rad(30.0));
+        const double out = sum(en.lobe);
+        EXPECT_NEAR(en.incident, 1.0, 1e-9);
+        EXPECT_NEAR(out + en.masked[0] + en.stopped[0], en.incident, 1e-11) << e << " " << alpha;
+        EXPECT_LE(out, 1.0);
+        if (mk == HuangMasking::None) {
+          EXPECT_EQ(en.masked[0], 0.0);
+          EXPECT_LT(en.stopped[0], 0.5 * alpha) << e << " " << alpha;
+        }
+        if (mk == HuangMasking::Separable) {
+          const double loss = en.masked[0] + en.stopped[0];
+          EXPECT_GT(loss, previous_loss) << e << " " << alpha;
+          previous_loss = loss;
+        }
+      }
+    }
+  }
+}
+
+// Oracle: at normal incidence the light onto the tilted mesonormal is
+// (wi.ns) = cos(tilt) (wi.n0) everywhere, so the paper's flux is cos(tilt)
+// of the projected width's, in closed form (and 1 with flux=macro).
+// Mutation caught: the flux ratio (wi.ns)/(wi.n0) inverted.
+TEST(Huang2022, MesonormalFluxIsCosTiltAtNormalIncidence) {
+  for (double tilt_deg : {3.0, 10.0}) {
+    Huang2022Params p = fiber(0.2);
+    p.tilt = deg_to_rad(tilt_deg);
+    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, std::cos(p.tilt), 2e-9);
+    p.mesonormal_flux = false;
+    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, 1.0, 1e-9);
+  }
+}
+
+// Oracle: the sign convention of SPEC s2 (tilt > 0 towards the root): the
+// R lobe of a tilted smooth fiber leaves below the specular cone (its mean
+// theta_r < -theta_i, by more than tilt/2), TT above it; tilt 0 is
+// symmetric under theta_i -> -theta_i, theta_r -> -theta_r.
+// Mutation caught: the mesonormal tilted towards the tip (+ sin(tilt) u).
+TEST(Huang2022, TiltMovesRTowardsTheRoot) {
+  const double ti = deg_to_rad(20.0), tilt = deg_to_rad(4.0);
+  Huang2022Params p = fiber(0.0);
+  p.tilt = tilt;
+  const BinGrid g = BinGrid::make(360, 4, ThetaBinning::Uniform);
+  const std::vector<double> b = Huang2022(p).bin_probabilities(g, ti, 0.0);
+  auto mean_theta = [&](int lobe) {
+    double s = 0.0, w = 0.0;
+    for (int i = 0; i < 360; ++i)
+      for (int j = 0; j < 4; ++j) {
+        const double x = b[(static_cast<std::size_t>(lobe) * 360 + i) * 4 + j];
+        s += x * 0.5 * (g.theta_edges[i] + g.theta_edges[i + 1]);
+        w += x;
+      }
+    return s / w;
+  };
+  EXPECT_LT(mean_theta(0), -ti - 0.5 * tilt);
+  EXPECT_GT(mean_theta(1), -ti + 0.25 * tilt);
+}
+
+// Oracle: mirror symmetries of an untilted fiber lit along a symmetry axis
+// of its cross-section (phi_i = 0 or 90 deg): phi -> -phi; and on a circle
+// theta_i -> -theta_i mirrors theta_r (to the quadrature's error: the VNDF
+// map of the point set is not itself mirror-symmetric; bins up to 2e-2).
+// (The entry point mirrored on one side, q_w's sign, is caught by the smooth
+// limit's phi bins and the white furnace.)
+TEST(Huang2022, MirrorSymmetries) {
+  const BinGrid g = BinGrid::make(12, 24, ThetaBinning::Uniform);
+  Huang2022Params p = fiber(0.3);
+  p.eccentricity = 0.8;
+  p.sigma_a = {0.5};
+  for (double phi_i : {0.0, kPi / 2}) {
+    const std::vector<double> b = Huang2022(p).bin_probabilities(g, deg_to_rad(25.0), phi_i);
+    for (int lobe = 0; lobe < 3; ++lobe)
+      for (int i = 0; i < 12; ++i)
+        for (int j = 1; j < 12; ++j) {
+          const std::size_t row = (static_cast<std::size_t>(lobe) * 12 + i) * 24;
+          EXPECT_NEAR(b[row + j], b[row + 23 - j], 5e-4) << phi_i << " " << lobe << " " << i << " " << j;
+        }
+  }
+  p.eccentricity = 1.0;
+  const std::vector<double> up = Huang2022(p).bin_probabilities(g, deg_to_rad(25.0), 0.0);
+  const std::vector<double> down = Huang2022(p).bin_probabilities(g, deg_to_rad(-25.0), 0.0);
+  for (int lobe = 0; lobe < 4; ++lobe)
+    for (int i = 0; i < 12; ++i)
+      for (int j = 0; j < 24; ++j)
+        EXPECT_NEAR(up[(static_cast<std::size_t>(lobe) * 12 + i) * 24 + j],
+                    down[(static_cast<std::size_t>(lobe) * 12 + 11 - i) * 24 + j], 1e-3);
+}
+
+// Oracle: the paper's pointwise form against the push-forward: R's arc
+// integral F D G2 / 4 and TT's last-interface BTDF (VNDF density times
+// Walter's refraction Jacobian), integrated over the sphere, give the lobe
+// energies of the point set; and over one theta band their phi profiles agree.
+// Mutations caught: Walter's Jacobian with eta^2 in the numerator (TT off by
+// eta^2); D of the half vector about n0 instead of the mesonormal (R off
+// with tilt); the R lobe's G2 without G1(wi).
+TEST(Huang2022, PaperDensityIntegratesToTheLobeEnergies) {
+  Huang2022Params p = fiber(0.4);
+  p.tilt = deg_to_rad(3.0);
+  p.sigma_a = {0.2};
+  Huang2022 model(p);
+  model.set_density_points(1L << 13);
+  const double ti = deg_to_rad(30.0);
+  const HuangEnergies e = model.energies(ti, 0.0);
+  const GaussLegendre& gl = gauss_legendre(12);
+  const int nt = 8, nphi = 24;
+  double total[2] = {0.0, 0.0};
+  std::vector<double> v;
+  for (int a = 0; a < nt; ++a)
+    for (int q = 0; q < 12; ++q) {
+      const double t0 = -kPi / 2 + a * kPi / nt, tr = t0 + (0.5 + 0.5 * gl.x[q]) * kPi / nt;
+      const double wt = 0.5 * gl.w[q] * kPi / nt;
+      for (int j = 0; j < nphi; ++j) {
+        const double ph = -kPi + (j + 0.5) * kTwoPi / nphi;
+        for (int lobe = 0; lobe < 2; ++lobe) {
+          if (lobe == 1 && (q % 3 != 1 || j % 2)) continue;  // TT is smooth and costly
+          model.density(lobe, ti, 0.0, tr, ph, v);
+          total[lobe] += v[0] * wt * kTwoPi / nphi * (lobe == 1 ? 6.0 : 1.0);
+        }
+      }
+    }
+  EXPECT_NEAR(total[0], e.lobe[0], 0.02 * e.lobe[0]);
+  EXPECT_NEAR(total[1], e.lobe[1], 0.05 * e.lobe[1]);
+}
+
+// Oracle: the paper's R lobe written from textbook formulas (Walter et al.
+// 2007's GGX: D = alpha^2 / (pi cos^4 (alpha^2 + tan^2)^2), Smith G1 =
+// 2 / (1 + sqrt(1 + alpha^2 tan^2)); the unit circle: dl = dt, projected
+// width 2): S_R = 1/(2 cos theta_i) int F(wi.h) D(h.n) G1(wi) G1(wr) / 4 dt,
+// density S_R cos theta_r, with masking=separable.
+// Mutations caught: Smith's Lambda doubled in the separable masking; D of the
+// half vector about n0 instead of the mesonormal (with tilt: here 0, so via
+// the density test); the R lobe's G2 without G1(wi).
+TEST(Huang2022, RDensityIsTheTextbookMicrofacetIntegral) {
+  const double alpha = 0.25, ti = deg_to_rad(30.0);
+  Huang2022Params p = fiber(alpha);
+  const Huang2022 model(p);
+  auto g1 = [&](double c) {
+    const double t2 = (1.0 - c * c) / (c * c);
+    return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * t2));
+  };
+  auto ggx_d = [&](double c) {
+    const double t2 = (1.0 - c * c) / (c * c);
+    return alpha * alpha / (kPi * c * c * c * c * (alpha * alpha + t2) * (alpha * alpha + t2));
+  };
+  std::vector<double> v;
+  for (double tr_deg : {-40.0, -25.0, 10.0})
+    for (double ph_deg : {0.0, 60.0, 150.0}) {
+      const double tr = deg_to_rad(tr_deg), ph = deg_to_rad(ph_deg);
+      const Vec3 wi = direction_from_angles(ti, 0.0), wr = direction_from_angles(tr, ph);
+      const Vec3 h = (wi + wr).normalized();
+      double s = 0.0;
+      const int n = 20000;
+      for (int k = 0; k < n; ++k) {
+        const double t = (k + 0.5) * kTwoPi / n;
+        const Vec3 nn(0.0, std::cos(t), std::sin(t));
+        const double ci = wi.dot(nn), co = wr.dot(nn), ch = h.dot(nn);
+        if (ci <= 0.0 || co <= 0.0 || ch <= 0.0) continue;
+        s += fresnel_dielectric(wi.dot(h), 1.55) * ggx_d(ch) * g1(ci) * g1(co) / 4.0 * kTwoPi / n;
+      }
+      const double expected = s / (2.0 * std::cos(ti)) * std::cos(tr);
+      model.density(0, ti, 0.0, tr, ph, v);
+      EXPECT_NEAR(v[0], expected, 2e-3 * expected + 1e-9) << tr_deg << " " << ph_deg;
+    }
+}
+
+// The parameter table: defaults, --set parsing and refusals.
+TEST(Huang2022, ParameterTable) {
+  ModelParams p = default_params("huang2022");
+  EXPECT_DOUBLE_EQ(p.ggx_roughness, 0.3);
+  apply_setting("huang2022", p, "roughness=0.1");
+  apply_setting("huang2022", p, "tilt=3");
+  apply_setting("huang2022", p, "masking=correlated");
+  apply_setting("huang2022", p, "quadrature_points=4096");
+  EXPECT_DOUBLE_EQ(p.ggx_roughness, 0.1);
+  EXPECT_NEAR(p.scale_tilt, deg_to_rad(3.0), 1e-15);
+  EXPECT_EQ(p.huang_masking, 1);
+  EXPECT_THROW(apply_setting("huang2022", p, "roughness=1.5"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "eccentricity=0"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "quadrature_points=100"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "beta_m=0.3"), Error);
+  p.sigma_a = {0.1, 0.2, 0.3};
+  auto m = make_model("huang2022", p);
+  EXPECT_EQ(m->name(), "huang2022");
+  const BinGrid g = BinGrid::make(6, 8, ThetaBinning::Uniform);
+  EXPECT_EQ(m->bin_probabilities(g, 0.3, 0.0).size(), 4u * 6 * 8 * 3);
+}
