@@ -1,22 +1,19 @@
 #pragma once
-// The same photon life as Tracer (sim/tracer.h), for unpolarised light,
-// traced for many photons at once: photons live in a pool of lanes kept in
-// structure-of-arrays form, and each interface event and each internal
-// segment is computed for a SIMD vector of lanes (xsimd: 8 doubles with
-// AVX-512). Lanes whose photon has left are refilled with new photons, so the
+// The photon life of sim/photon_life.h traced for many photons at once:
+// photons live in a pool of lanes kept in structure-of-arrays form, and each
+// step (an interface event and the next segment) runs on a SIMD vector of
+// lanes (xsimd: 8 doubles with AVX-512). Lanes whose photon is done are
+// handed to the sink and refilled with new photons from the Source, so the
 // few light-guided photons that run to max_segments do not hold up the rest.
-//
-// Each photon draws from its own random stream in the same order as in
-// Tracer, so a photon's path is the same in both up to the last bits of the
-// vectorised sin/cos/log (tests/sim/test_batch_tracer.cpp checks photon by
-// photon). Tracer stays the readable reference and serves polarization: stokes.
+// This file only manages lanes; the physics is the life's, shared with the
+// reference Tracer, for every roughness model and for scalar and Stokes light.
 #include <cstdint>
 #include <functional>
-#include <vector>
 
 #include "sim/finished_photons.h"
+#include "sim/photon_life.h"
+#include "sim/roughness_models.h"
 #include "sim/settings.h"
-#include "sim/source.h"
 #include "sim/tracer.h"
 
 namespace fiberlab::sim {
@@ -34,21 +31,14 @@ class BatchTracer {
   void trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
              const Sink& sink, TracerCounters& counters) const;
 
-  struct Lanes;  // the photons in flight (defined in batch_tracer.cpp)
-
  private:
-  void launch(Lanes& lanes, int lane, const Source& source, const Eigen::Vector2d& beam,
-              std::uint64_t photon) const;
-  void launch_group(Lanes& lanes, int first_lane, int n, std::uint64_t first_photon,
-                    const Source& source, const Vec3& d, const Eigen::Vector2d& beam,
-                    double phi_i) const;
-  void interface_events(Lanes& lanes, int n_active) const;
-  void travel(Lanes& lanes, int n_active) const;
+  template <class Light, class Model>
+  void trace_with(const Model& model, double theta_i, double phi_i, std::uint64_t first,
+                  std::uint64_t n, const Sink& sink, TracerCounters& counters) const;
 
   const Settings settings_;
-  RoughnessModel model_;  // Tracer::effective_model
-  EllipseCrossSection ellipse_;
-  double cos_tilt_, sin_tilt_;
+  life::LifeConfig config_;
+  AnyRoughness roughness_;
 };
 
 }  // namespace fiberlab::sim

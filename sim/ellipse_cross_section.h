@@ -3,11 +3,16 @@
 // with semi-axes r_v = 1/sqrt(e) along v and r_w = sqrt(e) along w, so that its
 // area is that of the unit circle. Points are (v, w) pairs; directions are 3D
 // fiber-frame vectors (u, v, w) of which only the (v, w) part matters here.
+//
+// The geometry a photon's life uses at every step (normal, distance to the
+// boundary, advance) is written once for a number type T (sim/lanes.h): one
+// photon (double) or a SIMD vector of photons.
 #include <Eigen/Core>
 #include <algorithm>
 #include <cmath>
 
 #include "common/fiber_frame.h"
+#include "sim/lanes.h"
 
 namespace fiberlab::sim {
 
@@ -22,11 +27,51 @@ class EllipseCrossSection {
   double r_v() const { return rv_; }
   double r_w() const { return rw_; }
 
-  // Outward unit normal n0 at a boundary point, in the normal plane.
-  Vec3 normal(const Point2& p) const {
-    const double nv = p.x() * inv_rv2_, nw = p.y() * inv_rw2_;
-    const double inv = 1.0 / std::sqrt(nv * nv + nw * nw);
-    return Vec3(0.0, nv * inv, nw * inv);
+  // Outward unit normal n0 at the boundary point (pv, pw), in the normal
+  // plane: the gradient of v^2 / r_v^2 + w^2 / r_w^2, normalised.
+  template <class T>
+  life::Vec3Of<T> normal_at(const T& pv, const T& pw) const {
+    using namespace life;
+    const T nv = pv * T(inv_rv2_), nw = pw * T(inv_rw2_);
+    const T inv = T(1.0) / sqrt(nv * nv + nw * nw);
+    return {T(0.0), nv * inv, nw * inv};
+  }
+  Vec3 normal(const Point2& p) const { return normal_at(p.x(), p.y()).to_vec3(); }
+
+  // From a boundary point (pv, pw), travelling inside along (., dv, dw): the
+  // 3D distance to the next boundary point. For a point on the ellipse the
+  // quadratic A t^2 + B t + C = 0 has C = 0, so the far root is t = -B / A
+  // exactly. `along_axis` is set where A = 0 (d runs along the fiber axis:
+  // no boundary ahead); t is 0 there.
+  template <class T>
+  T distance_to_boundary(const T& pv, const T& pw, const T& dv, const T& dw,
+                         life::MaskOf<T>& along_axis) const {
+    using namespace life;
+    const T a = dv * dv * T(inv_rv2_) + dw * dw * T(inv_rw2_);
+    const T b = T(2.0) * (pv * dv * T(inv_rv2_) + pw * dw * T(inv_rw2_));
+    along_axis = a <= T(0.0);
+    return select(along_axis, T(0.0), max(T(0.0), -b / a));
+  }
+  // Returns +inf when d runs along the axis.
+  double distance_to_boundary(const Point2& p, const Vec3& d) const {
+    bool along_axis = false;
+    const double t = distance_to_boundary(p.x(), p.y(), d.y(), d.z(), along_axis);
+    return along_axis ? INFINITY : t;
+  }
+
+  // Moves (pv, pw) along d by t and puts it back on the boundary (removes drift).
+  template <class T>
+  void advance(T& pv, T& pw, const T& dv, const T& dw, const T& t) const {
+    using namespace life;
+    const T qv = pv + t * dv, qw = pw + t * dw;
+    const T s = T(1.0) / sqrt(qv * qv * T(inv_rv2_) + qw * qw * T(inv_rw2_));
+    pv = qv * s;
+    pw = qw * s;
+  }
+  Point2 advance(const Point2& p, const Vec3& d, double t) const {
+    double pv = p.x(), pw = p.y();
+    advance(pv, pw, d.y(), d.z(), t);
+    return Point2(pv, pw);
   }
 
   // Where a photon travelling along d (3D, unit) enters, given the impact
@@ -47,24 +92,6 @@ class EllipseCrossSection {
     const Eigen::Vector2d g_perp(-g.y(), g.x());
     const Eigen::Vector2d q = h * g_perp - std::sqrt(std::max(0.0, 1.0 - h * h)) * g;
     return Point2(rv_ * q.x(), rw_ * q.y());
-  }
-
-  // From a boundary point p, travelling inside along d: the 3D distance to
-  // the next boundary point. For p on the ellipse the quadratic
-  // A t^2 + B t + C = 0 has C = 0, so the far root is t = -B / A exactly.
-  // Returns +inf when d runs along the axis (no boundary ahead).
-  double distance_to_boundary(const Point2& p, const Vec3& d) const {
-    const double a = d.y() * d.y() * inv_rv2_ + d.z() * d.z() * inv_rw2_;
-    const double b = 2.0 * (p.x() * d.y() * inv_rv2_ + p.y() * d.z() * inv_rw2_);
-    if (a <= 0.0) return INFINITY;
-    return std::max(0.0, -b / a);
-  }
-
-  // Moves p along d by t and puts it back on the boundary (removes drift).
-  Point2 advance(const Point2& p, const Vec3& d, double t) const {
-    Point2 q(p.x() + t * d.y(), p.y() + t * d.z());
-    const double s = std::sqrt(q.x() * q.x() * inv_rv2_ + q.y() * q.y() * inv_rw2_);
-    return q / s;
   }
 
  private:

@@ -10,6 +10,7 @@
 
 #include "common/fiber_frame.h"
 #include "sim/random.h"
+#include "sim/roughness_smooth.h"
 #include "sim/settings.h"
 
 namespace fiberlab::sim {
@@ -53,6 +54,16 @@ class ExitBlur {
 
  private:
   std::vector<double> v_, beta_azim_;
+};
+
+// Roughness model `exit_blur` (sim/roughness_model.h): smooth interfaces, the
+// exit direction blurred once.
+struct ExitBlurRoughness : life::SmoothRoughness {
+  explicit ExitBlurRoughness(const Settings& s) : blur(s.roughness) {}
+  Vec3 exit_direction(const Vec3& d, int segments, PhotonRandom& rng) const {
+    return blur.apply(d, segments, rng);
+  }
+  ExitBlur blur;
 };
 
 }  // namespace fiberlab::sim

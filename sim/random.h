@@ -5,9 +5,16 @@
 // nor on where its direction sits in a sweep: a sweep split into jobs and
 // merged equals one run (OpenMC's scheme; SPEC section 6, reproducibility).
 // Generator: xoshiro256** (Blackman & Vigna 2018) seeded through SplitMix64.
+//
+// LaneRandom<T> is the generator written once for a number type (sim/lanes.h):
+// one stream (T = double) or W streams side by side (T = Batch), each
+// advancing only where a mask says, so that every photon consumes its own
+// stream in the same order whichever way it is traced.
 #include <bit>
 #include <cmath>
 #include <cstdint>
+
+#include "sim/lanes.h"
 
 namespace fiberlab::sim {
 
@@ -19,27 +26,80 @@ struct RandomState {
   bool has_spare;
 };
 
+namespace life {
+
+template <class T>
+class LaneRandom {
+ public:
+  using Bits = BitsOf<T>;
+  LaneRandom() = default;
+  LaneRandom(Bits s0, Bits s1, Bits s2, Bits s3) : s_{s0, s1, s2, s3} {}
+  const Bits& word(int k) const { return s_[k]; }
+
+  // Uniform in [0, 1) where m (other lanes: any value, stream untouched).
+  T uniform(const MaskOf<T>& m) { return to_unit(next(m)); }
+  // Uniform in (0, 1]: safe under log().
+  T uniform_open0(const MaskOf<T>& m) { return to_unit(next(m)) + T(0x1.0p-53); }
+
+ private:
+  static Bits rotl(const Bits& x, int k) { return (x << k) | (x >> (64 - k)); }
+  static T to_unit(const Bits& x) {
+    if constexpr (std::is_same_v<T, double>) {
+      return static_cast<double>(x >> 11) * 0x1.0p-53;
+    } else {
+      return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x >> 11)) *
+             T(0x1.0p-53);
+    }
+  }
+  // xoshiro256**: result = rotl(s1 * 5, 7) * 9 (multiplies as shifts and adds,
+  // which every SIMD unit has), then the state steps where m.
+  Bits next(const MaskOf<T>& m) {
+    const auto um = bits_mask(m);
+    const Bits x5 = (s_[1] << 2) + s_[1];
+    const Bits r7 = rotl(x5, 7);
+    const Bits result = (r7 << 3) + r7;
+    const Bits t = s_[1] << 17;
+    Bits n2 = s_[2] ^ s_[0];
+    Bits n3 = s_[3] ^ s_[1];
+    const Bits n1 = s_[1] ^ n2;
+    const Bits n0 = s_[0] ^ n3;
+    n2 = n2 ^ t;
+    n3 = rotl(n3, 45);
+    s_[0] = select(um, n0, s_[0]);
+    s_[1] = select(um, n1, s_[1]);
+    s_[2] = select(um, n2, s_[2]);
+    s_[3] = select(um, n3, s_[3]);
+    return result;
+  }
+
+  Bits s_[4];
+};
+
+}  // namespace life
+
+// One photon's stream, with the normal deviates the exit blur draws.
 class PhotonRandom {
  public:
-  explicit PhotonRandom(const RandomState& st) : spare_(st.spare), has_spare_(st.has_spare) {
-    for (int i = 0; i < 4; ++i) s_[i] = st.s[i];
+  explicit PhotonRandom(const RandomState& st)
+      : core_(st.s[0], st.s[1], st.s[2], st.s[3]), spare_(st.spare), has_spare_(st.has_spare) {}
+  explicit PhotonRandom(const life::LaneRandom<double>& core) : core_(core) {}
+  RandomState state() const {
+    return {{core_.word(0), core_.word(1), core_.word(2), core_.word(3)}, spare_, has_spare_};
   }
-  RandomState state() const { return {{s_[0], s_[1], s_[2], s_[3]}, spare_, has_spare_}; }
+  const life::LaneRandom<double>& core() const { return core_; }
+  life::LaneRandom<double>& core() { return core_; }
 
   // The stream of photon `photon` of the incident direction (theta_i,
   // phi_i) (radians as configured; phi_i NaN for a randomly rotated fiber).
   PhotonRandom(std::uint64_t seed, double theta_i, double phi_i, std::uint64_t photon)
       : PhotonRandom(stream_key(seed, theta_i, phi_i), photon) {}
-  // The same from a precomputed stream_key.
-  PhotonRandom(std::uint64_t key, std::uint64_t photon) {
-    std::uint64_t x = splitmix(key ^ photon);
-    for (auto& s : s_) s = x = splitmix(x);
-  }
+  // The same from a precomputed stream_key: the state is SplitMix64 applied
+  // to (key ^ photon), then four more times.
+  PhotonRandom(std::uint64_t key, std::uint64_t photon) : core_(seeded(key, photon)) {}
 
   // What the streams of one incident direction share: SplitMix64 over the
   // seed and the bit patterns of theta_i and phi_i (-0 counted as +0, every
-  // NaN as one value). A photon's state is SplitMix64 applied to
-  // (key ^ photon), then four more times.
+  // NaN as one value).
   static std::uint64_t stream_key(std::uint64_t seed, double theta_i, double phi_i) {
     const std::uint64_t k = splitmix(splitmix(seed ^ 0x6a09e667f3bcc909ULL) ^ angle_bits(theta_i));
     return splitmix(k ^ angle_bits(phi_i));
@@ -56,9 +116,9 @@ class PhotonRandom {
   }
 
   // Uniform in [0, 1).
-  double uniform() { return static_cast<double>(next() >> 11) * 0x1.0p-53; }
+  double uniform() { return core_.uniform(true); }
   // Uniform in (0, 1]: safe under log().
-  double uniform_open0() { return static_cast<double>((next() >> 11) + 1) * 0x1.0p-53; }
+  double uniform_open0() { return core_.uniform_open0(true); }
 
   // Standard normal deviate (Box-Muller, both values used).
   double normal() {
@@ -74,20 +134,14 @@ class PhotonRandom {
   }
 
  private:
-  static std::uint64_t rotl(std::uint64_t x, int k) { return (x << k) | (x >> (64 - k)); }
-  std::uint64_t next() {
-    const std::uint64_t result = rotl(s_[1] * 5, 7) * 9;
-    const std::uint64_t t = s_[1] << 17;
-    s_[2] ^= s_[0];
-    s_[3] ^= s_[1];
-    s_[1] ^= s_[2];
-    s_[0] ^= s_[3];
-    s_[2] ^= t;
-    s_[3] = rotl(s_[3], 45);
-    return result;
+  static life::LaneRandom<double> seeded(std::uint64_t key, std::uint64_t photon) {
+    std::uint64_t s[4];
+    std::uint64_t x = splitmix(key ^ photon);
+    for (auto& w : s) w = x = splitmix(x);
+    return {s[0], s[1], s[2], s[3]};
   }
 
-  std::uint64_t s_[4];
+  life::LaneRandom<double> core_;
   double spare_ = 0.0;
   bool has_spare_ = false;
 };

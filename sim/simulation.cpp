@@ -302,8 +302,7 @@ Simulation::Simulation(Settings settings)
       tracer_(settings_),
       batch_tracer_(settings_),
       // The microfacet models (issue 12) run on the reference tracer for now.
-      use_batch_tracer_(settings_.polarization == Polarization::Scalar &&
-                        !settings_.roughness.microfacet()),
+      use_batch_tracer_(!settings_.roughness.microfacet()),  // scalar and Stokes light
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {

@@ -1,29 +1,19 @@
 #pragma once
-// A photon's life (SPEC sections 3-5): enter the fiber at an impact parameter,
-// meet the boundary, reflect or refract about a drawn normal, run straight
-// segments inside, until it leaves or is truncated. The path does not depend
-// on the colour channel, so the tracer returns the total internal path length
-// and the caller turns it into a Beer-Lambert weight per channel.
-#include <optional>
+// The reference tracer: one photon's life (sim/photon_life.h) at a time, the
+// scalar instantiation of the same steps the batched tracer runs on SIMD
+// vectors of photons (sim/batch_tracer.h).
 #include <vector>
 
 #include "common/fiber_frame.h"
-#include "sim/ellipse_cross_section.h"
-#include "sim/exit_blur.h"
-#include "sim/microfacet_roughness.h"
+#include "sim/photon_life.h"
 #include "sim/random.h"
+#include "sim/roughness_models.h"
 #include "sim/settings.h"
 
 namespace fiberlab::sim {
 
-// Lost: killed by masking (roughness.masking: smith_g1), its weight booked as lost.
+// Lost: a roughness model ended the path (its weight is booked as lost).
 enum class PhotonFate { Exited, Truncated, Lost };
-
-// Weight removed from a photon by masking, and the internal path length it had
-// travelled then: channel c lost weight * exp(-sigma_a[c] * path_length).
-struct WeightLoss {
-  double weight, path_length;
-};
 
 struct PhotonOutcome {
   PhotonFate fate = PhotonFate::Exited;
@@ -48,15 +38,36 @@ struct TracerCounters {
     normal_draws += o.normal_draws;
     sampler_caps += o.sampler_caps;
   }
+  void add(const life::LifeCounts<double>& c) {
+    events += static_cast<long>(c.events);
+    normal_draws += static_cast<long>(c.normal_draws);
+    sampler_caps += static_cast<long>(c.sampler_caps);
+  }
 };
+
+// The outcome of a photon whose life ended with `code`: the exit direction
+// goes through the model's exit hook (exit_blur), if it has one.
+template <class Model>
+PhotonOutcome finished_outcome(const Model& model, int code, const Vec3& d, int segments,
+                               double path, double weight, PhotonRandom& rng) {
+  PhotonOutcome out;
+  out.fate = code == life::kExited      ? PhotonFate::Exited
+             : code == life::kTruncated ? PhotonFate::Truncated
+                                        : PhotonFate::Lost;
+  out.segments = segments;
+  out.path_length = path;
+  out.weight = weight;
+  if (out.fate == PhotonFate::Exited) {
+    out.direction = d;
+    if constexpr (requires { model.exit_direction(d, segments, rng); })
+      out.direction = model.exit_direction(d, segments, rng);
+  }
+  return out;
+}
 
 class Tracer {
  public:
   explicit Tracer(const Settings& settings);
-
-  // The roughness model the tracers apply: gaussian with beta_long = beta_azim
-  // = 0 is the smooth model, fallback included (SPEC section 3).
-  static RoughnessModel effective_model(const RoughnessSettings& r);
 
   // Traces one photon arriving along -wi. h in (-1, 1) is its impact
   // parameter across the projected width.
@@ -64,31 +75,16 @@ class Tracer {
                       TracerCounters* counters = nullptr) const;
 
   // Cap on candidate normals per event (SPEC section 3: at least 10,000).
-  static constexpr int kMaxNormalTries = 100000;
+  static constexpr int kMaxNormalTries = life::kMaxNormalTries;
 
  private:
-  // The photon's life for one kind of light (ScalarLight or StokesLight).
-  template <typename Light>
-  PhotonOutcome trace_with(const Vec3& wi, double h, PhotonRandom& rng,
-                           TracerCounters& counters) const;
-  // Interface events at one boundary point until the consistency rule holds.
-  // False when the photon's life ends there (out.fate says how).
-  template <typename Light>
-  bool scatter_at_boundary(const Point2& p, Vec3& d, bool& inside, Light& light,
-                           PhotonRandom& rng, TracerCounters& counters, PhotonOutcome& out) const;
-  // masking: smith_g1: the weight times G1 of the scattered direction d, the
-  // rest booked as lost; false (fate Lost) when d is on the wrong side.
-  bool apply_masking(const Vec3& mean, const Vec3& d, bool refracted, PhotonOutcome& out) const;
+  template <class Light, class Model>
+  PhotonOutcome trace_with(const Model& model, const Vec3& wi, double h, PhotonRandom& rng,
+                           TracerCounters* counters) const;
 
-  EllipseCrossSection ellipse_;
-  RoughnessModel model_;
+  life::LifeConfig config_;
+  AnyRoughness roughness_;
   Polarization polarization_;
-  double eta_;
-  double cos_tilt_, sin_tilt_;
-  double beta_long_, beta_azim_;          // gaussian
-  ExitBlur exit_blur_;
-  std::optional<MicrofacetRoughness> microfacet_;  // beckmann / ggx
-  int max_segments_, max_events_;
 };
 
 }  // namespace fiberlab::sim

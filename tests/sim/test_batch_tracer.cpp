@@ -35,10 +35,11 @@ void expect_same_photons(const Settings& s, const char* what) {
               },
               counters);
   int differ = 0;
+  TracerCounters reference_counters;
   for (std::uint64_t i = 0; i < n; ++i) {
     ASSERT_EQ(seen[i], 1) << "photon " << i << " reported " << seen[i] << " times";
     LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, s.source.phi_i_uniform);
-    const PhotonOutcome r = reference.trace(p.wi, p.h, p.rng);
+    const PhotonOutcome r = reference.trace(p.wi, p.h, p.rng, &reference_counters);
     ASSERT_EQ(batched_phi[i], p.phi_i);
     const PhotonOutcome& b = batched[i];
     const bool same = r.fate == b.fate && r.segments == b.segments &&
@@ -50,6 +51,11 @@ void expect_same_photons(const Settings& s, const char* what) {
   }
   std::printf("%s: %d of %llu photons differ\n", what, differ, static_cast<unsigned long long>(n));
   EXPECT_LE(differ, static_cast<int>(n / 1000)) << what;
+  // The same work, counted lane by lane in the batch.
+  EXPECT_NEAR(counters.events, reference_counters.events, 1e-3 * reference_counters.events) << what;
+  EXPECT_NEAR(counters.normal_draws, reference_counters.normal_draws,
+              1e-3 * reference_counters.normal_draws) << what;
+  EXPECT_EQ(counters.sampler_caps, reference_counters.sampler_caps) << what;
 }
 
 TEST(BatchTracer, SmoothCircleMatchesReference) {
@@ -84,6 +90,18 @@ TEST(BatchTracer, SteepTiltMatchesReference) {
   testing::make_rough(s, 5.0, 20.0);
   s.max_segments = 30;
   expect_same_photons(s, "tilt 20, beta 5, max_segments 30");
+}
+
+// Stokes light (SPEC section 3) runs batched too: the Stokes vector and its
+// reference axis live in lanes; a photon's reflect/refract choices follow it.
+TEST(BatchTracer, StokesLightMatchesReference) {
+  Settings s = testing::smooth_circle(40.0, 1);
+  s.polarization = Polarization::Stokes;
+  expect_same_photons(s, "stokes, smooth circle");
+  s.fiber.eccentricity = 0.8;
+  testing::make_rough(s, 7.5, 3.0);
+  s.source.phi_i = {deg_to_rad(11.0)};
+  expect_same_photons(s, "stokes, rough tilted ellipse");
 }
 
 TEST(BatchTracer, ExitBlurMatchesReference) {

@@ -1,0 +1,121 @@
+#pragma once
+// The number types a photon's life is written for (sim/photon_life.h): a
+// scalar `double` (one photon, the readable reference) or an
+// xsimd::batch<double> (one photon per SIMD lane, 8 with AVX-512). Generic
+// code calls the functions below unqualified: the scalar forms are defined
+// here, the batch forms are xsimd's, found by argument-dependent lookup.
+// A comparison gives a mask (bool, or a batch_bool); select(mask, a, b)
+// replaces every branch that depends on a photon.
+#include <xsimd/xsimd.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+
+#include "common/fiber_frame.h"
+
+namespace fiberlab::sim {
+
+using Batch = xsimd::batch<double>;
+inline constexpr int kBatchWidth = static_cast<int>(Batch::size);
+
+namespace life {
+
+template <class T>
+struct NumberTraits;
+template <>
+struct NumberTraits<double> {
+  using Mask = bool;
+  using Bits = std::uint64_t;  // a random stream's state word
+  static constexpr int kWidth = 1;
+};
+template <>
+struct NumberTraits<Batch> {
+  using Mask = Batch::batch_bool_type;
+  using Bits = xsimd::batch<std::uint64_t>;
+  static constexpr int kWidth = kBatchWidth;
+};
+template <class T>
+using MaskOf = typename NumberTraits<T>::Mask;
+template <class T>
+using BitsOf = typename NumberTraits<T>::Bits;
+
+// Scalar forms of xsimd's functions.
+inline double select(bool m, double a, double b) { return m ? a : b; }
+inline std::uint64_t select(bool m, std::uint64_t a, std::uint64_t b) { return m ? a : b; }
+inline bool any(bool m) { return m; }
+inline double sqrt(double x) { return std::sqrt(x); }
+inline double log(double x) { return std::log(x); }
+inline double abs(double x) { return std::abs(x); }
+inline double min(double a, double b) { return std::min(a, b); }
+inline double max(double a, double b) { return std::max(a, b); }
+inline double asin(double x) { return std::asin(x); }
+inline std::pair<double, double> sincos(double x) { return {std::sin(x), std::cos(x)}; }
+
+// A mask over doubles as a mask over the random streams' 64-bit words.
+inline bool bits_mask(bool m) { return m; }
+inline NumberTraits<Batch>::Bits::batch_bool_type bits_mask(const MaskOf<Batch>& m) {
+  using U = NumberTraits<Batch>::Bits;
+  return xsimd::bitwise_cast<U>(xsimd::select(m, Batch(1.0), Batch(0.0))) != U(0);
+}
+
+template <class T>
+T ones(const MaskOf<T>& m) {  // 1 where m, else 0
+  return select(m, T(1.0), T(0.0));
+}
+
+// Loads and stores of one lane (double) or W lanes (Batch) from aligned arrays.
+template <class T>
+T load(const double* p) {
+  if constexpr (std::is_same_v<T, double>) return *p;
+  else return T::load_aligned(p);
+}
+inline void store(double x, double* p) { *p = x; }
+inline void store(const Batch& x, double* p) { x.store_aligned(p); }
+template <class T>
+BitsOf<T> load_bits(const std::uint64_t* p) {
+  if constexpr (std::is_same_v<T, double>) return *p;
+  else return BitsOf<T>::load_aligned(p);
+}
+inline void store_bits(std::uint64_t x, std::uint64_t* p) { *p = x; }
+inline void store_bits(const BitsOf<Batch>& x, std::uint64_t* p) { x.store_aligned(p); }
+
+// A 3-vector of numbers: one direction, or W directions side by side.
+template <class T>
+struct Vec3Of {
+  T x, y, z;
+  Vec3Of() = default;
+  Vec3Of(T x_, T y_, T z_) : x(x_), y(y_), z(z_) {}
+  explicit Vec3Of(const Vec3& v) : x(v.x()), y(v.y()), z(v.z()) {}
+  Vec3 to_vec3() const { return Vec3(x, y, z); }  // T = double only
+  T dot(const Vec3Of& o) const { return x * o.x + y * o.y + z * o.z; }
+  Vec3Of cross(const Vec3Of& o) const {
+    return {y * o.z - z * o.y, z * o.x - x * o.z, x * o.y - y * o.x};
+  }
+  T norm() const { return sqrt(dot(*this)); }
+  Vec3Of normalized() const {
+    const T inv = T(1.0) / norm();
+    return {x * inv, y * inv, z * inv};
+  }
+  Vec3Of operator-() const { return {-x, -y, -z}; }
+};
+template <class T>
+Vec3Of<T> operator*(const T& s, const Vec3Of<T>& v) {
+  return {s * v.x, s * v.y, s * v.z};
+}
+template <class T>
+Vec3Of<T> operator+(const Vec3Of<T>& a, const Vec3Of<T>& b) {
+  return {a.x + b.x, a.y + b.y, a.z + b.z};
+}
+template <class T>
+Vec3Of<T> operator-(const Vec3Of<T>& a, const Vec3Of<T>& b) {
+  return {a.x - b.x, a.y - b.y, a.z - b.z};
+}
+template <class T>
+Vec3Of<T> select(const MaskOf<T>& m, const Vec3Of<T>& a, const Vec3Of<T>& b) {
+  return {select(m, a.x, b.x), select(m, a.y, b.y), select(m, a.z, b.z)};
+}
+
+}  // namespace life
+}  // namespace fiberlab::sim
