@@ -24,7 +24,11 @@ TEST(ModelParams, EveryTableKeyParses) {
       {"lobes", "5"}, {"quadrature_order", "50"}, {"r_fresnel", "per_h"}, {"max_order", "30"},
       {"n_theta_d", "specular"}, {"beta_m", "0.4"}, {"beta_n", "0.6"}};
   // Keys whose meaning is the model's own (chiang2016's alpha is the tilt itself).
-  const std::map<std::string, std::string> own{{"chiang2016 alpha", "3"}};
+  const std::map<std::string, std::string> own{
+      {"chiang2016 alpha", "3"},          {"huang2022 roughness", "0.2"},
+      {"huang2022 tilt", "3"},            {"huang2022 lobe_scale", "1,0.5,2"},
+      {"huang2022 masking", "correlated"}, {"huang2022 flux", "macro"},
+      {"huang2022 quadrature_points", "65536"}};
   for (const ModelInfo& m : registered_models()) {
     ModelParams p = default_params(m.name);
     for (const ParamSpec& spec : m.params) {
