@@ -8,7 +8,7 @@
 // - the ledger exited + absorbed + truncated + lost = N with absorption, and
 //   lost is absorbed along the path (less lost in a darker channel).
 //
-// Mutations tried (each caught, by the test named):
+// Mutations each test is built to catch (not yet run against them):
 // - the tracer's mean normal untilted (mean_normal(d, {n0, n0})):
 //   SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber (R's theta marginal);
 // - no consistency rule for microfacet events (return after the first

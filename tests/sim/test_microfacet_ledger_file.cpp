@@ -4,9 +4,10 @@
 // `lost` existed (read as 0), a tampered `lost` (refused), and the exact sums'
 // flat words (MPI, merge) carrying it.
 //
-// Mutation tried: Tally::score_lost without its cap at 1 - kept: the white
-// masking run's exact absorbed wraps below 0 and the reader refuses the file
-// (WhiteMaskingRunWritesAndReadsBack).
+// Seen before the fix (not a planted mutation): Tally::score_lost without its
+// cap at 1 - kept let the white masking run's exact absorbed wrap below 0, and
+// the reader refused the file `fiberlab run` had written; the round trip in
+// WhiteMaskingRunWritesAndReadsBack is the check.
 #include <gtest/gtest.h>
 #include <unistd.h>
 

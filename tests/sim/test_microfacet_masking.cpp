@@ -12,10 +12,10 @@
 // vectors, and the integral by Gauss-Legendre quadrature over the hemisphere;
 // only the textbook Fresnel (common/fresnel, tested on its own) is shared.
 //
-// Mutations tried, each caught here: no G1 factor (only wrong-side kills
-// booked), G1 of the incident instead of the scattered direction, G1 of a
-// refracted direction judged on the incident side (always 0: every
-// refraction killed).
+// Mutations this is built to catch (not yet run against it): no G1 factor
+// (only wrong-side kills booked), G1 of the incident instead of the
+// scattered direction, G1 of a refracted direction judged on the incident
+// side (always 0: every refraction killed).
 #include <gtest/gtest.h>
 
 #include <cmath>

@@ -8,9 +8,10 @@
 // max(0, w.m) D(m) / D(n_f) (D peaks at the mean normal for alpha < 0.7).
 // Two-sample chi-square as for the gaussian sampler (test_microfacet_normal).
 //
-// Mutations tried: the mean normal untilted (MicrofacetRoughness::mean_normal
-// returning n.untilted_facing) and alpha_long / alpha_azim swapped: both
-// caught here (chi2 in the thousands).
+// Mutations this is built to catch (not yet run against it): the mean normal
+// untilted (MicrofacetRoughness::mean_normal returning n.untilted_facing; the
+// 10-degree tilt moves the histogram by many bins) and alpha_long /
+// alpha_azim swapped (the anisotropic cases).
 #include <gtest/gtest.h>
 
 #include <algorithm>
