@@ -2,6 +2,8 @@
 #include <fmt/core.h>
 
 #include <CLI/CLI.hpp>
+#include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <new>
 
@@ -30,6 +32,10 @@ int main(int argc, char** argv) {
     return status == 0 ? 0 : 2;
   } catch (const fiberlab::Error& e) {
     fmt::print(stderr, "fiberlab: error: {}\n", e.what());
+    if (fiberlab::h5::abandoned_a_written_file()) {  // see common/h5_file.h
+      std::fflush(nullptr);
+      std::_Exit(2);
+    }
     return 2;
   } catch (const std::bad_alloc&) {
     fmt::print(stderr, "fiberlab: error: out of memory (lower the tally size, the incident "

@@ -251,12 +251,19 @@ void prepare_hdf5() {
 void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
 
 namespace {
+bool abandoned_files = false;
+}  // namespace
+
+bool abandoned_a_written_file() { return abandoned_files; }
+
+namespace {
 
 // Closes a file being written that was not close()d: an error ended the
 // write (e.g. a full disk). Its contents are dropped first (drop_contents) so
 // that the close has room for the little metadata HDF5 still flushes.
 herr_t abandon_written_file(hid_t id) {
   drop_contents(id);
+  abandoned_files = true;
   return H5Fclose(id);
 }
 

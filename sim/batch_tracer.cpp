@@ -181,7 +181,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       pool.store_state(o, s);
     }
     for (int i = 0; i < n_active;) {  // hand over finished photons; the last lane takes the slot
-      if (pool.col[Pool::kCode][i] != life::kAtBoundary) {
+      if (pool.col[Pool::kCode][i] != static_cast<double>(life::kAtBoundary)) {
         finish(i);
         pool.move(i, --n_active, Light::kPolarized);
       } else {

@@ -20,8 +20,10 @@ using AnyRoughness = std::variant<life::SmoothRoughness, life::GaussianRoughness
 // = 0 is the smooth model, fallback included (SPEC section 3).
 inline AnyRoughness make_roughness(const Settings& s) {
   const RoughnessSettings& r = s.roughness;
-  if (r.microfacet()) return MicrofacetLifeModel(s);
   switch (r.model) {
+    case RoughnessModel::Beckmann:
+    case RoughnessModel::GGX:
+      return MicrofacetLifeModel(s);
     case RoughnessModel::Smooth:
       return life::SmoothRoughness(s);
     case RoughnessModel::Gaussian:

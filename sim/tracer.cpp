@@ -22,7 +22,7 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   const Vec3 d = -wi;
   auto s = life::start_photon<Light>(config_.ellipse.entry_point(d, h), d, rng.core());
   life::LifeCounts<double> counts;
-  while (s.code == life::kAtBoundary) step(config_, model, s, true, counts, kMaxNormalTries);
+  while (s.code == static_cast<double>(life::kAtBoundary)) step(config_, model, s, true, counts, kMaxNormalTries);
   rng.core() = s.rng;
   if (counters) counters->add(counts);
   PhotonOutcome out = finished_outcome(model, static_cast<int>(s.code), s.d.to_vec3(),

@@ -87,11 +87,15 @@ TEST(Huang2022, SmallRoughnessApproachesTheExactCylinder) {
       double distance = 0.0;
       for (int l = 0; l < 4; ++l) {
         distance += std::abs(e.lobe[l] - k.e[l]);
-        if (alpha <= 1e-4) EXPECT_NEAR(e.lobe[l], k.e[l], 2e-3) << k.theta_deg << " lobe " << l;
+        if (alpha <= 1e-4) {
+          EXPECT_NEAR(e.lobe[l], k.e[l], 2e-3) << k.theta_deg << " lobe " << l;
+        }
       }
       EXPECT_LT(distance, previous) << k.theta_deg << " alpha " << alpha;
       previous = distance;
-      if (alpha <= 1e-3) EXPECT_LT(e.masked[0], 1e-3);
+      if (alpha <= 1e-3) {
+        EXPECT_LT(e.masked[0], 1e-3);
+      }
     }
   }
 }

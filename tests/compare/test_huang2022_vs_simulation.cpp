@@ -53,7 +53,9 @@ TEST(Huang2022VsSimulation, TiltedEllipseNeedsTheProjectedWidthsFlux) {
   expect_accepted(testing::compare_with(r, "huang2022", {"quadrature_points=262144", "flux=macro"}));
   // The paper's flux gives wi.ns / wi.n0 of the light: TT off in energy.
   for (const auto& c : testing::compare_with(r, "huang2022", {"quadrature_points=262144"}))
-    if (c.lobe == 1) EXPECT_GT(c.energy_z, 5.0);
+    if (c.lobe == 1) {
+      EXPECT_GT(c.energy_z, 5.0);
+    }
 }
 
 }  // namespace
