@@ -34,7 +34,8 @@
 //   +44, +99; ggx and beckmann swapped (model mapping): -168 to +145;
 // - stretch inverted in the sampler: Beckmann -21, -515; GGX's unstretch
 //   inverted +274, +153 (GGX's stretch of w alone: within 2 sd here, the
-//   normals test catches it).
+//   normals test catches it); Beckmann's slope CDF target unscaled +65,
+//   +168; GGX's disk not warped towards the visible half +30, +22.
 #include <gtest/gtest.h>
 
 #include <algorithm>
