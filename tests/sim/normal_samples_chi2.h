@@ -1,6 +1,6 @@
 #pragma once
 // Two-sample chi-square of two sets of roughness normals, shared by the tests
-// of the gaussian sampler (test_microfacet_normal.cpp) and of the microfacet
+// of the gaussian sampler (test_gaussian_normal.cpp) and of the microfacet
 // VNDF sampler (test_microfacet_normals.cpp): each normal m is binned by
 // (m.u, azimuth of m about the fiber axis u relative to the tilted normal
 // n_f), 20 x 20 bins over the 1st to 99th percentiles of the reference
