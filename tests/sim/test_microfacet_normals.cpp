@@ -6,7 +6,7 @@
 // the TILTED normal n_f facing the photon, w = -d. Reference sampler:
 // uniform proposals on the hemisphere about n_f, accepted with probability
 // max(0, w.m) D(m) / D(n_f) (D peaks at the mean normal for alpha < 0.7).
-// Two-sample chi-square as for the gaussian sampler (test_microfacet_normal;
+// Two-sample chi-square as for the gaussian sampler (test_gaussian_normal;
 // shared binning in tests/sim/normal_samples_chi2.h).
 //
 // Mutations run, each alone (chi2 vs threshold of the cases that fail; the
