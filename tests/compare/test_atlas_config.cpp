@@ -5,6 +5,7 @@
 
 #include "common/error.h"
 #include "common/units.h"
+#include "compare/atlas.h"
 #include "compare/atlas_config.h"
 
 namespace fiberlab::compare {
@@ -55,9 +56,57 @@ TEST(AtlasConfig, ErrorsNameTheEntry) {
             std::string::npos);
   EXPECT_NE(error_of("photons: 0\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n").find("photons"),
             std::string::npos);
+  // model_parameters: the model, the key and the value, each named with what is allowed.
+  const std::string sweep = "photons: 10\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n";
+  const std::string unknown_model = error_of(sweep + "model_parameters: {huang1999: {x: 1}}\n");
+  EXPECT_NE(unknown_model.find("unknown key model_parameters.huang1999 (allowed: "), std::string::npos)
+      << unknown_model;
+  EXPECT_NE(unknown_model.find("huang2022"), std::string::npos) << unknown_model;
+  EXPECT_NE(error_of(sweep + "models: [exact]\nmodel_parameters: {huang2022: {quadrature_points: 4096}}\n")
+                .find("unknown key model_parameters.huang2022 (allowed: exact)"),
+            std::string::npos);
+  const std::string bad_key = error_of(sweep + "model_parameters: {huang2022: {points: 4096}}\n");
+  EXPECT_NE(bad_key.find("unknown key model_parameters.huang2022.points (allowed: "), std::string::npos) << bad_key;
+  EXPECT_NE(bad_key.find("quadrature_points"), std::string::npos) << bad_key;
+  const std::string free_key = error_of(sweep + "model_parameters: {huang2022: {roughness: 0.2}}\n");
+  EXPECT_NE(free_key.find("model_parameters.huang2022.roughness is a free parameter"), std::string::npos) << free_key;
+  const std::string bad_value = error_of(sweep + "model_parameters: {huang2022: {quadrature_points: 100}}\n");
+  EXPECT_NE(bad_value.find("model_parameters.huang2022.quadrature_points = 100 is not allowed (allowed: an integer "
+                           "in [1024, 1073741824])"),
+            std::string::npos)
+      << bad_value;
+  EXPECT_EQ(bad_value.rfind("a.yaml: ", 0), 0u) << bad_value;
+  EXPECT_NE(error_of(sweep + "model_parameters: {huang2022: {masking: sideways}}\n").find("masking = sideways"),
+            std::string::npos);
+  EXPECT_NE(error_of(sweep + "model_parameters: {huang2022: 4096}\n").find("model_parameters.huang2022 = 4096 must be a mapping"),
+            std::string::npos);
   EXPECT_NE(error_of("photons: 10\nfit: {max_iterations: -1}\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n")
                 .find("fit.max_iterations"),
             std::string::npos);
+}
+
+// Fixed model parameters reach the model on top of its physical defaults:
+// the "before" parameters show the config's value, and the fiber's own
+// (eccentricity from the sweep) are still there.
+TEST(AtlasConfig, ModelParametersApplyOnTopOfThePhysicalDefaults) {
+  const AtlasConfig c = parse_atlas_config(
+      "photons: 2000\ntally: {n_theta: 6, n_phi: 8}\n"
+      "sweep: {roughness: [{model: ggx, alpha: 0.2}], eccentricity: [0.9], theta_i: 30}\n"
+      "models: [deon2011, huang2022]\n"
+      "model_parameters: {huang2022: {quadrature_points: 4096, masking: none}}\nfit: {max_iterations: 0}\n",
+      "t");
+  ASSERT_EQ(c.model_parameters.at("huang2022"),
+            (std::vector<std::string>{"quadrature_points=4096", "masking=none"}));
+  EXPECT_EQ(c.model_parameters.count("deon2011"), 0u);
+  AtlasControl control;
+  control.threads = 1;
+  const AtlasFiberResult r = run_atlas_fiber(c, 0, control);
+  ASSERT_EQ(r.models.size(), 2u);
+  const std::string& huang = r.models[1].params_before;
+  EXPECT_NE(huang.find("quadrature_points=4096"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("masking=none"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("eccentricity=0.9"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("roughness=0.2"), std::string::npos) << huang;
 }
 
 }  // namespace
