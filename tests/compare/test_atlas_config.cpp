@@ -30,6 +30,9 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   // Melanin: three channels, sigma_a derived by the simulator.
   EXPECT_EQ(full.fibers[4].settings.fiber.sigma_a.size(), 3u);
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());
+  // huang2022's quadrature sized for the atlas (the config's comment says why).
+  EXPECT_EQ(full.model_parameters.at("huang2022"), std::vector<std::string>{"quadrature_points=262144"});
+  EXPECT_EQ(full.max_iterations, 10);
 }
 
 TEST(AtlasConfig, ModelsDefaultToEveryRegisteredOne) {
