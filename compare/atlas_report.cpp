@@ -6,8 +6,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "common/atomic_output.h"
+#include "common/error.h"
 #include "common/file_schema.h"
-#include "compare/atlas_file.h"
 #include "compare/report.h"
 
 namespace fiberlab::compare {
@@ -37,6 +38,16 @@ std::string fitted_params(const AtlasModelResult& m) {
 }
 
 int lobe_count(const std::vector<AtlasFiberResult>& fibers) { return fibers.empty() ? 0 : fibers[0].lobes; }
+
+// report_data.h5 (what scripts/plot_atlas.py reads) is the atlas file
+// itself, copied byte for byte, not written a second time.
+void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
+  AtomicOutput out((std::filesystem::path(dir) / "report_data.h5").string());
+  std::error_code ec;
+  std::filesystem::copy_file(atlas_path, out.temp_path(), std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw Error(fmt::format("cannot copy {} to {}: {}", atlas_path, out.target(), ec.message()));
+  out.commit();
+}
 
 }  // namespace
 
@@ -99,7 +110,7 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
 std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
                                const std::vector<AtlasFiberResult>& fibers, const std::string& command) {
   make_report_dir(dir);
-  write_atlas_file((std::filesystem::path(dir) / "report_data.h5").string(), config, fibers);
+  copy_atlas_file(atlas_path, dir);
   double sim_s = 0.0, fit_s = 0.0;
   for (const auto& f : fibers) {
     sim_s += f.sim_seconds;
