@@ -58,7 +58,13 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const sim::ResultFile
   m.model = name;
   analytic::ModelParams p;
   try {
-    p = params_for(r.settings, ModelSpec{name, {}, name}, {});
+    // The config's fixed parameters (model_parameters) on top of the
+    // model's physical defaults for this fiber.
+    const auto fixed = config.model_parameters.find(name);
+    p = params_for(r.settings,
+                   ModelSpec{name, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second,
+                             name},
+                   {});
     compare::make_model(name, p);  // the model's own checks
   } catch (const Error& e) {
     m.status = std::string("not applicable: ") + e.what();

@@ -1,6 +1,7 @@
 #include "compare/atlas_config.h"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cmath>
@@ -169,6 +170,53 @@ std::vector<std::string> read_models(const Reader& r, const YAML::Node& n) {
   return out;
 }
 
+// model_parameters: {MODEL: {KEY: VALUE, ...}, ...}, each KEY a fixed
+// (not free) parameter of MODEL's table, each VALUE accepted by the table's
+// own parser (applied to the model's defaults here, to each fiber's
+// physical defaults by the atlas).
+std::map<std::string, std::vector<std::string>> read_model_parameters(const Reader& r, const YAML::Node& n,
+                                                                      const std::vector<std::string>& models) {
+  std::map<std::string, std::vector<std::string>> out;
+  if (!n) return out;
+  std::set<std::string> chosen(models.begin(), models.end());
+  only_keys(r, n, "model_parameters", chosen);
+  for (const auto& kv : n) {
+    const std::string model = kv.first.Scalar();
+    const std::string path = "model_parameters." + model;
+    const analytic::ParamTable& table = analytic::model_info(model).params;
+    std::set<std::string> fixed;
+    for (const analytic::ParamSpec& s : table)
+      if (!s.free) fixed.insert(s.key);
+    if (kv.second.IsMap())
+      for (const auto& setting : kv.second)
+        if (const analytic::ParamSpec* spec = analytic::find_param(table, setting.first.Scalar()); spec && spec->free)
+          r.fail(fmt::format("{}.{} is a free parameter: the atlas fits it, starting from the fiber's physical "
+                             "value (fixed keys of {}: {})",
+                             path, spec->key, model, fmt::join(fixed, ", ")));
+    only_keys(r, kv.second, path, fixed);
+    analytic::ModelParams p = analytic::default_params(model);
+    for (const auto& setting : kv.second) {
+      const std::string key = setting.first.Scalar();
+      const analytic::ParamSpec* spec = analytic::find_param(table, key);
+      std::string value;
+      if (setting.second.IsScalar()) {
+        value = setting.second.Scalar();
+      } else if (setting.second.IsSequence()) {  // a per-lobe or per-channel list
+        for (const auto& x : setting.second)
+          value += (value.empty() ? "" : ",") + (x.IsScalar() ? x.Scalar() : show(x));
+      }
+      try {
+        if (value.empty()) throw Error("empty");
+        spec->set(p, value);
+      } catch (const Error&) {
+        r.fail(fmt::format("{}.{} = {} is not allowed (allowed: {})", path, key, show(setting.second), spec->allowed));
+      }
+      out[model].push_back(key + "=" + value);
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin) {
@@ -180,7 +228,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
     r.fail(fmt::format("malformed YAML at line {}: {}", e.mark.line + 1, e.msg));
   }
   if (!top.IsDefined() || top.IsNull()) r.fail("the config is empty (see configs/atlas_small.yaml)");
-  only_keys(r, top, "", {"photons", "seed", "eta", "tally", "sweep", "models", "fit"});
+  only_keys(r, top, "", {"photons", "seed", "eta", "tally", "sweep", "models", "model_parameters", "fit"});
   if (!top["photons"]) r.fail("photons is missing (photons per fiber and incident direction, an integer >= 1)");
   integer(r, top["photons"], "photons", 1, 1e12);
   if (!top["sweep"]) r.fail("sweep is missing (roughness, absorption, scale_tilt, eccentricity, theta_i lists)");
@@ -191,6 +239,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   c.path = origin;
   c.yaml = yaml_text;
   c.models = read_models(r, top["models"]);
+  c.model_parameters = read_model_parameters(r, top["model_parameters"], c.models);
   if (const YAML::Node fit = top["fit"]) {
     only_keys(r, fit, "fit", {"max_iterations"});
     if (fit["max_iterations"])

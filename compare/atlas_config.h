@@ -17,7 +17,17 @@
 //     eccentricity: [1.0]
 //     theta_i: [0, 30, 60]  # degrees: the incident directions of every fiber
 //   models: all           # or a list of registered model names
+//   model_parameters:     # optional: fixed (not fitted) parameters per model
+//     huang2022: {quadrature_points: 262144}
 //   fit: {max_iterations: 20}
+//
+// model_parameters: for a model of `models`, keys of its own parameter table
+// (`fiberlab models`) that the fit does not move (a free key is refused: the
+// fit starts from the fiber's physical value), in command-line units. They
+// are applied on top of the model's physical defaults for each fiber
+// (ModelInfo::from_fiber, compare/models.h params_for), so they hold for the
+// "before" comparison, the fit and the "after" one; each value is checked by
+// the table's own parser when the config is read.
 //
 // Each fiber is checked by the simulator's own config parser (the entry is
 // written as a simulator config and parsed back), so a roughness model the
@@ -25,6 +35,7 @@
 // checked before anything runs: a bad value is one line naming the file, the
 // entry and what is allowed (fiberlab::Error, exit status 2).
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -47,6 +58,8 @@ struct AtlasConfig {
   std::string path, yaml;       // the file and its text (stored in the output)
   std::vector<AtlasFiber> fibers;
   std::vector<std::string> models;  // registered names, in registry order
+  // model name -> its fixed settings "KEY=VALUE" (model_parameters), checked.
+  std::map<std::string, std::vector<std::string>> model_parameters;
   int max_iterations = 20;
   std::vector<double> theta_i;  // radians
 };

@@ -32,6 +32,15 @@ struct Shape {
   h5::Dims dims() const { return {F, K, L, C}; }
 };
 
+// One dataset and its description (common/file_schema.h describe()): each
+// array is named, shaped, written and described in one place.
+template <class T>
+void put(h5::File& f, const std::string& path, const h5::Dims& dims, const std::vector<T>& data,
+         const std::string& dimensions, const std::string& units, const std::string& description) {
+  f.write(path, dims, data);
+  describe(f, "/" + path, dimensions, units, description);
+}
+
 void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResult>& fibers) {
   f.create_group("fibers");
   std::vector<double> roughness, tilt, ecc, sim_s, fit_s, e(s.F * s.K * s.L * s.C, kNaN), se = e;
@@ -59,34 +68,23 @@ void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResul
           se[s.at(i, k, l, c)] = r.sim_error[src];
         }
   }
-  f.write("fibers/roughness", {s.F}, roughness);
-  f.write("fibers/roughness_index", {s.F}, gi);
-  f.write("fibers/absorption_index", {s.F}, ai);
-  f.write("fibers/scale_tilt", {s.F}, tilt);
-  f.write("fibers/eccentricity", {s.F}, ecc);
-  f.write("fibers/channels", {s.F}, channels);
-  f.write("fibers/photons", {s.F}, photons);
-  f.write("fibers/sim_seconds", {s.F}, sim_s);
-  f.write("fibers/fit_seconds", {s.F}, fit_s);
-  f.write("fibers/sim_energy", s.dims(), e);
-  f.write("fibers/sim_energy_error", s.dims(), se);
+  const h5::Dims F{s.F};
+  put(f, "fibers/roughness", F, roughness, "fiber", "degrees (beta) or unitless (alpha)",
+      "roughness size: beta_long for gaussian/exit_blur, alpha for microfacet models, 0 smooth");
+  put(f, "fibers/roughness_index", F, gi, "fiber", "index", "entry of sweep.roughness");
+  put(f, "fibers/absorption_index", F, ai, "fiber", "index", "entry of sweep.absorption");
+  put(f, "fibers/scale_tilt", F, tilt, "fiber", "radians", "cuticle scale tilt, towards the root");
+  put(f, "fibers/eccentricity", F, ecc, "fiber", "", "minor/major axis ratio");
+  put(f, "fibers/channels", F, channels, "fiber", "channels", "channels of this fiber (later channels are NaN)");
+  put(f, "fibers/photons", F, photons, "fiber", "photons", "photons per incident direction");
+  put(f, "fibers/sim_seconds", F, sim_s, "fiber", "seconds", "wall time of the simulation");
+  put(f, "fibers/fit_seconds", F, fit_s, "fiber", "seconds", "wall time of every model's comparison and fit");
+  put(f, "fibers/sim_energy", s.dims(), e, kAtlasDims, "fraction of incident light", "simulated lobe energy (ledger)");
+  put(f, "fibers/sim_energy_error", s.dims(), se, kAtlasDims, "fraction of incident light",
+      "standard error of sim_energy");
   f.set_attr("/fibers", "labels", joined(labels));
   f.set_attr("/fibers", "roughness_models", joined(models));
   f.set_attr("/fibers", "absorption", joined(absorption));
-  describe(f, "/fibers/roughness", "fiber", "degrees (beta) or unitless (alpha)",
-           "roughness size: beta_long for gaussian/exit_blur, alpha for microfacet models, 0 smooth");
-  describe(f, "/fibers/roughness_index", "fiber", "index", "entry of sweep.roughness");
-  describe(f, "/fibers/absorption_index", "fiber", "index", "entry of sweep.absorption");
-  describe(f, "/fibers/scale_tilt", "fiber", "radians", "cuticle scale tilt, towards the root");
-  describe(f, "/fibers/eccentricity", "fiber", "", "minor/major axis ratio");
-  describe(f, "/fibers/channels", "fiber", "channels", "channels of this fiber (later channels are NaN)");
-  describe(f, "/fibers/photons", "fiber", "photons", "photons per incident direction");
-  describe(f, "/fibers/sim_seconds", "fiber", "seconds", "wall time of the simulation");
-  describe(f, "/fibers/fit_seconds", "fiber", "seconds", "wall time of every model's comparison and fit");
-  describe(f, "/fibers/sim_energy", kAtlasDims, "fraction of incident light",
-           "simulated lobe energy (ledger)");
-  describe(f, "/fibers/sim_energy_error", kAtlasDims, "fraction of incident light",
-           "standard error of sim_energy");
 }
 
 void write_model(h5::File& f, const Shape& s, const std::string& name, const std::vector<AtlasFiberResult>& fibers,
@@ -148,51 +146,32 @@ void write_model(h5::File& f, const Shape& s, const std::string& name, const std
   f.set_attr("/" + g, "status", joined(status));
   f.set_attr("/" + g, "params_before", joined(before));
   f.set_attr("/" + g, "params_after", joined(after));
-  f.write(g + "/applicable", {s.F}, applicable);
-  f.write(g + "/fitted", {s.F}, fitted);
-  f.write(g + "/converged", {s.F}, converged);
-  f.write(g + "/seconds", {s.F}, seconds);
-  f.write(g + "/model_energy_before", s.dims(), eb);
-  f.write(g + "/model_energy_after", s.dims(), ea);
-  f.write(g + "/chi2_before", s.dims(), cb);
-  f.write(g + "/dof_before", s.dims(), db);
-  f.write(g + "/chi2_after", s.dims(), ca);
-  f.write(g + "/dof_after", s.dims(), da);
-  f.write(g + "/judged", s.dims(), judged);
-  f.write(g + "/fit_start", {s.F, P}, start);
-  f.write(g + "/fit_value", {s.F, P}, value);
-  f.write(g + "/fit_error", {s.F, P}, error);
-  f.write(g + "/fit_error_unscaled", {s.F, P}, unscaled);
-  f.write(g + "/fit_at_bound", {s.F, P}, bound);
-  f.write(g + "/fit_chi2_start", {s.F}, chi2_start);
-  f.write(g + "/fit_chi2", {s.F}, chi2);
-  f.write(g + "/fit_dof", {s.F}, dof);
-  f.write(g + "/fit_iterations", {s.F}, iterations);
-  const std::string dims4 = kAtlasDims;
-  describe(f, "/" + g + "/applicable", "fiber", "0/1", "1: the model accepted the fiber (status says why not)");
-  describe(f, "/" + g + "/fitted", "fiber", "0/1", "1: the free parameters were fitted");
-  describe(f, "/" + g + "/converged", "fiber", "0/1", "1: the fit converged");
-  describe(f, "/" + g + "/seconds", "fiber", "seconds", "wall time of this model's comparison and fit");
-  describe(f, "/" + g + "/model_energy_before", dims4, "fraction of incident light",
-           "the model's lobe energy with its physical defaults (NaN: not applicable)");
-  describe(f, "/" + g + "/model_energy_after", dims4, "fraction of incident light",
-           "the model's lobe energy with the fitted parameters (NaN: not fitted)");
-  describe(f, "/" + g + "/chi2_before", dims4, "", "chi-square of the bins (compare/comparison.h), physical defaults");
-  describe(f, "/" + g + "/dof_before", dims4, "", "its degrees of freedom");
-  describe(f, "/" + g + "/chi2_after", dims4, "", "chi-square of the bins with the fitted parameters");
-  describe(f, "/" + g + "/dof_after", dims4, "", "its degrees of freedom");
-  describe(f, "/" + g + "/judged", dims4, "0/1", "1: the lobe has enough energy to be judged");
-  describe(f, "/" + g + "/fit_start", "fiber,fit_key", "the key's unit (degrees for angles)",
-           "start value of each fit key (attribute fit_keys)");
-  describe(f, "/" + g + "/fit_value", "fiber,fit_key", "the key's unit (degrees for angles)", "fitted value");
-  describe(f, "/" + g + "/fit_error", "fiber,fit_key", "the key's unit",
-           "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
-  describe(f, "/" + g + "/fit_error_unscaled", "fiber,fit_key", "the key's unit", "sqrt(diag((J^T W J)^-1))");
-  describe(f, "/" + g + "/fit_at_bound", "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
-  describe(f, "/" + g + "/fit_chi2_start", "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
-  describe(f, "/" + g + "/fit_chi2", "fiber", "", "the fit's chi-square at the minimum");
-  describe(f, "/" + g + "/fit_dof", "fiber", "", "residuals minus fitted parameters");
-  describe(f, "/" + g + "/fit_iterations", "fiber", "", "Levenberg-Marquardt iterations");
+  const h5::Dims F{s.F}, FP{s.F, P};
+  const std::string energy = "fraction of incident light", key_unit = "the key's unit (degrees for angles)";
+  put(f, g + "/applicable", F, applicable, "fiber", "0/1", "1: the model accepted the fiber (status says why not)");
+  put(f, g + "/fitted", F, fitted, "fiber", "0/1", "1: the free parameters were fitted");
+  put(f, g + "/converged", F, converged, "fiber", "0/1", "1: the fit converged");
+  put(f, g + "/seconds", F, seconds, "fiber", "seconds", "wall time of this model's comparison and fit");
+  put(f, g + "/model_energy_before", s.dims(), eb, kAtlasDims, energy,
+      "the model's lobe energy with its physical defaults (NaN: not applicable)");
+  put(f, g + "/model_energy_after", s.dims(), ea, kAtlasDims, energy,
+      "the model's lobe energy with the fitted parameters (NaN: not fitted)");
+  put(f, g + "/chi2_before", s.dims(), cb, kAtlasDims, "",
+      "chi-square of the bins (compare/comparison.h), physical defaults");
+  put(f, g + "/dof_before", s.dims(), db, kAtlasDims, "", "its degrees of freedom");
+  put(f, g + "/chi2_after", s.dims(), ca, kAtlasDims, "", "chi-square of the bins with the fitted parameters");
+  put(f, g + "/dof_after", s.dims(), da, kAtlasDims, "", "its degrees of freedom");
+  put(f, g + "/judged", s.dims(), judged, kAtlasDims, "0/1", "1: the lobe has enough energy to be judged");
+  put(f, g + "/fit_start", FP, start, "fiber,fit_key", key_unit, "start value of each fit key (attribute fit_keys)");
+  put(f, g + "/fit_value", FP, value, "fiber,fit_key", key_unit, "fitted value");
+  put(f, g + "/fit_error", FP, error, "fiber,fit_key", "the key's unit",
+      "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
+  put(f, g + "/fit_error_unscaled", FP, unscaled, "fiber,fit_key", "the key's unit", "sqrt(diag((J^T W J)^-1))");
+  put(f, g + "/fit_at_bound", FP, bound, "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
+  put(f, g + "/fit_chi2_start", F, chi2_start, "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
+  put(f, g + "/fit_chi2", F, chi2, "fiber", "", "the fit's chi-square at the minimum");
+  put(f, g + "/fit_dof", F, dof, "fiber", "", "residuals minus fitted parameters");
+  put(f, g + "/fit_iterations", F, iterations, "fiber", "", "Levenberg-Marquardt iterations");
 }
 
 }  // namespace
@@ -211,8 +190,7 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
     for (const auto& m : config.models) models += (models.empty() ? "" : ",") + m;
     f.set_attr("/", "models", models);
     f.set_attr("/", "lobe_names", join_names(lobe_names(static_cast<int>(s.L))));
-    f.write("theta_i", {s.K}, config.theta_i);
-    describe(f, "/theta_i", "incidence", "radians", "incident inclinations, the same for every fiber");
+    put(f, "theta_i", {s.K}, config.theta_i, "incidence", "radians", "incident inclinations, the same for every fiber");
     write_fibers(f, s, fibers);
     f.create_group("models");
     for (std::size_t m = 0; m < config.models.size(); ++m) write_model(f, s, config.models[m], fibers, m);

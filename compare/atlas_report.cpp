@@ -6,8 +6,9 @@
 #include <cmath>
 #include <filesystem>
 
+#include "common/atomic_output.h"
+#include "common/error.h"
 #include "common/file_schema.h"
-#include "compare/atlas_file.h"
 #include "compare/report.h"
 
 namespace fiberlab::compare {
@@ -37,6 +38,27 @@ std::string fitted_params(const AtlasModelResult& m) {
 }
 
 int lobe_count(const std::vector<AtlasFiberResult>& fibers) { return fibers.empty() ? 0 : fibers[0].lobes; }
+
+// The config's model_parameters, one sentence (empty when there are none).
+std::string fixed_parameters(const AtlasConfig& config) {
+  std::string s;
+  for (const auto& [model, settings] : config.model_parameters) {
+    s += fmt::format("{}{}:", s.empty() ? " Fixed model parameters (not fitted; the config's model_parameters): "
+                                        : "; ", model);
+    for (const std::string& kv : settings) s += " " + kv;
+  }
+  return s.empty() ? s : s + ".";
+}
+
+// report_data.h5 (what scripts/plot_atlas.py reads) is the atlas file
+// itself, copied byte for byte, not written a second time.
+void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
+  AtomicOutput out((std::filesystem::path(dir) / "report_data.h5").string());
+  std::error_code ec;
+  std::filesystem::copy_file(atlas_path, out.temp_path(), std::filesystem::copy_options::overwrite_existing, ec);
+  if (ec) throw Error(fmt::format("cannot copy {} to {}: {}", atlas_path, out.target(), ec.message()));
+  out.commit();
+}
 
 }  // namespace
 
@@ -99,7 +121,7 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
 std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
                                const std::vector<AtlasFiberResult>& fibers, const std::string& command) {
   make_report_dir(dir);
-  write_atlas_file((std::filesystem::path(dir) / "report_data.h5").string(), config, fibers);
+  copy_atlas_file(atlas_path, dir);
   double sim_s = 0.0, fit_s = 0.0;
   for (const auto& f : fibers) {
     sim_s += f.sim_seconds;
@@ -114,11 +136,11 @@ std::string write_atlas_report(const std::string& dir, const std::string& atlas_
       "ΔE: |E_model - E_sim| of a lobe (fraction of the incident light), the largest over theta_i and "
       "channels. χ²/dof: the bins' chi-square (compare/comparison.h) summed over theta_i and channels. "
       "\"before\": the model's physical defaults for the fiber; \"after\": its free parameters fitted jointly "
-      "over every theta_i (compare/fit.h).\n\n## Per model and lobe (median over fibers)\n\n{}\n"
+      "over every theta_i (compare/fit.h).{}\n\n## Per model and lobe (median over fibers)\n\n{}\n"
       "## Per fiber\n\n{}\n",
       config.path, command, atlas_path, fibers.size(), config.theta_i.size(),
       fibers.empty() ? 0 : fibers[0].photons, sim_s, fit_s,
-      fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(), headline, table);
+      fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(), fixed_parameters(config), headline, table);
   // The tables for the page (scripts/plot_atlas.py turns them into HTML).
   write_text(dir, "atlas_tables.md",
              "## Per model and lobe (median over fibers)\n\n" + headline + "\n## Per fiber\n\n" + table);

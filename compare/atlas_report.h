@@ -1,7 +1,7 @@
 #pragma once
 // The atlas's report folder (`fiberlab atlas --report DIR`): report.md (the
-// tables), tables.html (the same tables for the page), report_data.h5 (the
-// atlas file again, for the plots), and, through scripts/plot_report.py
+// tables), atlas_tables.md (the same tables for the page), report_data.h5 (a copy of
+// the atlas file, for the plots), and, through scripts/plot_report.py
 // (kind "atlas", scripts/plot_atlas.py), the summary figures and
 // report.html. Numbers come from compare/atlas.h; nothing is computed here
 // but medians and maxima of them.
@@ -20,7 +20,8 @@ std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector
 // |dE| and chi2/dof before -> after (Markdown).
 std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers);
 
-// Writes the folder; returns the line to print.
+// Writes the folder (`atlas_path`: the atlas file already written, copied
+// as report_data.h5); returns the line to print.
 std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
                                const std::vector<AtlasFiberResult>& fibers, const std::string& command);
 

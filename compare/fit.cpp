@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <tuple>
 
 #include "common/error.h"
@@ -224,44 +225,60 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     for (int j = 0; j < n; ++j) set_parameter(model_name, p, keys[j], x[j]);
     return p;
   };
-  auto residuals = [&](const Eigen::VectorXd& x, bool parallel) {
-    const analytic::ModelParams p = params_at(x);
-    const auto model = compare::make_model(model_name, p);
-    const std::vector<double> r =
-        normalised_residuals(result, sel, predict_result(*model, result, parallel), options);
+  auto to_vector = [](const std::vector<double>& r) {
     return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.data(), static_cast<long>(r.size())));
+  };
+  auto residuals = [&](const Eigen::VectorXd& x) {
+    const auto model = compare::make_model(model_name, params_at(x));
+    return to_vector(normalised_residuals(result, sel, predict_result(*model, result), options));
   };
   // Central differences; steps in the keys' units (degrees for angles).
   auto step = [&](int j, double x) {
     return std::max(1e-3 * std::fabs(x), keys[j].rfind("eta", 0) == 0 ? 1e-5 : 1e-3);
   };
+  // The 2n trial points' predictions are 2n x K independent model
+  // evaluations (K incident configurations): one parallel loop over all of
+  // them keeps every thread busy (a loop over the n columns leaves threads
+  // idle when n is small or not a multiple of them). Each evaluation is
+  // deterministic and the residuals are formed afterwards in a fixed order,
+  // so J is the same for any thread count.
+  const long K = static_cast<long>(result.configs());
   auto jacobian = [&](const Eigen::VectorXd& x, long m) {
-    Eigen::MatrixXd J(m, n);
+    std::vector<Eigen::VectorXd> trial(2 * n, x);
+    std::vector<std::unique_ptr<analytic::Model>> models(2 * n);
+    for (int j = 0; j < n; ++j) {
+      const double h = step(j, x[j]);
+      trial[2 * j][j] = std::min(x[j] + h, hi[j]);
+      trial[2 * j + 1][j] = std::max(x[j] - h, lo[j]);
+      for (int s = 0; s < 2; ++s) models[2 * j + s] = compare::make_model(model_name, params_at(trial[2 * j + s]));
+    }
+    std::vector<std::vector<std::vector<double>>> predicted(2 * n, std::vector<std::vector<double>>(K));
     std::string error;
 #pragma omp parallel for schedule(dynamic)
-    for (int j = 0; j < n; ++j) {
+    for (long t = 0; t < 2 * n * K; ++t) {
       try {
-        const double h = step(j, x[j]);
-        Eigen::VectorXd xp = x, xm = x;
-        xp[j] = std::min(x[j] + h, hi[j]);
-        xm[j] = std::max(x[j] - h, lo[j]);
-        const Eigen::VectorXd rp = residuals(xp, false), rm = residuals(xm, false);
-        // set_parameter may clamp (beta floor): use the actual difference.
-        const double dx = get_parameter(model_name, params_at(xp), keys[j]) -
-                          get_parameter(model_name, params_at(xm), keys[j]);
-        J.col(j) = (rp - rm) / (dx != 0.0 ? dx : 2.0 * h);
+        predicted[t / K][t % K] = predict_config(*models[t / K], result, static_cast<std::size_t>(t % K));
       } catch (const std::exception& e) {
 #pragma omp critical
         error = e.what();
       }
     }
     if (!error.empty()) throw Error(error);
+    Eigen::MatrixXd J(m, n);
+    for (int j = 0; j < n; ++j) {
+      const Eigen::VectorXd rp = to_vector(normalised_residuals(result, sel, predicted[2 * j], options));
+      const Eigen::VectorXd rm = to_vector(normalised_residuals(result, sel, predicted[2 * j + 1], options));
+      // set_parameter may clamp (beta floor): use the actual difference.
+      const double dx = get_parameter(model_name, params_at(trial[2 * j]), keys[j]) -
+                        get_parameter(model_name, params_at(trial[2 * j + 1]), keys[j]);
+      J.col(j) = (rp - rm) / (dx != 0.0 ? dx : 2.0 * step(j, x[j]));
+    }
     return J;
   };
 
   Eigen::VectorXd x(n);
   for (int j = 0; j < n; ++j) x[j] = fr.start[j];
-  Eigen::VectorXd r = residuals(x, true);
+  Eigen::VectorXd r = residuals(x);
   ++fr.evaluations;
   const long m = r.size();
   fr.residuals = static_cast<int>(m);
@@ -298,7 +315,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
         }
       const Eigen::VectorXd xn = project(x + Ad.ldlt().solve(-gh));
       const Eigen::VectorXd step = xn - x;
-      const Eigen::VectorXd rn = residuals(xn, true);
+      const Eigen::VectorXd rn = residuals(xn);
       ++fr.evaluations;
       const double chi2n = rn.squaredNorm();
       if (chi2n < chi2) {

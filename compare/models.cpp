@@ -134,6 +134,11 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 
 namespace fiberlab::compare {
 
+std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& r, std::size_t k) {
+  return predict_bins(model, r.grid, r.theta_i.at(k), r.phi_i.at(k), r.lobes, r.channels,
+                      r.settings.fiber.eccentricity != 1.0);
+}
+
 std::vector<std::vector<double>> predict_result(const analytic::Model& model,
                                                 const sim::ResultFile& r, bool parallel) {
   const long K = static_cast<long>(r.configs());
@@ -142,8 +147,7 @@ std::vector<std::vector<double>> predict_result(const analytic::Model& model,
 #pragma omp parallel for schedule(dynamic) if (parallel && K > 1)
   for (long k = 0; k < K; ++k) {
     try {
-      out[k] = predict_bins(model, r.grid, r.theta_i[k], r.phi_i[k], r.lobes, r.channels,
-                            r.settings.fiber.eccentricity != 1.0);
+      out[k] = predict_config(model, r, static_cast<std::size_t>(k));
     } catch (const std::exception& e) {
 #pragma omp critical
       error = e.what();

@@ -62,7 +62,10 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 
 namespace fiberlab::compare {
 
-// predict_bins() for every incident configuration of a result (parallel
+// predict_bins() for incident configuration k of a result.
+std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& result, std::size_t k);
+
+// predict_config() for every incident configuration of a result (parallel
 // over configurations with OpenMP when `parallel`).
 std::vector<std::vector<double>> predict_result(const analytic::Model& model,
                                                 const sim::ResultFile& result,

@@ -7,6 +7,7 @@
 #    ~0.1 deg, and the model's published R Fresnel departs slightly from the
 #    simulator's), beta_azim within 1.5 deg, scale_tilt within 0.5 deg of 0;
 #    the fiber-atlas file, report.md, report.html and the figures are written.
+#    model_parameters reach the model (params_before) and the report.
 # 2. Bad configs: exit 2, one line naming the entry, nothing written.
 # 3. SIGINT during the sweep: exit 130, nothing written.
 set -uo pipefail
@@ -26,6 +27,7 @@ sweep:
   scale_tilt: [0]
   theta_i: [25]
 models: [exact, deon2011]
+model_parameters: {deon2011: {quadrature_order: 40}}
 fit: {max_iterations: 10}
 YAML
 if ! "$fiberlab" atlas "$work/a.yaml" -o "$work/a.h5" --threads 2 >"$work/out" 2>"$work/err"; then
@@ -37,6 +39,9 @@ for f in a.h5 a_report/report.md a_report/report.html a_report/report_data.h5 \
   [ -s "$work/$f" ] || { echo "FAIL: $f missing"; fail=1; }
 done
 grep -q "| deon2011 | 2 | TT |" "$work/a_report/report.md" || { echo "FAIL: no headline row in report.md"; fail=1; }
+grep -q "Fixed model parameters (not fitted; the config's model_parameters): deon2011: quadrature_order=40." \
+  "$work/a_report/report.md" || { echo "FAIL: report.md does not name the fixed parameters"; fail=1; }
+cmp -s "$work/a.h5" "$work/a_report/report_data.h5" || { echo "FAIL: report_data.h5 is not the atlas file"; fail=1; }
 /usr/bin/python3 - "$work/a.h5" <<'PY' || fail=1
 import sys, h5py, numpy as np
 f = h5py.File(sys.argv[1], "r")
@@ -53,6 +58,9 @@ for i, truth in enumerate([8.0, 12.0]):
     assert abs(v[i, 2]) < 0.5, ("scale_tilt", i, v[i, 2])
     assert 0 < e[i, 0] < 0.5, e[i]
 assert g["fitted"][...].tolist() == [1, 1]
+before = g.attrs["params_before"]
+before = (before.decode() if isinstance(before, bytes) else before).split("\n")
+assert all("quadrature_order=40" in b for b in before), before  # model_parameters reach the model
 assert f["models/exact/fitted"][...].tolist() == [0, 0]
 assert f["fibers/sim_energy"].shape == (2, 1, 4, 1), f["fibers/sim_energy"].shape
 print("ok: the fitted widths are the simulated ones")
@@ -84,6 +92,9 @@ sweep: {roughness: [{model: smooth}], theta_i: [10]}
 models: [huang1999]"
 bad "absorption both" "both sigma_a and melanin" "$base
 sweep: {roughness: [{model: smooth}], absorption: [{sigma_a: 1, melanin: {eumelanin: 1}}], theta_i: [10]}"
+bad "model parameter value" "model_parameters.deon2011.quadrature_order = 0 is not allowed" "$base
+sweep: {roughness: [{model: smooth}], theta_i: [10]}
+model_parameters: {deon2011: {quadrature_order: 0}}"
 bad "missing photons" "photons is missing" "sweep: {roughness: [{model: smooth}], theta_i: [10]}"
 # Ctrl-C: a sweep of several seconds, interrupted after one.
 cat >"$work/long.yaml" <<'YAML'

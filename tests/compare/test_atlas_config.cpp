@@ -3,9 +3,14 @@
 // simulator's, not a copy of its rules).
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "common/error.h"
 #include "common/units.h"
+#include "analytic/model_registry.h"
+#include "compare/atlas.h"
 #include "compare/atlas_config.h"
+#include "compare/models.h"
 
 namespace fiberlab::compare {
 namespace {
@@ -29,6 +34,9 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   // Melanin: three channels, sigma_a derived by the simulator.
   EXPECT_EQ(full.fibers[4].settings.fiber.sigma_a.size(), 3u);
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());
+  // huang2022's quadrature sized for the atlas (the config's comment says why).
+  EXPECT_EQ(full.model_parameters.at("huang2022"), std::vector<std::string>{"quadrature_points=262144"});
+  EXPECT_EQ(full.max_iterations, 10);
 }
 
 TEST(AtlasConfig, ModelsDefaultToEveryRegisteredOne) {
@@ -55,9 +63,96 @@ TEST(AtlasConfig, ErrorsNameTheEntry) {
             std::string::npos);
   EXPECT_NE(error_of("photons: 0\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n").find("photons"),
             std::string::npos);
+  // model_parameters: the model, the key and the value, each named with what is allowed.
+  const std::string sweep = "photons: 10\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n";
+  const std::string unknown_model = error_of(sweep + "model_parameters: {huang1999: {x: 1}}\n");
+  EXPECT_NE(unknown_model.find("unknown key model_parameters.huang1999 (allowed: "), std::string::npos)
+      << unknown_model;
+  EXPECT_NE(unknown_model.find("huang2022"), std::string::npos) << unknown_model;
+  EXPECT_NE(error_of(sweep + "models: [exact]\nmodel_parameters: {huang2022: {quadrature_points: 4096}}\n")
+                .find("unknown key model_parameters.huang2022 (allowed: exact)"),
+            std::string::npos);
+  const std::string bad_key = error_of(sweep + "model_parameters: {huang2022: {points: 4096}}\n");
+  EXPECT_NE(bad_key.find("unknown key model_parameters.huang2022.points (allowed: "), std::string::npos) << bad_key;
+  EXPECT_NE(bad_key.find("quadrature_points"), std::string::npos) << bad_key;
+  const std::string free_key = error_of(sweep + "model_parameters: {huang2022: {roughness: 0.2}}\n");
+  EXPECT_NE(free_key.find("model_parameters.huang2022.roughness is a free parameter"), std::string::npos) << free_key;
+  const std::string bad_value = error_of(sweep + "model_parameters: {huang2022: {quadrature_points: 100}}\n");
+  EXPECT_NE(bad_value.find("model_parameters.huang2022.quadrature_points = 100 is not allowed (allowed: an integer "
+                           "in [1024, 1073741824])"),
+            std::string::npos)
+      << bad_value;
+  EXPECT_EQ(bad_value.rfind("a.yaml: ", 0), 0u) << bad_value;
+  EXPECT_NE(error_of(sweep + "model_parameters: {huang2022: {masking: sideways}}\n").find("masking = sideways"),
+            std::string::npos);
+  EXPECT_NE(error_of(sweep + "model_parameters: {huang2022: 4096}\n").find("model_parameters.huang2022 = 4096 must be a mapping"),
+            std::string::npos);
   EXPECT_NE(error_of("photons: 10\nfit: {max_iterations: -1}\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n")
                 .find("fit.max_iterations"),
             std::string::npos);
+}
+
+// Fixed model parameters reach the model on top of its physical defaults:
+// the "before" parameters show the config's value, and the fiber's own
+// (eccentricity from the sweep) are still there.
+TEST(AtlasConfig, ModelParametersApplyOnTopOfThePhysicalDefaults) {
+  const AtlasConfig c = parse_atlas_config(
+      "photons: 2000\ntally: {n_theta: 6, n_phi: 8}\n"
+      "sweep: {roughness: [{model: ggx, alpha: 0.2}], eccentricity: [0.9], theta_i: 30}\n"
+      "models: [deon2011, huang2022]\n"
+      "model_parameters: {huang2022: {quadrature_points: 4096, masking: none}}\nfit: {max_iterations: 0}\n",
+      "t");
+  ASSERT_EQ(c.model_parameters.at("huang2022"),
+            (std::vector<std::string>{"quadrature_points=4096", "masking=none"}));
+  EXPECT_EQ(c.model_parameters.count("deon2011"), 0u);
+  AtlasControl control;
+  control.threads = 1;
+  const AtlasFiberResult r = run_atlas_fiber(c, 0, control);
+  ASSERT_EQ(r.models.size(), 2u);
+  const std::string& huang = r.models[1].params_before;
+  EXPECT_NE(huang.find("quadrature_points=4096"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("masking=none"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("eccentricity=0.9"), std::string::npos) << huang;
+  EXPECT_NE(huang.find("roughness=0.2"), std::string::npos) << huang;
+}
+
+// configs/atlas.yaml lowers huang2022's quadrature_points for speed; its
+// comment states the quadrature error against the simulation's noise at the
+// atlas's grid and photon count. Checked on the config's own ggx 0.3 fiber
+// (tilt 3 deg, e 0.85, white) at theta_i 45 deg against 4x the points: the
+// mean over bins with >= 10 expected photons of (bin error)^2 / (p / N) (the
+// simulated bin's variance, weights 1) is below 0.1 for R and p >= 3
+// (measured 0.014 and 0.003) and below 0.6 for TT and TRT (measured 0.43 and
+// 0.40: RMS errors of 0.65 standard errors, as the config's comment says).
+TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
+  const AtlasConfig c = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas.yaml");
+  const AtlasFiber& fiber = c.fibers.at(27);
+  ASSERT_EQ(fiber.roughness_model, "ggx");
+  ASSERT_EQ(fiber.roughness, 0.3);
+  ASSERT_EQ(fiber.settings.fiber.eccentricity, 0.85);
+  const analytic::ModelParams p =
+      params_for(fiber.settings, ModelSpec{"huang2022", c.model_parameters.at("huang2022"), "huang2022"}, {});
+  analytic::ModelParams reference = p;
+  reference.quadrature_points = 4 * p.quadrature_points;
+  const sim::TallySettings& t = fiber.settings.tally;
+  const BinGrid grid = BinGrid::make(t.n_theta, t.n_phi, t.theta_bins);
+  const double theta_i = deg_to_rad(45.0), photons = static_cast<double>(fiber.settings.photons);
+  const std::vector<double> q = compare::make_model("huang2022", p)->bin_probabilities(grid, theta_i, 0.0);
+  const std::vector<double> r = compare::make_model("huang2022", reference)->bin_probabilities(grid, theta_i, 0.0);
+  const std::size_t bins = static_cast<std::size_t>(t.n_theta) * t.n_phi;
+  ASSERT_EQ(q.size(), 4 * bins);  // one channel
+  for (int lobe = 0; lobe < 4; ++lobe) {
+    double sum = 0.0;
+    int n = 0;
+    for (std::size_t b = lobe * bins; b < (lobe + 1) * bins; ++b) {
+      if (r[b] * photons < 10.0) continue;
+      sum += (q[b] - r[b]) * (q[b] - r[b]) / (r[b] / photons);
+      ++n;
+    }
+    ASSERT_GT(n, 0) << "lobe " << lobe;
+    std::printf("lobe %d: mean squared quadrature error / simulated variance %.3f (%d bins)\n", lobe, sum / n, n);
+    EXPECT_LT(sum / n, lobe == 1 || lobe == 2 ? 0.6 : 0.1) << "lobe " << lobe;
+  }
 }
 
 }  // namespace
