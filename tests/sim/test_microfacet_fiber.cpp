@@ -8,13 +8,33 @@
 // - the ledger exited + absorbed + truncated + lost = N with absorption, and
 //   lost is absorbed along the path (less lost in a darker channel).
 //
-// Mutations each test is built to catch (not yet run against them):
-// - the tracer's mean normal untilted (mean_normal(d, {n0, n0})):
-//   SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber (R's theta marginal);
-// - no consistency rule for microfacet events (return after the first
-//   event): WhiteFurnaceWithoutMaskingLosesNothing (truncated jumps);
-// - lost not absorbed (weight booked without exp(-sigma l)):
-//   LedgerBalancesWithAbsorptionAndLost (lost equal in every channel).
+// Mutations run, each alone (statistic vs threshold):
+// - the VNDF about the untilted normal (mean_normal returns
+//   n.untilted_facing, or draw_normal handed {n0, n0}):
+//   SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber, R lobe theta chi2 28313
+//   over the 1 bin both runs fill (threshold 8.1, and >= 2 bins required;
+//   TT and TRT share none), phi chi2 867 vs 272 (R), 1255 vs 152 (TT);
+// - GGX stretch of w inverted (alpha 1e-4 acts as 1e4 at oblique w):
+//   SmallAlphaIsTheSmoothCylinder, TRT+ chi2 500 vs 131 (and the tilted
+//   test, TT theta 462 vs 20.8); GGX unstretch inverted: every test here;
+// - no repeated events (truncated after the first inconsistent event):
+//   WhiteFurnaceWithoutMaskingLosesNothing, truncated 0.025 (ggx 0.1) to
+//   0.34 (ggx 0.6) vs 5e-3; inconsistent events killed as Lost instead:
+//   absorbed 0.025 vs 0 (1e-12), and the same in the masking furnace;
+// - masking applied without `masking: smith_g1` (masks() always true):
+//   WhiteFurnaceWithoutMaskingLosesNothing, lost 0.039 to 0.53 vs exactly 0;
+// - lost not booked (photon_life's losses.add removed) or not scored
+//   (ExitScorer without score_lost): WhiteFurnaceWithMaskingLosesMoreWithAlpha,
+//   absorbed 0.039 (ggx 0.1) vs 0 and lost 0 not growing;
+// - lost not absorbed along the path (weight booked without exp(-sigma l)):
+//   LedgerBalancesWithAbsorptionAndLost, lost equal in the three channels;
+// - every refraction judged on the incident side (killed):
+//   SmallAlphaIsTheSmoothCylinder (beckmann + smith_g1 loses the TT, TRT
+//   lobes), LedgerBalances;
+// - the masking factor not multiplied into the weight (only its removal
+//   booked): caught here only by chance (absorbed 2.7e-4 at beckmann 0.1:
+//   Tally::score_lost caps each photon's lost at 1 - kept, which hides the
+//   double count); test_microfacet_masking's per-photon ledger catches it.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -132,9 +152,10 @@ TEST(MicrofacetFiber, SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber) {
     const Chi2 p = two_sample(pa1, a2, a.photons[0], pb1, b2, b.photons[0]);
     std::printf("tilted, lobe %d: theta chi2 %.1f over %d bins, phi chi2 %.1f over %d bins\n", lobe,
                 t.value, t.dof, p.value, p.dof);
-    ASSERT_GE(t.dof, 2);
+    // A lobe moved whole leaves few bins both runs fill: that fails too.
+    EXPECT_GE(t.dof, 2) << "theta, lobe " << lobe;
     EXPECT_LT(t.value, testing::chi2_threshold(t.dof)) << "theta, lobe " << lobe;
-    ASSERT_GT(p.dof, 10);
+    EXPECT_GT(p.dof, 10) << "phi, lobe " << lobe;
     EXPECT_LT(p.value, testing::chi2_threshold(p.dof)) << "phi, lobe " << lobe;
   }
 }

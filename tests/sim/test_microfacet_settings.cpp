@@ -1,6 +1,11 @@
 // The microfacet roughness block (issue 12): `roughness: {model: beckmann |
 // ggx, alpha: A | [longitudinal, azimuthal], masking: none | smith_g1}`, its
 // round trip through to_yaml and its one-line errors.
+//
+// Mutations run: [longitudinal, azimuthal] read in the other order
+// (IsotropicAnisotropicAndMasking: alpha_long 0.4 vs 0.1; the round trip
+// fails too); masking read but not stored (masking none vs smith_g1);
+// to_yaml writing the list in the other order (RoundTripThroughToYaml).
 #include <gtest/gtest.h>
 
 #include <string>

@@ -6,12 +6,12 @@
 
 #include <algorithm>
 #include <cmath>
-#include <tuple>
 #include <cstdio>
 #include <vector>
 
 #include "common/units.h"
 #include "sim/roughness_gaussian.h"
+#include "tests/sim/normal_samples_chi2.h"
 
 namespace fiberlab::sim {
 namespace {
@@ -30,27 +30,6 @@ Vec3 reference_normal(const Vec3& d, const Vec3& nf, double bl, double ba, Photo
   }
 }
 
-// 2D histogram of (m.u, azimuth of m about u relative to n_f), 20 x 20 bins
-// over the range the samples cover.
-struct Histogram2D {
-  std::vector<double> counts = std::vector<double>(400, 0.0);
-  double lo_u, hi_u, lo_a, hi_a;
-  static double azimuth_offset(const Vec3& m, const Vec3& nf) {
-    return wrap_angle(std::atan2(m.z(), m.y()) - std::atan2(nf.z(), nf.y()));
-  }
-  void add(const Vec3& m, const Vec3& nf) {
-    const int i = static_cast<int>((m.x() - lo_u) / (hi_u - lo_u) * 20);
-    const int j = static_cast<int>((azimuth_offset(m, nf) - lo_a) / (hi_a - lo_a) * 20);
-    if (i >= 0 && i < 20 && j >= 0 && j < 20) counts[i * 20 + j] += 1.0;
-  }
-};
-
-// The 1st and 99th percentiles of x: the histogram range.
-std::pair<double, double> central_range(std::vector<double> x) {
-  std::sort(x.begin(), x.end());
-  return {x[x.size() / 100], x[x.size() - 1 - x.size() / 100]};
-}
-
 void compare_samplers(const Vec3& d, const Vec3& nf, double bl, double ba, const char* what,
                       int n = 200000) {
   PhotonRandom ra(1, 2.0, 0.0, 3), rb(4, 5.0, 0.0, 6);
@@ -64,35 +43,11 @@ void compare_samplers(const Vec3& d, const Vec3& nf, double bl, double ba, const
     sa.push_back(*m);
     sb.push_back(reference_normal(d, nf, bl, ba, rb));
   }
-  // Bins over the range the reference samples cover.
-  std::vector<double> u, a;
-  for (const Vec3& m : sb) {
-    u.push_back(m.x());
-    a.push_back(Histogram2D::azimuth_offset(m, nf));
-  }
-  Histogram2D ha;
-  std::tie(ha.lo_u, ha.hi_u) = central_range(u);
-  std::tie(ha.lo_a, ha.hi_a) = central_range(a);
-  Histogram2D hb = ha;
-  for (int k = 0; k < n; ++k) {
-    ha.add(sa[k], nf);
-    hb.add(sb[k], nf);
-  }
-  // Two-sample chi-square over bins with >= 30 counts in both.
-  double chi2 = 0.0;
-  int dof = 0;
-  for (int k = 0; k < 400; ++k) {
-    if (ha.counts[k] < 30 || hb.counts[k] < 30) continue;
-    const double diff = ha.counts[k] - hb.counts[k];
-    chi2 += diff * diff / (ha.counts[k] + hb.counts[k]);
-    ++dof;
-  }
-  // chi2 ~ chi-square(dof) (mean dof, sd sqrt(2 dof)); 5 sd above the mean.
-  const double threshold = dof + 5.0 * std::sqrt(2.0 * dof);
+  const testing::NormalsChi2 r = testing::two_sample_normals_chi2(sa, sb, nf);
   std::printf("%s: %.1f draws per normal, chi2 %.1f over %d bins (threshold %.1f)\n", what,
-              static_cast<double>(tries) / n, chi2, dof, threshold);
-  ASSERT_GT(dof, 30);
-  EXPECT_LT(chi2, threshold) << what;
+              static_cast<double>(tries) / n, r.chi2, r.dof, r.threshold());
+  ASSERT_GT(r.dof, 30);
+  EXPECT_LT(r.chi2, r.threshold()) << what;
 }
 
 TEST(GaussianNormal, SameDistributionAsDefinitionAtNormalIncidence) {
