@@ -17,7 +17,7 @@ using life::store;
 using life::store_bits;
 using life::MaskOf;
 constexpr int W = kBatchWidth;
-static_assert(W <= 8, "the hand-over reads a vector's finished flags as one 64-bit word");
+static_assert(W <= 8, "the hand-over reads a vector's finished flags into one 64-bit word");
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many candidate normals per step; lanes
@@ -189,8 +189,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     // the lane moved down is one still in flight. (The order photons reach
     // the sink does not matter: tallies are exact integer sums.)
     for (int o = (n_active - 1) / W * W; o >= 0; o -= W) {
-      std::uint64_t lanes;  // byte k: lane o + k finished (0 or 1)
-      std::memcpy(&lanes, finished + o, sizeof lanes);
+      std::uint64_t lanes = 0;  // byte k: lane o + k finished (0 or 1)
+      std::memcpy(&lanes, finished + o, W);
       while (lanes != 0) {
         const int top_byte = (63 - __builtin_clzll(lanes)) / 8;
         lanes &= ~(std::uint64_t{0xff} << (8 * top_byte));
