@@ -1,6 +1,7 @@
 #include "sim/batch_tracer.h"
 
 #include <algorithm>
+#include <cstring>
 #include <memory>
 
 #include "common/error.h"
@@ -16,6 +17,7 @@ using life::store;
 using life::store_bits;
 using life::MaskOf;
 constexpr int W = kBatchWidth;
+static_assert(W <= 8, "the hand-over reads a vector's finished flags into one 64-bit word");
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many candidate normals per step; lanes
@@ -171,6 +173,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const std::uint64_t end = first + n;
   std::uint64_t next = first;
   int n_active = 0;
+  alignas(64) bool finished[kPoolLanes];  // lanes that finished this step
   while (true) {
     while (n_active < kPoolLanes && next < end) launch(n_active++, next++);
     if (n_active == 0) break;
@@ -179,13 +182,20 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       auto s = pool.load_state<Batch, Light>(o);
       life::step(config_, model, s, live, counts, kRoundsPerStep);
       pool.store_state(o, s);
+      (live & (s.code != Batch(life::kAtBoundary))).store_aligned(finished + o);
     }
-    for (int i = 0; i < n_active;) {  // hand over finished photons; the last lane takes the slot
-      if (pool.col[Pool::kCode][i] != static_cast<double>(life::kAtBoundary)) {
-        finish(i);
-        pool.move(i, --n_active, Light::kPolarized);
-      } else {
-        ++i;
+    // Hand over the finished photons, highest lane first: the last lane takes
+    // a finished lane's slot, and every lane above it is already settled, so
+    // the lane moved down is one still in flight. (The order photons reach
+    // the sink does not matter: tallies are exact integer sums.)
+    for (int o = (n_active - 1) / W * W; o >= 0; o -= W) {
+      std::uint64_t lanes = 0;  // byte k: lane o + k finished (0 or 1)
+      std::memcpy(&lanes, finished + o, W);
+      while (lanes != 0) {
+        const int top_byte = (63 - __builtin_clzll(lanes)) / 8;
+        lanes &= ~(std::uint64_t{0xff} << (8 * top_byte));
+        finish(o + top_byte);
+        pool.move(o + top_byte, --n_active, Light::kPolarized);
       }
     }
   }

@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "common/units.h"
+#include "common/bin_grid.h"
 
 namespace fiberlab::sim {
 
@@ -14,8 +15,58 @@ ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lob
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()) {}
 
+namespace {
+
+using Batch = xsimd::batch<double>;
+using Index = xsimd::batch<std::int64_t>;
+
+// BinGrid::theta_bin / phi_bin (common/bin_grid.cpp, the definition) for a
+// vector of values: the closed-form index, clamped, then settled on the
+// grid's own edges, so the result is the scalar one exactly (a test compares
+// them at and next to every edge).
+Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges) {
+  Batch i = xsimd::min(xsimd::max(xsimd::floor(fraction * Batch(n)), Batch(0.0)), Batch(n - 1));
+  const Index k = xsimd::to_int(i);
+  const Batch lo = Batch::gather(edges.data(), k), hi = Batch::gather(edges.data(), k + Index(1));
+  const auto down = (i > Batch(0.0)) & (v < lo);
+  const auto up = (!down) & (i < Batch(n - 1)) & (v >= hi);
+  i = i - xsimd::select(down, Batch(1.0), Batch(0.0)) + xsimd::select(up, Batch(1.0), Batch(0.0));
+  return xsimd::to_int(i);
+}
+
+// wrap_angle(a) (common/units.h) where a + pi lies in (-2 pi, 4 pi): there
+// fmod(a + pi, 2 pi) is a + pi, or a + pi - 2 pi computed exactly (Sterbenz),
+// so this is the same number. `in_range` is false where it does not apply.
+Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
+  Batch t = a + Batch(kPi);
+  in_range = (t > Batch(-kTwoPi)) & (t < Batch(2.0 * kTwoPi));
+  t = xsimd::select(t >= Batch(kTwoPi), t - Batch(kTwoPi), t);
+  t = xsimd::select(t < Batch(0.0), t + Batch(kTwoPi), t);
+  const Batch w = t - Batch(kPi);
+  return xsimd::select(w >= Batch(kPi), Batch(-kPi), w);
+}
+
+}  // namespace
+
+void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, std::int64_t* phi_bin) const {
+  constexpr int W = static_cast<int>(Batch::size);
+  const int n_theta = grid_.n_theta(), n_phi = grid_.n_phi();
+  const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
+  for (int i = 0; i < f.n; i += W) {
+    const Batch theta = Batch::load_aligned(f.theta + i);
+    const Batch theta_fraction = uniform ? (theta + Batch(kPi / 2)) / Batch(kPi)
+                                         : Batch(0.5) * (xsimd::sin(theta) + Batch(1.0));
+    settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges).store_aligned(theta_bin + i);
+    Batch::batch_bool_type in_range;
+    const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
+    settled_bin(phi, (phi + Batch(kPi)) / Batch(kTwoPi), n_phi, grid_.phi_edges).store_aligned(phi_bin + i);
+    if (!xsimd::all(in_range))
+      for (int k = i; k < std::min(i + W, f.n); ++k)
+        phi_bin[k] = grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k]));
+  }
+}
+
 void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
-  using Batch = xsimd::batch<double>;
   constexpr int W = static_cast<int>(Batch::size);
   constexpr int kCap = FinishedPhotons::kCapacity;
   const int channels = static_cast<int>(sigma_a_.size());
@@ -26,11 +77,13 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
       (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
           .store_unaligned(w + i);
   }
+  alignas(64) std::int64_t theta_bin[kCap], phi_bin[kCap];
+  block_bins(f, theta_bin, phi_bin);
   std::size_t bin[kCap];
   for (int i = 0; i < f.n; ++i) {
     if (!f.exited[i]) continue;
-    bin[i] = tally.bin_index(std::min(f.segments[i], last_lobe_), grid_.theta_bin(f.theta[i]),
-                             grid_.phi_bin(wrap_angle(f.phi[i] - f.phi_i[i])));
+    bin[i] = tally.bin_index(std::min(f.segments[i], last_lobe_), static_cast<int>(theta_bin[i]),
+                             static_cast<int>(phi_bin[i]));
     tally.prefetch(bin[i]);
   }
   double* weight = one_photon_.data();

@@ -3,6 +3,7 @@
 // Beer-Lambert weight exp(-sigma_a[c] l) per channel along the whole internal
 // path (times the photon's masking throughput), the lobe min(p, L - 1) and the
 // (theta_r, phi_r - phi_i) bin; weight removed by masking as the ledger's lost.
+#include <cstdint>
 #include <vector>
 
 #include "common/bin_grid.h"
@@ -17,6 +18,9 @@ class ExitScorer {
   // Weights are computed for a whole block at once (vectorised), the tally
   // cells of the exits are located and prefetched, then added.
   void score(const FinishedPhotons& f, Tally& tally);
+  // The theta and relative phi bins of a block's photons, vectorised (the
+  // same numbers as BinGrid::theta_bin / phi_bin of wrap_angle(phi - phi_i)).
+  void block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, std::int64_t* phi_bin) const;
 
  private:
   const BinGrid& grid_;

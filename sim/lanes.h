@@ -45,6 +45,7 @@ using BitsOf = typename NumberTraits<T>::Bits;
 inline double select(bool m, double a, double b) { return m ? a : b; }
 inline std::uint64_t select(bool m, std::uint64_t a, std::uint64_t b) { return m ? a : b; }
 inline bool any(bool m) { return m; }
+inline bool all(bool m) { return m; }
 inline double sqrt(double x) { return std::sqrt(x); }
 inline double log(double x) { return std::log(x); }
 inline double abs(double x) { return std::abs(x); }

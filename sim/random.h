@@ -10,6 +10,7 @@
 // one stream (T = double) or W streams side by side (T = Batch), each
 // advancing only where a mask says, so that every photon consumes its own
 // stream in the same order whichever way it is traced.
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -39,7 +40,19 @@ class LaneRandom {
   // Uniform in [0, 1) where m (other lanes: any value, stream untouched).
   T uniform(const MaskOf<T>& m) { return to_unit(next(m)); }
   // Uniform in (0, 1]: safe under log().
-  T uniform_open0(const MaskOf<T>& m) { return to_unit(next(m)) + T(0x1.0p-53); }
+  T uniform_open0(const MaskOf<T>& m) { return open0(uniform(m)); }
+  // N uniforms in [0, 1) where m: the same numbers as N calls of uniform(m),
+  // the stream's state masked once instead of N times.
+  template <int N>
+  std::array<T, N> uniforms(const MaskOf<T>& m) {
+    Bits s[4] = {s_[0], s_[1], s_[2], s_[3]};
+    std::array<T, N> u;
+    for (int k = 0; k < N; ++k) u[k] = to_unit(step(s));
+    commit(m, s);
+    return u;
+  }
+  // A uniform in [0, 1) moved to (0, 1].
+  static T open0(const T& u) { return u + T(0x1.0p-53); }
 
  private:
   static Bits rotl(const Bits& x, int k) { return (x << k) | (x >> (64 - k)); }
@@ -51,25 +64,31 @@ class LaneRandom {
              T(0x1.0p-53);
     }
   }
-  // xoshiro256**: result = rotl(s1 * 5, 7) * 9 (multiplies as shifts and adds,
-  // which every SIMD unit has), then the state steps where m.
   Bits next(const MaskOf<T>& m) {
-    const auto um = bits_mask(m);
-    const Bits x5 = (s_[1] << 2) + s_[1];
+    Bits s[4] = {s_[0], s_[1], s_[2], s_[3]};
+    const Bits result = step(s);
+    commit(m, s);
+    return result;
+  }
+  // xoshiro256**: result = rotl(s1 * 5, 7) * 9 (multiplies as shifts and adds,
+  // which every SIMD unit has), and the state s steps.
+  static Bits step(Bits (&s)[4]) {
+    const Bits x5 = (s[1] << 2) + s[1];
     const Bits r7 = rotl(x5, 7);
     const Bits result = (r7 << 3) + r7;
-    const Bits t = s_[1] << 17;
-    Bits n2 = s_[2] ^ s_[0];
-    Bits n3 = s_[3] ^ s_[1];
-    const Bits n1 = s_[1] ^ n2;
-    const Bits n0 = s_[0] ^ n3;
-    n2 = n2 ^ t;
-    n3 = rotl(n3, 45);
-    s_[0] = select(um, n0, s_[0]);
-    s_[1] = select(um, n1, s_[1]);
-    s_[2] = select(um, n2, s_[2]);
-    s_[3] = select(um, n3, s_[3]);
+    const Bits t = s[1] << 17;
+    s[2] = s[2] ^ s[0];
+    s[3] = s[3] ^ s[1];
+    s[1] = s[1] ^ s[2];
+    s[0] = s[0] ^ s[3];
+    s[2] = s[2] ^ t;
+    s[3] = rotl(s[3], 45);
     return result;
+  }
+  // The stepped state s becomes the stream's where m.
+  void commit(const MaskOf<T>& m, const Bits (&s)[4]) {
+    const auto um = bits_mask(m);
+    for (int k = 0; k < 4; ++k) s_[k] = select(um, s[k], s_[k]);
   }
 
   Bits s_[4];

@@ -7,7 +7,7 @@
 //
 // The sampler: one exact rejection sampler for every incidence, with the same
 // work for every candidate (a fixed block of five uniforms, one log, one
-// square root, three sincos), so that a SIMD vector of photons never waits
+// square root, three sine-cosine pairs, sim/life_trig.h), so that a SIMD vector of photons never waits
 // on a branch only some of its lanes take.
 //
 // The target density of the offsets is G(x) max(0, -d.m) with x = (dl /
@@ -36,6 +36,7 @@
 // (x from phi, accept with probability -d.m) is used instead.
 #include <optional>
 
+#include "sim/life_trig.h"
 #include "sim/roughness_model.h"
 #include "sim/settings.h"
 
@@ -61,13 +62,12 @@ class GaussianRoughness {
     for (int k = 0; k < rounds && any(pending); ++k) {
       counts.normal_draws = counts.normal_draws + ones<T>(pending);
       tries = tries + ones<T>(pending);
-      const T u_pick = rng.uniform(pending), u1 = rng.uniform_open0(pending),
-              u2 = rng.uniform_open0(pending), u_psi = rng.uniform(pending),
-              u_accept = rng.uniform(pending);
+      const auto [u_pick, u1_closed, u2_closed, u_psi, u_accept] = rng.template uniforms<5>(pending);
+      const T u1 = LaneRandom<T>::open0(u1_closed), u2 = LaneRandom<T>::open0(u2_closed);
       const MaskOf<T> gamma2 = u_pick * (env.a0 + env.b) < env.b;
       const T e = -log(u1 * select(gamma2, u2, T(1.0)));
       const T rho = sqrt(T(2.0) * (env.w0 + e));
-      const auto [sp, cp] = sincos(T(6.283185307179586) * u_psi);
+      const auto [sp, cp] = sincos_turn(u_psi);
       const Vec3Of<T> m =
           rotated_normal(sin_n, cos_n, pv, pw, T(beta_long_) * rho * cp, T(beta_azim_) * rho * sp);
       const T visible = -d.dot(m);
@@ -112,8 +112,8 @@ class GaussianRoughness {
   template <class T>
   static Vec3Of<T> rotated_normal(const T& sin_n, const T& cos_n, const T& pv, const T& pw,
                                   const T& dl, const T& da) {
-    const auto [sl, cl] = sincos(dl);
-    const auto [sa, ca] = sincos(da);
+    const auto [sl, cl] = sincos_small(dl);
+    const auto [sa, ca] = sincos_small(da);
     const T st = sin_n * cl + cos_n * sl, ct = cos_n * cl - sin_n * sl;
     return {st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
   }

@@ -1,5 +1,7 @@
 #include "sim/tally.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 
 #include "common/error.h"
@@ -50,7 +52,18 @@ void Tally::score_truncated(const double* weight) {
 
 void Tally::score_lost(const double* lost, const double* kept) {
   constexpr Fixed one = Fixed{1} << 60;
-  for (int c = 0; c < channels_; ++c) lost_[c] += std::min(to_fixed(lost[c]), one - to_fixed(kept[c]));
+  // Rounding of a photon's products: a few 2^-53 per event, so 2^-40 (about
+  // 1e-12 of the photon's weight) is far beyond it, and far below any real
+  // double booking (of the order of the weight itself).
+  constexpr Fixed rounding_allowance = Fixed{1} << 20;
+  for (int c = 0; c < channels_; ++c) {
+    const Fixed room = one - to_fixed(kept[c]), booked = to_fixed(lost[c]);
+    if (booked - room > rounding_allowance)
+      throw Error(fmt::format("internal error: a photon's lost weight {} plus its kept weight {} exceeds 1 "
+                              "(channel {}) by more than rounding",
+                              lost[c], kept[c], c));
+    lost_[c] += std::min(booked, room);
+  }
 }
 
 void Tally::add(const Tally& o) {

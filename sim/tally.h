@@ -63,7 +63,9 @@ class Tally {
   // the ledger's `lost`. In exact arithmetic lost + kept <= 1; the products
   // that make them round by a few 2^-53, so when nothing was absorbed they
   // can exceed 1 by that much: lost is held at 1 - kept in the fixed point
-  // here, so that absorbed (the complement) is never below 0.
+  // here, so that absorbed (the complement) is never below 0. More than
+  // rounding (2^-40) is a booking error: an internal error is thrown, never
+  // clamped.
   void score_lost(const double* lost, const double* kept);
   // Every launched photon must have been scored (exited, truncated, lost): what
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).

@@ -16,7 +16,8 @@
 // - lost not absorbed along the path: lost[0] > lost[1] fails (equal);
 // - ggx <-> beckmann model swap: lost[0] > 0.1 fails (beckmann 0.3 loses 0.07);
 // - score_lost's cap removed: RoundingNeverMakesAbsorbedNegative (absorbed
-//   wraps round to 2^128 - 256 units).
+//   wraps round to 2^128 - 256 units); its allowance check removed:
+//   DoubleBookingIsAnInternalError.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -129,6 +130,17 @@ TEST(TallyLost, RoundingNeverMakesAbsorbedNegative) {
     EXPECT_EQ(e.absorbed[0], 0u) << "kept " << kept;
     EXPECT_EQ(e.exited[0] + e.lost[0] + e.absorbed[0], one) << "kept " << kept;
   }
+}
+
+// More than rounding is a booking error, reported, never clamped (a lost
+// factor booked but also left in the weight double-counts the whole factor).
+// Mutation caught: the allowance check removed (the excess is clamped
+// silently and nothing is thrown).
+TEST(TallyLost, DoubleBookingIsAnInternalError) {
+  Tally t(1, 1, 1, 1);
+  const double kept = 0.6, lost = 0.5;
+  t.score_exit(0, 0, 0, &kept);
+  EXPECT_THROW(t.score_lost(&lost, &kept), Error);
 }
 
 TEST(ExactTallyLost, WordsAndSumsCarryLost) {
