@@ -37,6 +37,11 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   // huang2022's quadrature sized for the atlas (the config's comment says why).
   EXPECT_EQ(full.model_parameters.at("huang2022"), std::vector<std::string>{"quadrature_points=262144"});
   EXPECT_EQ(full.max_iterations, 10);
+  // The medium sweep: 8 of the default's fibers with its settings.
+  const AtlasConfig medium = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas_medium.yaml");
+  EXPECT_EQ(medium.fibers.size(), 8u);
+  EXPECT_EQ(medium.model_parameters, full.model_parameters);
+  EXPECT_EQ(medium.max_iterations, full.max_iterations);
 }
 
 TEST(AtlasConfig, ModelsDefaultToEveryRegisteredOne) {
