@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <cmath>
+#include <filesystem>
 #include <limits>
 #include <sstream>
 #include <type_traits>
@@ -336,6 +337,11 @@ void write_atlas_checkpoint(const std::string& path, const AtlasRunSetup& setup,
 }
 
 AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw Error(fmt::format("{}: no such checkpoint file (an interrupted atlas leaves OUT.checkpoint.h5)", path));
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(fmt::format("{}: is not a regular file (a checkpoint is OUT.checkpoint.h5)", path));
   const h5::File f = h5::File::open_read(path);
   const Reader r{f, path};
   if (!f.has_attr("/", "format") || r.text("/", "format") != kFormat)
