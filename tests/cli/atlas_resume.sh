@@ -14,7 +14,8 @@
 #    times), the same report tables, and removes the checkpoint.
 # 5. SIGKILL (a killed session: no handler runs) after a checkpoint: the
 #    resume without CONFIG gives the reference's results too, and no
-#    temporary file is left.
+#    temporary file is left. Again once OUT is written, before the report:
+#    the resume restores all 4 fibers and runs none.
 # 6. Damaged checkpoints (truncated, not HDF5, not a checkpoint, an index out
 #    of range): exit 2, one line naming the file, nothing written, no crash.
 # 7. SIGTERM before the first fiber is finished: exit 143, nothing written.
@@ -49,15 +50,16 @@ say_fail() { echo "FAIL: $*"; fail=1; }
 [ -e "$work/ref.checkpoint.h5" ] && say_fail "the finished run left its checkpoint"
 
 # Starts an atlas of OUT in the background (set -m: SIGINT not ignored),
-# waits for its checkpoint, sends SIGNAL; sets `got` to its exit status.
-interrupt_after_checkpoint() {  # OUT SIGNAL
-  local out=$1 sig=$2 pid
+# waits for the file OUT.WAIT_FOR (its checkpoint by default), sends SIGNAL;
+# sets `got` to its exit status.
+interrupt_after_checkpoint() {  # OUT SIGNAL [WAIT_FOR]
+  local out=$1 sig=$2 wait_for=${3:-checkpoint.h5} pid
   set -m
   "$fiberlab" atlas "$work/r.yaml" -o "$work/$out.h5" --threads 2 >"$work/$out.out" 2>"$work/$out.err" &
   pid=$!
   set +m
   for _ in $(seq 1 3000); do
-    [ -e "$work/$out.checkpoint.h5" ] && break
+    [ -e "$work/$out.$wait_for" ] && break
     kill -0 "$pid" 2>/dev/null || break
     sleep 0.02
   done
@@ -114,6 +116,8 @@ if (cd / && "$fiberlab" atlas --resume "$ck" "$work/r.yaml" --threads 2 >"$work/
   cmp -s "$work/ref_report/atlas_tables.md" "$work/b_report/atlas_tables.md" || say_fail "report tables differ"
   [ -e "$ck" ] && say_fail "the checkpoint is left after the final write"
   [ -s "$work/b_report/report.md" ] || say_fail "no report after the resume"
+  [ "$(grep -c '^fiber ' "$work/err")" = "$((4 - ${saved:-0}))" ] || say_fail "the resume did not run just the rest"
+  echo "ok (resume): $(head -n 1 "$work/err"), the reference's results, checkpoint removed"
 else
   say_fail "resume exited $?"; cat "$work/err"
 fi
@@ -129,6 +133,24 @@ else
   ls -a "$work" | grep -q '\.tmp-' && say_fail "a temporary file is left after the resume"
   [ -e "$work/c.checkpoint.h5" ] && say_fail "the checkpoint is left after SIGKILL's resume"
   echo "ok (SIGKILL, then resume): the reference's results"
+fi
+
+# 5b. SIGKILL once OUT is written, while the report is made: the checkpoint
+#     (removed only after the report) has every fiber; the resume runs none
+#     and writes OUT and the report again. Skipped when the run ends first.
+interrupt_after_checkpoint n KILL h5
+if [ "$got" = 0 ]; then
+  echo "skipped (SIGKILL after OUT): the run finished before the signal"
+elif [ "$got" != 137 ] || [ ! -s "$work/n.checkpoint.h5" ]; then
+  say_fail "SIGKILL after OUT: exit $got, want 137 and a checkpoint"
+elif ! "$fiberlab" atlas --resume "$work/n.checkpoint.h5" >"$work/out" 2>"$work/err"; then
+  say_fail "resume of a complete checkpoint exited $?"; cat "$work/err"
+else
+  grep -qx "resuming: 4 of 4 fibers from $work/n.checkpoint.h5" "$work/err" || say_fail "no 'resuming: 4 of 4' line"
+  grep -q "^fiber " "$work/err" && say_fail "a saved fiber was run again"
+  "$py" "$same_results" "$work/ref.h5" "$work/n.h5" || say_fail "complete checkpoint: results differ"
+  [ -s "$work/n_report/report.md" ] && [ ! -e "$work/n.checkpoint.h5" ] || say_fail "complete checkpoint: report or cleanup"
+  echo "ok (SIGKILL after OUT, then resume): 4 of 4 fibers restored, the reference's results"
 fi
 
 # 6. Damaged checkpoints.
