@@ -130,10 +130,10 @@ void atlas_command(const AtlasOptions& o, const std::string& command) {
     }
   } catch (const compare::AtlasInterrupted& s) {
     if (job.fibers.empty())
-      fmt::print(stderr, "\nfiberlab: atlas interrupted by {} before its first fiber was finished; nothing "
+      fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first fiber was finished; nothing "
                  "written\n", signal_name(s.signal));
     else
-      fmt::print(stderr, "\nfiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
+      fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
                  "fiberlab atlas --resume {}\n", signal_name(s.signal), job.fibers.size(), n, job.checkpoint,
                  job.checkpoint);
     exit_code = 128 + s.signal;
