@@ -165,11 +165,11 @@ damaged "not an HDF5 file" "cannot open as an HDF5 file"
 cp "$work/ref.h5" "$work/d.checkpoint.h5"
 damaged "an atlas file, not a checkpoint" "not a fiberlab atlas checkpoint"
 cp "$work/saved.h5" "$work/d.checkpoint.h5"
-"$py" -c 'import sys, h5py; h5py.File(sys.argv[1], "r+")["fiber_0/model_1/before"][0, 1] = 7' "$work/d.checkpoint.h5"
+"$py" -c 'import sys, h5py; h5py.File(sys.argv[1], "r+")["comparisons"][0, 1] = 7' "$work/d.checkpoint.h5"
 damaged "lobe index out of range" "(k, lobe, channel) = (0, 7, 0) is outside the fiber's 1 x 4 x 1"
 cp "$work/saved.h5" "$work/d.checkpoint.h5"
-"$py" -c 'import sys, h5py; del h5py.File(sys.argv[1], "r+")["fiber_0/sim_energy"]' "$work/d.checkpoint.h5"
-damaged "missing dataset" "missing /fiber_0/sim_energy"
+"$py" -c 'import sys, h5py; del h5py.File(sys.argv[1], "r+")["sim_energy"]' "$work/d.checkpoint.h5"
+damaged "missing dataset" "sim_energy"
 
 # 7. SIGTERM before any fiber is finished: nothing to keep.
 set -m

@@ -148,6 +148,28 @@ TEST_F(AtlasCheckpointTest, AFiberReadBackIsTheFiberWrittenBitForBit) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 1);
 }
 
+// No model fitted (fit.max_iterations 0) and a model not applicable (an
+// elliptical fiber for deon2011): nothing of either kind to store, and still
+// read back as written.
+TEST_F(AtlasCheckpointTest, FibersWithoutFitsReadBackToo) {
+  std::string yaml = kConfig;
+  yaml.replace(yaml.find("max_iterations: 2"), 17, "max_iterations: 0");
+  yaml.replace(yaml.find("theta_i: [20, 50]"), 17, "theta_i: [20, 50]\n  eccentricity: [1, 0.9]");
+  AtlasRunSetup setup{"u.yaml", yaml, "", "u.h5", "/tmp/r", "fiberlab atlas u.yaml -o u.h5 --report /tmp/r"};
+  const AtlasConfig config = atlas_config_of(setup);
+  ASSERT_EQ(config.fibers.size(), 4u);
+  AtlasControl control;
+  control.threads = 1;
+  const std::vector<AtlasFiberResult> fibers{run_atlas_fiber(config, 0, control), run_atlas_fiber(config, 1, control)};
+  ASSERT_FALSE(fibers[1].models[1].applicable) << fibers[1].models[1].status;
+  ASSERT_FALSE(fibers[0].models[1].fitted) << fibers[0].models[1].status;
+  write_atlas_checkpoint(path("u.checkpoint.h5"), setup, config, fibers);
+  const AtlasCheckpoint c = read_atlas_checkpoint(path("u.checkpoint.h5"));
+  ASSERT_EQ(c.fibers.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) expect_same(fibers[i], c.fibers[i], "fiber " + std::to_string(i + 1));
+  EXPECT_EQ(c.setup.report_dir, "/tmp/r");
+}
+
 TEST(AtlasCheckpoint, IdentityFollowsWhatChangesTheResults) {
   const std::string base = atlas_config_identity(parse_atlas_config(kConfig, "a"));
   // Comments, key order and the file's name change nothing.
