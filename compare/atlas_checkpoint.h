@@ -12,12 +12,12 @@
 // simulation's sums are exact, its photons seeded by index; the fits are
 // deterministic), and the saved ones are restored bit for bit (float64).
 //
-// Format "fiber-atlas-checkpoint" (format_version, software_version as every
-// fiberlab file; checkpoint_version below), root attributes config_path,
-// config_yaml, photons_flag, output_name, report_dir, command, identity,
-// fibers_total, fibers_saved; one group /fiber_I per saved fiber (I = 0 ..
-// fibers_saved - 1, the sweep's order), one /fiber_I/model_M per model of the
-// config. Only the fiberlab version that wrote a checkpoint resumes it.
+// Format "fiber-atlas-checkpoint" (docs/FILE_FORMAT.md): format_version,
+// software_version as every fiberlab file, checkpoint_version below; the
+// setup and identity as root attributes; every saved fiber's numbers
+// flattened into a dozen datasets (the sweep's order), its strings into
+// line-per-entry attributes. Only the fiberlab version that wrote a
+// checkpoint resumes it.
 #include <cstdint>
 #include <string>
 #include <vector>
