@@ -36,7 +36,6 @@ std::vector<std::string> lines_of(const std::string& text) {
   return out;
 }
 
-
 // Every field of a LobeComparison, in one place: visit(name, member) for
 // each, so that writing (a row of doubles) and reading (the row back, each
 // value checked for its type) cannot disagree on the columns.
