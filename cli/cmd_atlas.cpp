@@ -143,6 +143,13 @@ void atlas_command(const AtlasOptions& o, const std::string& command) {
   fmt::print("wrote {}\n", job.output);
   fmt::print("\n{}", compare::atlas_headline_markdown(job.config, job.fibers));
   fmt::print("{}", compare::write_atlas_report(job.report, job.output, job.config, job.fibers, job.setup.command));
+  if (interrupt_requested()) {  // during the report (its plots run in a child process the signal reached too)
+    fmt::print(stderr, "fiberlab: atlas interrupted by {} while making its report: {} is written, the report may "
+               "be incomplete; both are written again by: fiberlab atlas --resume {}\n",
+               signal_name(interrupt_signal()), job.output, job.checkpoint);
+    exit_code = 128 + interrupt_signal();
+    return;
+  }
   // The file and the report are written: the checkpoint has served.
   std::error_code ec;
   if (!std::filesystem::remove(job.checkpoint, ec) && ec)

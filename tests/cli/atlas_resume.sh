@@ -14,8 +14,8 @@
 #    times), the same report tables, and removes the checkpoint.
 # 5. SIGKILL (a killed session: no handler runs) after a checkpoint: the
 #    resume without CONFIG gives the reference's results too, and no
-#    temporary file is left. Again once OUT is written, before the report:
-#    the resume restores all 4 fibers and runs none.
+#    temporary file is left. SIGTERM once OUT is written, during the
+#    report: the resume restores all 4 fibers and runs none.
 # 6. Damaged checkpoints (truncated, not HDF5, not a checkpoint, an index out
 #    of range): exit 2, one line naming the file, nothing written, no crash.
 # 7. SIGTERM before the first fiber is finished: exit 143, nothing written.
@@ -50,16 +50,16 @@ say_fail() { echo "FAIL: $*"; fail=1; }
 [ -e "$work/ref.checkpoint.h5" ] && say_fail "the finished run left its checkpoint"
 
 # Starts an atlas of OUT in the background (set -m: SIGINT not ignored),
-# waits for the file OUT.WAIT_FOR (its checkpoint by default), sends SIGNAL;
-# sets `got` to its exit status.
+# waits for the file WAIT_FOR in the work folder (OUT's checkpoint by
+# default), sends SIGNAL; sets `got` to its exit status.
 interrupt_after_checkpoint() {  # OUT SIGNAL [WAIT_FOR]
-  local out=$1 sig=$2 wait_for=${3:-checkpoint.h5} pid
+  local out=$1 sig=$2 wait_for=${3:-$1.checkpoint.h5} pid
   set -m
   "$fiberlab" atlas "$work/r.yaml" -o "$work/$out.h5" --threads 2 >"$work/$out.out" 2>"$work/$out.err" &
   pid=$!
   set +m
   for _ in $(seq 1 3000); do
-    [ -e "$work/$out.$wait_for" ] && break
+    [ -e "$work/$wait_for" ] && break
     kill -0 "$pid" 2>/dev/null || break
     sleep 0.02
   done
@@ -135,14 +135,17 @@ else
   echo "ok (SIGKILL, then resume): the reference's results"
 fi
 
-# 5b. SIGKILL once OUT is written, while the report is made: the checkpoint
-#     (removed only after the report) has every fiber; the resume runs none
-#     and writes OUT and the report again. Skipped when the run ends first.
-interrupt_after_checkpoint n KILL h5
+# 5b. SIGTERM once OUT is written, while the report's plots are made (after
+#     its copy of OUT: a signal during a file's write ends at once): exit
+#     143, one line saying so; the checkpoint (removed only after the
+#     report) has every fiber; the resume runs none and writes OUT and the
+#     report again. Skipped when the run ends before the signal.
+interrupt_after_checkpoint n TERM n_report/report_data.h5
 if [ "$got" = 0 ]; then
-  echo "skipped (SIGKILL after OUT): the run finished before the signal"
-elif [ "$got" != 137 ] || [ ! -s "$work/n.checkpoint.h5" ]; then
-  say_fail "SIGKILL after OUT: exit $got, want 137 and a checkpoint"
+  echo "skipped (SIGTERM after OUT): the run finished before the signal"
+elif [ "$got" != 143 ] || [ ! -s "$work/n.checkpoint.h5" ] || ! tail -n 1 "$work/n.err" | grep -qx \
+     "fiberlab: atlas interrupted by SIGTERM while making its report: $work/n.h5 is written, the report may be incomplete; both are written again by: fiberlab atlas --resume $work/n.checkpoint.h5"; then
+  say_fail "SIGTERM after OUT: exit $got, want 143, the line and a checkpoint"; tail -n 1 "$work/n.err"
 elif ! "$fiberlab" atlas --resume "$work/n.checkpoint.h5" >"$work/out" 2>"$work/err"; then
   say_fail "resume of a complete checkpoint exited $?"; cat "$work/err"
 else
@@ -150,7 +153,7 @@ else
   grep -q "^fiber " "$work/err" && say_fail "a saved fiber was run again"
   "$py" "$same_results" "$work/ref.h5" "$work/n.h5" || say_fail "complete checkpoint: results differ"
   [ -s "$work/n_report/report.md" ] && [ ! -e "$work/n.checkpoint.h5" ] || say_fail "complete checkpoint: report or cleanup"
-  echo "ok (SIGKILL after OUT, then resume): 4 of 4 fibers restored, the reference's results"
+  echo "ok (SIGTERM after OUT, then resume): 4 of 4 fibers restored, the reference's results"
 fi
 
 # 6. Damaged checkpoints.
