@@ -1,10 +1,13 @@
 // `fiberlab atlas CONFIG -o OUT.h5 [--report DIR] [--threads T] [--photons N] [--quiet]`
+// `fiberlab atlas --resume OUT.checkpoint.h5 [CONFIG] [--threads T] [--quiet]`
 // How wrong is each model for each physical fiber of a sweep, per lobe,
 // before and after fitting its free parameters? The sweep and the
 // judgement: compare/atlas.h; the config: compare/atlas_config.h; the file:
-// compare/atlas_file.h; the report: compare/atlas_report.h.
+// compare/atlas_file.h; the report: compare/atlas_report.h; the checkpoint
+// saved after each fiber (OUT.checkpoint.h5, as `fiberlab run`'s):
+// compare/atlas_checkpoint.h.
 // Exit status 0 when written, 2 on bad input (nothing written), 128 + signal
-// when interrupted (nothing written).
+// when interrupted (the finished fibers kept in the checkpoint, no OUT).
 #include <fmt/core.h>
 
 #include <omp.h>
@@ -17,9 +20,11 @@
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "compare/atlas.h"
+#include "compare/atlas_checkpoint.h"
 #include "compare/atlas_config.h"
 #include "compare/atlas_file.h"
 #include "compare/atlas_report.h"
+#include "sim/checkpoint.h"
 #include "sim/memory_budget.h"
 #include "sim/settings.h"
 
@@ -28,7 +33,7 @@ namespace fiberlab::cli {
 namespace {
 
 struct AtlasOptions {
-  std::string config, output, report, threads, photons;
+  std::string config, output, report, threads, photons, resume;
   bool quiet = false;
 };
 
@@ -50,36 +55,105 @@ void check_report_dir(const std::string& dir) {
     throw Error(fmt::format("--report {}: its parent folder {} does not exist", dir, parent.string()));
 }
 
+const char* signal_name(int sig) { return sig == 2 ? "SIGINT" : sig == 15 ? "SIGTERM" : "a signal"; }
+
+// What one invocation runs: a new atlas, or the rest of a checkpoint's.
+struct AtlasJob {
+  compare::AtlasRunSetup setup;
+  compare::AtlasConfig config;
+  std::vector<compare::AtlasFiberResult> fibers;  // finished (from the checkpoint when resuming)
+  std::string output, report, checkpoint;
+  std::vector<std::string> inputs;                // files read: never overwritten
+  bool resumed = false;
+};
+
+AtlasJob new_job(const AtlasOptions& o, const std::string& command) {
+  if (o.config.empty()) throw Error("atlas: give a CONFIG file, or --resume CHECKPOINT");
+  if (o.output.empty()) throw Error("atlas: give the output file with -o OUT.h5");
+  AtlasJob job;
+  job.config = compare::load_atlas_config(o.config);
+  if (!o.photons.empty()) compare::override_photons(job.config, o.photons);
+  job.output = o.output;
+  job.report = o.report.empty() ? default_report_dir(o.output) : o.report;
+  job.checkpoint = sim::checkpoint_path(o.output);
+  job.inputs = {o.config};
+  if (std::filesystem::exists(job.checkpoint))
+    throw Error(fmt::format("{} exists (an interrupted atlas of this output): resume it with "
+                            "`fiberlab atlas --resume {}`, or delete it", job.checkpoint, job.checkpoint));
+  job.setup = {o.config, job.config.yaml, o.photons, std::filesystem::path(o.output).filename().string(),
+               o.report.empty() ? "" : std::filesystem::absolute(o.report).string(), command};
+  return job;
+}
+
+// The checkpoint holds the config, the flags and OUT (in its own folder):
+// only --threads and --quiet may be given; CONFIG, if given, must be the same.
+AtlasJob resumed_job(const AtlasOptions& o) {
+  if (!o.output.empty() || !o.report.empty() || !o.photons.empty())
+    throw Error("--resume: -o, --report and --photons are the checkpoint's and cannot be changed "
+                "(only --threads and --quiet; CONFIG, if given, must be the checkpoint's)");
+  compare::AtlasCheckpoint c = compare::read_atlas_checkpoint(o.resume);
+  if (!o.config.empty()) compare::check_same_atlas_config(c, compare::load_atlas_config(o.config), o.resume);
+  AtlasJob job;
+  job.setup = std::move(c.setup);
+  job.config = std::move(c.config);
+  job.fibers = std::move(c.fibers);
+  job.output = (std::filesystem::path(o.resume).parent_path() / job.setup.output_name).string();
+  job.report = job.setup.report_dir.empty() ? default_report_dir(job.output) : job.setup.report_dir;
+  job.checkpoint = o.resume;
+  job.inputs = {o.resume};
+  if (!o.config.empty()) job.inputs.push_back(o.config);
+  job.resumed = true;
+  return job;
+}
+
 void atlas_command(const AtlasOptions& o, const std::string& command) {
-  compare::AtlasConfig config = compare::load_atlas_config(o.config);
-  if (!o.photons.empty()) {
-    const std::uint64_t n = sim::parse_integer_flag("--photons", o.photons, 1, 1000000000000ULL);
-    for (auto& f : config.fibers) f.settings.photons = n;
-  }
+  AtlasJob job = o.resume.empty() ? new_job(o, command) : resumed_job(o);
   compare::AtlasControl control;
   if (!o.threads.empty()) {
     control.threads = static_cast<int>(sim::parse_integer_flag("--threads", o.threads, 1, sim::kMaxThreads));
     omp_set_num_threads(control.threads);
   }
-  if (o.output.empty()) throw Error("atlas: give the output file with -o OUT.h5");
-  const std::string report = o.report.empty() ? default_report_dir(o.output) : o.report;
-  check_output_target(o.output, {o.config});
-  check_report_dir(report);
+  check_output_target(job.output, job.inputs);
+  // The checkpoint is rewritten in place when resuming; never over CONFIG.
+  check_output_target(job.checkpoint, o.config.empty() ? std::vector<std::string>{} : std::vector{o.config});
+  check_report_dir(job.report);
   if (!o.quiet) control.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
 
   install_interrupt_handlers();
-  std::vector<compare::AtlasFiberResult> results;
+  const std::size_t n = job.config.fibers.size();
+  if (job.resumed && control.progress)
+    control.progress(fmt::format("resuming: {} of {} fibers from {}", job.fibers.size(), n, job.checkpoint));
   try {
-    for (std::size_t i = 0; i < config.fibers.size(); ++i) results.push_back(compare::run_atlas_fiber(config, i, control));
+    while (job.fibers.size() < n) {
+      job.fibers.push_back(compare::run_atlas_fiber(job.config, job.fibers.size(), control));
+      compare::write_atlas_checkpoint(job.checkpoint, job.setup, job.config, job.fibers);
+    }
   } catch (const compare::AtlasInterrupted& s) {
-    fmt::print(stderr, "\nfiberlab: atlas interrupted by signal {}; nothing written\n", s.signal);
+    if (job.fibers.empty())
+      fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first fiber was finished; nothing "
+                 "written\n", signal_name(s.signal));
+    else
+      fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
+                 "fiberlab atlas --resume {}\n", signal_name(s.signal), job.fibers.size(), n, job.checkpoint,
+                 job.checkpoint);
     exit_code = 128 + s.signal;
     return;
   }
-  compare::write_atlas_file(o.output, config, results);
-  fmt::print("wrote {}\n", o.output);
-  fmt::print("\n{}", compare::atlas_headline_markdown(config, results));
-  fmt::print("{}", compare::write_atlas_report(report, o.output, config, results, command));
+  compare::write_atlas_file(job.output, job.config, job.fibers);
+  fmt::print("wrote {}\n", job.output);
+  fmt::print("\n{}", compare::atlas_headline_markdown(job.config, job.fibers));
+  fmt::print("{}", compare::write_atlas_report(job.report, job.output, job.config, job.fibers, job.setup.command));
+  if (interrupt_requested()) {  // during the report (its plots run in a child process the signal reached too)
+    fmt::print(stderr, "fiberlab: atlas interrupted by {} while making its report: {} is written, the report may "
+               "be incomplete; both are written again by: fiberlab atlas --resume {}\n",
+               signal_name(interrupt_signal()), job.output, job.checkpoint);
+    exit_code = 128 + interrupt_signal();
+    return;
+  }
+  // The file and the report are written: the checkpoint has served.
+  std::error_code ec;
+  if (!std::filesystem::remove(job.checkpoint, ec) && ec)
+    fmt::print(stderr, "fiberlab: warning: could not remove the checkpoint {}: {}\n", job.checkpoint, ec.message());
 }
 
 }  // namespace
@@ -90,11 +164,13 @@ void add_atlas_command(CLI::App& app) {
       "atlas",
       "Simulate a sweep of physical fibers and judge every registered model on each, before and after "
       "fitting its free parameters (configs/atlas_small.yaml; docs/ATLAS.md)");
-  cmd->add_option("config", o->config, "Atlas config (.yaml)")->required();
-  cmd->add_option("-o,--output", o->output, "Output file (.h5, format fiber-atlas)")->required();
+  cmd->add_option("config", o->config, "Atlas config (.yaml); with --resume, checked against the checkpoint's");
+  cmd->add_option("-o,--output", o->output, "Output file (.h5, format fiber-atlas)");
   cmd->add_option("--report", o->report, "Report folder (default: OUT without .h5, plus _report)");
   cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
   cmd->add_option("--photons", o->photons, "Photons per fiber and incident direction (overrides the config)");
+  cmd->add_option("--resume", o->resume,
+                  "Finish the atlas saved in this checkpoint (OUT.checkpoint.h5, written after each fiber)");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] {
     std::string command = "fiberlab atlas " + o->config + " -o " + o->output;

@@ -51,21 +51,14 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
   return compare(r, predict_result(*model, r), p.alpha);
 }
 
-AtlasModelResult evaluate_model(const AtlasConfig& config, const sim::ResultFile& r, const std::string& name,
-                                const AtlasControl& control) {
+AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fiber, const sim::ResultFile& r,
+                                const std::string& name, const AtlasControl& control) {
   const auto t0 = Clock::now();
   AtlasModelResult m;
   m.model = name;
   analytic::ModelParams p;
   try {
-    // The config's fixed parameters (model_parameters) on top of the
-    // model's physical defaults for this fiber.
-    const auto fixed = config.model_parameters.find(name);
-    p = params_for(r.settings,
-                   ModelSpec{name, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second,
-                             name},
-                   {});
-    compare::make_model(name, p);  // the model's own checks
+    p = atlas_start_params(config, fiber, name);
   } catch (const Error& e) {
     m.status = std::string("not applicable: ") + e.what();
     say(control, fmt::format("  {}: {}", name, m.status));
@@ -101,6 +94,17 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const sim::ResultFile
 
 }  // namespace
 
+analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+                                         const std::string& model) {
+  const auto fixed = config.model_parameters.find(model);
+  const analytic::ModelParams p = params_for(
+      fiber.settings,
+      ModelSpec{model, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second, model},
+      {});
+  compare::make_model(model, p);  // the model's own checks
+  return p;
+}
+
 AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t index, const AtlasControl& control) {
   check_interrupt();
   AtlasFiberResult out;
@@ -124,7 +128,7 @@ AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t index, c
   const auto t1 = Clock::now();
   for (const std::string& name : config.models) {
     check_interrupt();
-    out.models.push_back(evaluate_model(config, r, name, control));
+    out.models.push_back(evaluate_model(config, out.fiber, r, name, control));
   }
   out.fit_seconds = seconds_since(t1);
   return out;

@@ -61,6 +61,13 @@ struct AtlasControl {
 // (install_interrupt_handlers() must have been called by the command).
 AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t fiber, const AtlasControl& control);
 
+// The parameters model `model` starts from for `fiber`: its physical
+// defaults for the fiber (ModelInfo::from_fiber) with the config's
+// model_parameters on top, checked by the model. Throws fiberlab::Error when
+// the model refuses the fiber (then "not applicable").
+analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+                                         const std::string& model);
+
 // Summary per fiber, model and lobe, over every theta_i and channel.
 struct AtlasLobeSummary {
   double max_abs_energy_error = 0.0;     // max |E_model - E_sim| (fraction of incident light)

@@ -300,4 +300,9 @@ AtlasConfig load_atlas_config(const std::string& path) {
   return parse_atlas_config(text, path);
 }
 
+void override_photons(AtlasConfig& config, const std::string& flag_text) {
+  const std::uint64_t n = sim::parse_integer_flag("--photons", flag_text, 1, 1000000000000ULL);
+  for (AtlasFiber& f : config.fibers) f.settings.photons = n;
+}
+
 }  // namespace fiberlab::compare

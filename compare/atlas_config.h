@@ -68,4 +68,9 @@ struct AtlasConfig {
 AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin);
 AtlasConfig load_atlas_config(const std::string& path);
 
+// `fiberlab atlas --photons N`: N photons per fiber and incident direction
+// for every fiber, read by sim::parse_integer_flag's rules (1 to 10^12, the
+// config's own range). Throws fiberlab::Error naming the flag.
+void override_photons(AtlasConfig& config, const std::string& flag_text);
+
 }  // namespace fiberlab::compare

@@ -9,7 +9,8 @@
 #    the fiber-atlas file, report.md, report.html and the figures are written.
 #    model_parameters reach the model (params_before) and the report.
 # 2. Bad configs: exit 2, one line naming the entry, nothing written.
-# 3. SIGINT during the sweep: exit 130, nothing written.
+# 3. SIGINT during the first fiber: exit 130, nothing written, no checkpoint
+#    (checkpoints and --resume: tests/cli/atlas_resume.sh).
 set -uo pipefail
 fiberlab=$1 source_dir=$2
 work=$(mktemp -d)
@@ -111,7 +112,8 @@ sleep 1.5
 kill -INT "$pid"
 wait "$pid"
 got=$?
-if [ "$got" != 130 ] || [ -e "$work/long.h5" ] || [ -e "$work/long_report" ]; then
+if [ "$got" != 130 ] || [ -e "$work/long.h5" ] || [ -e "$work/long_report" ] || [ -e "$work/long.checkpoint.h5" ] \
+   || ! tail -n 1 "$work/err" | grep -q "before its first fiber was finished; nothing written"; then
   echo "FAIL (SIGINT): exit $got"; cat "$work/err"; fail=1
 else
   echo "ok (SIGINT): exit 130, nothing written"

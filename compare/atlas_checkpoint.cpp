@@ -1,0 +1,520 @@
+#include "compare/atlas_checkpoint.h"
+
+#include <fmt/core.h>
+
+#include <cmath>
+#include <filesystem>
+#include <limits>
+#include <optional>
+#include <sstream>
+#include <type_traits>
+
+#include "analytic/model_registry.h"
+#include "common/atomic_output.h"
+#include "common/error.h"
+#include "common/h5_file.h"
+#include "common/result_layout.h"
+#include "compare/fit.h"
+#include "sim/settings.h"
+
+namespace fiberlab::compare {
+
+namespace {
+
+constexpr const char* kFormat = "fiber-atlas-checkpoint";
+
+std::string joined(const std::vector<std::string>& items, const char* separator) {
+  std::string s;
+  for (std::size_t i = 0; i < items.size(); ++i) s += (i ? separator : "") + items[i];
+  return s;
+}
+
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> out;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) out.push_back(line);
+  return out;
+}
+
+// Every field of a LobeComparison, in one place: visit(name, member) for
+// each, so that writing (a row of doubles) and reading (the row back, each
+// value checked for its type) cannot disagree on the columns.
+template <class Comparison, class Visit>
+void for_each_field(Comparison& c, Visit&& visit) {
+  visit("k", c.k);
+  visit("lobe", c.lobe);
+  visit("channel", c.channel);
+  visit("theta_i", c.theta_i);
+  visit("phi_i", c.phi_i);
+  visit("sim_energy", c.sim_energy);
+  visit("sim_error", c.sim_error);
+  visit("model_energy", c.model_energy);
+  visit("energy_z", c.energy_z);
+  visit("bins_chi2", c.bins.chi2);
+  visit("bins_dof", c.bins.dof);
+  visit("theta_marginal_chi2", c.theta_marginal.chi2);
+  visit("theta_marginal_dof", c.theta_marginal.dof);
+  visit("phi_marginal_chi2", c.phi_marginal.chi2);
+  visit("phi_marginal_dof", c.phi_marginal.dof);
+  visit("compared_bins", c.compared_bins);
+  visit("rest_sim", c.rest_sim);
+  visit("rest_model", c.rest_model);
+  visit("l1", c.l1);
+  visit("peak_sim", c.peak_sim);
+  visit("peak_model", c.peak_model);
+  visit("centroid_sim", c.centroid_sim);
+  visit("centroid_sim_error", c.centroid_sim_error);
+  visit("centroid_model", c.centroid_model);
+  visit("alpha_model", c.alpha_model);
+  visit("measured_shift", c.measured_shift);
+  visit("judged", c.judged);
+}
+
+std::vector<std::string> comparison_columns() {
+  std::vector<std::string> names;
+  LobeComparison c;
+  for_each_field(c, [&](const char* name, auto&) { names.push_back(name); });
+  return names;
+}
+
+// Strings of many fibers and models in one attribute: one per line, with
+// "\" and line breaks escaped so that any text survives.
+std::string escaped(const std::string& text) {
+  std::string out;
+  for (char ch : text) {
+    if (ch == '\\') out += "\\\\";
+    else if (ch == '\n') out += "\\n";
+    else if (ch == '\r') out += "\\r";
+    else out += ch;
+  }
+  return out;
+}
+
+std::string lines_attr(const std::vector<std::string>& items) {
+  std::string s;
+  for (std::size_t i = 0; i < items.size(); ++i) {
+    if (i) s += '\n';
+    s += escaped(items[i]);
+  }
+  return s;
+}
+
+// The inverse of lines_attr for one line or more; nullopt when an escape is
+// malformed.
+std::optional<std::vector<std::string>> from_lines_attr(const std::string& text) {
+  std::vector<std::string> out(1);
+  for (std::size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (ch == '\n') {
+      out.emplace_back();
+    } else if (ch != '\\') {
+      out.back() += ch;
+    } else if (i + 1 < text.size() && (text[i + 1] == '\\' || text[i + 1] == 'n' || text[i + 1] == 'r')) {
+      const char e = text[++i];
+      out.back() += e == 'n' ? '\n' : e == 'r' ? '\r' : '\\';
+    } else {
+      return std::nullopt;
+    }
+  }
+  return out;
+}
+
+// The numbers of every fiber, flattened in the sweep's order: a handful of
+// datasets whatever the number of fibers. (One dataset per fiber and model
+// made each rewrite grow as the square of the fibers, HDF5 flushing its
+// metadata after each dataset: measured 0.3 s at 32 fibers, 6 s at 128.)
+struct Flat {
+  std::vector<std::uint64_t> photons, shape, model_state;
+  std::vector<double> seconds, theta_i, sim_energy, sim_error, model_seconds, comparisons, fit_numbers, fit_values;
+  std::vector<std::string> labels, status, params_before, params_after, fit_keys;
+};
+
+constexpr std::size_t kFitNumbers = 7;  // chi2_start, chi2, residuals, dof, iterations, evaluations, converged
+constexpr std::size_t kFitValues = 5;   // per key: start, value, error, error_unscaled, at_bound
+
+void add_comparisons(Flat& flat, const std::vector<LobeComparison>& list) {
+  for (const LobeComparison& c : list)
+    for_each_field(c, [&](const char*, const auto& x) { flat.comparisons.push_back(static_cast<double>(x)); });
+}
+
+void add_fit(Flat& flat, const FitResult& fit) {
+  flat.fit_keys.push_back(joined(fit.keys, ","));
+  for (double x : {fit.chi2_start, fit.chi2, double(fit.residuals), double(fit.dof), double(fit.iterations),
+                   double(fit.evaluations), double(fit.converged)})
+    flat.fit_numbers.push_back(x);
+  for (std::size_t j = 0; j < fit.keys.size(); ++j)
+    for (double x : {fit.start[j], fit.value[j], fit.error[j], fit.error_unscaled[j], double(fit.at_bound[j])})
+      flat.fit_values.push_back(x);
+}
+
+Flat flatten(const std::vector<AtlasFiberResult>& fibers) {
+  Flat flat;
+  for (const AtlasFiberResult& r : fibers) {
+    flat.labels.push_back(r.fiber.label);
+    flat.photons.push_back(r.photons);
+    flat.shape.insert(flat.shape.end(), {std::uint64_t(r.lobes), std::uint64_t(r.channels)});
+    flat.seconds.insert(flat.seconds.end(), {r.sim_seconds, r.fit_seconds});
+    flat.theta_i.insert(flat.theta_i.end(), r.theta_i.begin(), r.theta_i.end());
+    flat.sim_energy.insert(flat.sim_energy.end(), r.sim_energy.begin(), r.sim_energy.end());
+    flat.sim_error.insert(flat.sim_error.end(), r.sim_error.begin(), r.sim_error.end());
+    for (const AtlasModelResult& m : r.models) {
+      flat.model_state.insert(flat.model_state.end(), {std::uint64_t(m.applicable), std::uint64_t(m.fitted),
+                                                       m.before.size(), m.after.size()});
+      flat.model_seconds.push_back(m.seconds);
+      flat.status.push_back(m.status);
+      flat.params_before.push_back(m.params_before);
+      flat.params_after.push_back(m.params_after);
+      add_comparisons(flat, m.before);
+      add_comparisons(flat, m.after);
+      if (m.fitted && !m.fit.keys.empty()) add_fit(flat, m.fit);
+    }
+  }
+  return flat;
+}
+
+void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std::size_t M) {
+  const std::size_t columns = comparison_columns().size();
+  f.set_attr("/", "fiber_labels", lines_attr(flat.labels));
+  f.set_attr("/", "status", lines_attr(flat.status));
+  f.set_attr("/", "params_before", lines_attr(flat.params_before));
+  f.set_attr("/", "params_after", lines_attr(flat.params_after));
+  f.set_attr("/", "fit_keys", lines_attr(flat.fit_keys));
+  f.set_attr("/", "comparison_columns", joined(comparison_columns(), ","));
+  f.write("photons", {F}, flat.photons);
+  f.write("shape", {F, 2}, flat.shape);
+  f.write("seconds", {F, 2}, flat.seconds);
+  f.write("theta_i", {F, K}, flat.theta_i);
+  f.write("sim_energy", {flat.sim_energy.size()}, flat.sim_energy);
+  f.write("sim_error", {flat.sim_error.size()}, flat.sim_error);
+  f.write("model_state", {F, M, 4}, flat.model_state);
+  f.write("model_seconds", {F, M}, flat.model_seconds);
+  if (!flat.comparisons.empty()) f.write("comparisons", {flat.comparisons.size() / columns, columns}, flat.comparisons);
+  if (!flat.fit_numbers.empty()) {
+    f.write("fit_numbers", {flat.fit_numbers.size() / kFitNumbers, kFitNumbers}, flat.fit_numbers);
+    f.write("fit_values", {flat.fit_values.size() / kFitValues, kFitValues}, flat.fit_values);
+  }
+}
+
+// ---- reading: every value checked before it is used ----
+
+struct Reader {
+  const h5::File& f;
+  const std::string& path;
+
+  [[noreturn]] void fail(const std::string& what) const { throw Error(fmt::format("{}: {}", path, what)); }
+
+  std::string text(const std::string& obj, const char* name) const { return f.attr_string(obj, name); }
+  std::vector<std::string> lines(const char* name, std::size_t count, const char* each) const {
+    const std::string stored = text("/", name);
+    if (count == 0 && stored.empty()) return {};  // no line (lines_attr of nothing)
+    const auto out = from_lines_attr(stored);
+    if (!out || out->size() != count)
+      fail(fmt::format("attribute {} must hold {} line(s), one per {}", name, count, each));
+    return *out;
+  }
+  std::vector<double> doubles(const std::string& name, const h5::Dims& shape, const std::string& meaning) const {
+    return f.read_doubles(name, shape, meaning);
+  }
+};
+
+// A stored number into a member of its type: integers must be integral and
+// in range (unsigned ones >= 0), flags 0 or 1.
+template <class T>
+T from_cell(const Reader& r, double v, const std::string& where) {
+  if constexpr (std::is_same_v<T, bool>) {
+    if (v != 0.0 && v != 1.0) r.fail(fmt::format("{} = {} must be 0 or 1", where, v));
+    return v == 1.0;
+  } else if constexpr (std::is_integral_v<T>) {
+    const double lo = std::is_signed_v<T> ? static_cast<double>(std::numeric_limits<int>::min()) : 0.0;
+    if (!(v >= lo && v <= static_cast<double>(std::numeric_limits<int>::max()) && v == std::floor(v)))
+      r.fail(fmt::format("{} = {} must be an integer{}", where, v, lo == 0.0 ? " >= 0" : ""));
+    return static_cast<T>(v);
+  } else {
+    return v;
+  }
+}
+
+// Walks the flat arrays in the order flatten() wrote them.
+struct Cursor {
+  std::size_t energy = 0, comparison = 0, fit = 0, fit_value = 0;
+};
+
+std::vector<LobeComparison> read_comparisons(const Reader& r, const std::vector<double>& cells, std::size_t rows,
+                                             Cursor& at, const AtlasFiberResult& fiber, const std::string& where) {
+  const std::size_t columns = comparison_columns().size();
+  std::vector<LobeComparison> out;
+  for (std::size_t row = 0; row < rows; ++row, ++at.comparison) {
+    if ((at.comparison + 1) * columns > cells.size())
+      r.fail("the dataset comparisons has fewer rows than model_state counts");
+    LobeComparison c;
+    std::size_t j = 0;
+    for_each_field(c, [&](const char* field, auto& x) {
+      x = from_cell<std::remove_reference_t<decltype(x)>>(r, cells[at.comparison * columns + j++],
+                                                          fmt::format("{}[{}].{}", where, row, field));
+    });
+    if (c.bins.dof < 0 || c.theta_marginal.dof < 0 || c.phi_marginal.dof < 0)
+      r.fail(fmt::format("{}[{}]: a degree-of-freedom count is negative", where, row));
+    // k, lobe and channel index the output's arrays (negative ones were refused above).
+    if (c.k >= fiber.theta_i.size() || c.lobe >= fiber.lobes || c.channel >= fiber.channels)
+      r.fail(fmt::format("{}[{}]: (k, lobe, channel) = ({}, {}, {}) is outside the fiber's {} x {} x {}", where, row,
+                         c.k, c.lobe, c.channel, fiber.theta_i.size(), fiber.lobes, fiber.channels));
+    out.push_back(c);
+  }
+  return out;
+}
+
+struct FitArrays {
+  std::vector<double> numbers, values;
+  std::vector<std::string> keys;
+};
+
+FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const AtlasConfig& config,
+                   const AtlasFiber& fiber, const std::string& model, const std::string& where) {
+  if (at.fit >= fits.keys.size()) r.fail("fit_keys has fewer lines than fitted models");
+  FitResult fit;
+  fit.keys = free_fit_keys(model);
+  if (fits.keys[at.fit] != joined(fit.keys, ","))
+    r.fail(fmt::format("{}: fit keys {} are not {}'s free keys {}", where, fits.keys[at.fit], model,
+                       joined(fit.keys, ",")));
+  const double* n = &fits.numbers[at.fit * kFitNumbers];
+  fit.chi2_start = n[0];
+  fit.chi2 = n[1];
+  fit.residuals = from_cell<int>(r, n[2], where + ".fit.residuals");
+  fit.dof = from_cell<int>(r, n[3], where + ".fit.dof");
+  fit.iterations = from_cell<int>(r, n[4], where + ".fit.iterations");
+  fit.evaluations = from_cell<int>(r, n[5], where + ".fit.evaluations");
+  fit.converged = from_cell<bool>(r, n[6], where + ".fit.converged");
+  ++at.fit;
+  if ((at.fit_value + fit.keys.size()) * kFitValues > fits.values.size())
+    r.fail("the dataset fit_values has fewer rows than the fitted models' keys");
+  for (std::size_t j = 0; j < fit.keys.size(); ++j, ++at.fit_value) {
+    const double* v = &fits.values[at.fit_value * kFitValues];
+    fit.start.push_back(v[0]);
+    fit.value.push_back(v[1]);
+    fit.error.push_back(v[2]);
+    fit.error_unscaled.push_back(v[3]);
+    fit.at_bound.push_back(from_cell<bool>(r, v[4], where + ".fit.at_bound"));
+  }
+  // The parameters at the minimum, as fit_model made them: the start
+  // parameters with each key set to its fitted value.
+  try {
+    fit.params = atlas_start_params(config, fiber, model);
+    for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
+  } catch (const Error& e) {
+    r.fail(fmt::format("{}: the fitted parameters are refused by {}: {}", where, model, e.what()));
+  }
+  return fit;
+}
+
+// Everything of the file, each array read with the shape the config and
+// model_state give it; then walked fiber by fiber.
+struct Stored {
+  std::vector<std::string> labels, status, params_before, params_after;
+  std::vector<std::uint64_t> photons, shape, model_state;
+  std::vector<double> seconds, theta_i, sim_energy, sim_error, model_seconds, comparisons;
+  FitArrays fits;
+};
+
+Stored read_stored(const Reader& r, std::size_t F, const AtlasConfig& config) {
+  const std::size_t K = config.theta_i.size(), M = config.models.size(), columns = comparison_columns().size();
+  if (r.text("/", "comparison_columns") != joined(comparison_columns(), ","))
+    r.fail("its comparison columns are not this build's (resume it with the fiberlab build that wrote it)");
+  Stored s;
+  s.labels = r.lines("fiber_labels", F, "saved fiber");
+  s.status = r.lines("status", F * M, "saved fiber and model");
+  s.params_before = r.lines("params_before", F * M, "saved fiber and model");
+  s.params_after = r.lines("params_after", F * M, "saved fiber and model");
+  s.photons = r.f.read_uint64s("photons", {F}, "fibers_saved");
+  s.shape = r.f.read_uint64s("shape", {F, 2}, "fibers_saved x (lobes, channels)");
+  s.seconds = r.doubles("seconds", {F, 2}, "fibers_saved x (simulation, fits)");
+  s.theta_i = r.doubles("theta_i", {F, K}, "fibers_saved x theta_i");
+  s.model_state = r.f.read_uint64s("model_state", {F, M, 4}, "fibers_saved x models x 4");
+  std::size_t energies = 0, rows = 0, fitted = 0, fitted_keys = 0;
+  for (std::size_t i = 0; i < F; ++i) {
+    const AtlasFiber& fiber = config.fibers[i];
+    const std::uint64_t L = fiber.settings.tally.lobes, C = fiber.settings.fiber.sigma_a.size();
+    if (s.shape[2 * i] != L || s.shape[2 * i + 1] != C)
+      r.fail(fmt::format("shape of fiber {} = ({}, {}) is not its config's (lobes {}, channels {})", i + 1,
+                         s.shape[2 * i], s.shape[2 * i + 1], L, C));
+    energies += K * L * C;
+    for (std::size_t m = 0; m < M; ++m) {
+      const std::uint64_t* st = &s.model_state[(i * M + m) * 4];
+      if (st[0] > 1 || st[1] > 1 || st[2] > K * L * C || st[3] > K * L * C)
+        r.fail(fmt::format("model_state of fiber {}, model {} is out of range", i + 1, config.models[m]));
+      rows += st[2] + st[3];
+      const std::size_t P = free_fit_keys(config.models[m]).size();
+      if (st[1] == 1 && P > 0) {
+        ++fitted;
+        fitted_keys += P;
+      }
+    }
+  }
+  s.sim_energy = r.doubles("sim_energy", {energies}, "theta_i x lobes x channels of every saved fiber");
+  s.sim_error = r.doubles("sim_error", {energies}, "theta_i x lobes x channels of every saved fiber");
+  s.model_seconds = r.doubles("model_seconds", {F, M}, "fibers_saved x models");
+  if (rows > 0) s.comparisons = r.doubles("comparisons", {rows, columns}, "the rows model_state counts");
+  s.fits.keys = r.lines("fit_keys", fitted, "fitted model");
+  if (fitted > 0) {
+    s.fits.numbers = r.doubles("fit_numbers", {fitted, kFitNumbers}, "one row per fitted model");
+    s.fits.values = r.doubles("fit_values", {fitted_keys, kFitValues}, "one row per fitted key");
+  }
+  return s;
+}
+
+AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const AtlasConfig& config,
+                            const AtlasFiberResult& fiber, std::size_t i, std::size_t m) {
+  const std::size_t M = config.models.size(), at_im = i * M + m;
+  const std::uint64_t* st = &s.model_state[at_im * 4];
+  AtlasModelResult out;
+  out.model = config.models[m];
+  const std::string where = fmt::format("fiber {}, model {}", i + 1, out.model);
+  out.applicable = st[0] == 1;
+  out.fitted = st[1] == 1;
+  out.status = s.status[at_im];
+  out.params_before = s.params_before[at_im];
+  out.params_after = s.params_after[at_im];
+  out.seconds = s.model_seconds[at_im];
+  out.before = read_comparisons(r, s.comparisons, st[2], at, fiber, where + ", before");
+  out.after = read_comparisons(r, s.comparisons, st[3], at, fiber, where + ", after");
+  if (out.fitted && !out.applicable) r.fail(where + ": fitted but not applicable");
+  if (out.fitted && !free_fit_keys(out.model).empty()) {
+    out.fit = read_fit(r, s.fits, at, config, fiber.fiber, out.model, where);
+    if (analytic::describe_params(out.model, out.fit.params) != out.params_after)
+      r.fail(where + ": the fitted values do not give params_after");
+  }
+  return out;
+}
+
+AtlasFiberResult read_fiber(const Reader& r, const Stored& s, Cursor& at, const AtlasConfig& config, std::size_t i) {
+  const std::size_t K = config.theta_i.size();
+  AtlasFiberResult out;
+  out.fiber = config.fibers[i];
+  if (s.labels[i] != out.fiber.label)
+    r.fail(fmt::format("fiber {} is \"{}\", not the config's \"{}\"", i + 1, s.labels[i], out.fiber.label));
+  out.lobes = static_cast<int>(s.shape[2 * i]);
+  out.channels = static_cast<int>(s.shape[2 * i + 1]);
+  out.photons = s.photons[i];
+  out.sim_seconds = s.seconds[2 * i];
+  out.fit_seconds = s.seconds[2 * i + 1];
+  out.theta_i.assign(s.theta_i.begin() + i * K, s.theta_i.begin() + (i + 1) * K);
+  const std::size_t n = K * out.lobes * out.channels;
+  out.sim_energy.assign(s.sim_energy.begin() + at.energy, s.sim_energy.begin() + at.energy + n);
+  out.sim_error.assign(s.sim_error.begin() + at.energy, s.sim_error.begin() + at.energy + n);
+  at.energy += n;
+  for (std::size_t m = 0; m < config.models.size(); ++m) out.models.push_back(read_model(r, s, at, config, out, i, m));
+  return out;
+}
+
+// The first line where two identities differ, for the error message.
+std::string first_difference(const std::string& a, const std::string& b) {
+  const std::vector<std::string> x = lines_of(a), y = lines_of(b);
+  for (std::size_t i = 0; i < std::max(x.size(), y.size()); ++i) {
+    const std::string u = i < x.size() ? x[i] : "(nothing)", v = i < y.size() ? y[i] : "(nothing)";
+    if (u != v) return fmt::format("\"{}\" where the checkpoint has \"{}\"", u, v);
+  }
+  return "none";
+}
+
+}  // namespace
+
+std::string atlas_config_identity(const AtlasConfig& config) {
+  std::string s = fmt::format("fiberlab atlas config identity {}\nmodels: {}\n", kAtlasCheckpointVersion,
+                              joined(config.models, ","));
+  for (const auto& [model, settings] : config.model_parameters)
+    s += fmt::format("model_parameters.{}: {}\n", model, joined(settings, " "));
+  s += fmt::format("fit.max_iterations: {}\ntheta_i (rad):", config.max_iterations);
+  for (double t : config.theta_i) s += fmt::format(" {}", t);
+  s += "\n";
+  for (std::size_t i = 0; i < config.fibers.size(); ++i)
+    s += fmt::format("fiber {}: {}\n{}", i + 1, config.fibers[i].label, sim::to_yaml(config.fibers[i].settings));
+  return s;
+}
+
+AtlasConfig atlas_config_of(const AtlasRunSetup& setup) {
+  AtlasConfig config = parse_atlas_config(setup.config_yaml, setup.config_path);
+  if (!setup.photons_flag.empty()) override_photons(config, setup.photons_flag);
+  return config;
+}
+
+void write_atlas_checkpoint(const std::string& path, const AtlasRunSetup& setup, const AtlasConfig& config,
+                            const std::vector<AtlasFiberResult>& fibers) {
+  AtomicOutput out(path, {setup.config_path});
+  {
+    h5::File f = h5::File::create(out.temp_path(), path);
+    write_file_identity(f, kFormat, utc_timestamp());
+    f.set_attr("/", "checkpoint_version", static_cast<std::int64_t>(kAtlasCheckpointVersion));
+    f.set_attr("/", "config_path", setup.config_path);
+    f.set_attr("/", "config_yaml", setup.config_yaml);
+    f.set_attr("/", "photons_flag", setup.photons_flag);
+    f.set_attr("/", "output_name", setup.output_name);
+    f.set_attr("/", "report_dir", setup.report_dir);
+    f.set_attr("/", "command", setup.command);
+    f.set_attr("/", "identity", atlas_config_identity(config));
+    f.set_attr("/", "fibers_total", static_cast<std::uint64_t>(config.fibers.size()));
+    f.set_attr("/", "fibers_saved", static_cast<std::uint64_t>(fibers.size()));
+    if (!fibers.empty()) write_flat(f, flatten(fibers), fibers.size(), config.theta_i.size(), config.models.size());
+    f.close();
+  }
+  out.commit();
+}
+
+AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw Error(fmt::format("{}: no such checkpoint file (an interrupted atlas leaves OUT.checkpoint.h5)", path));
+  if (!std::filesystem::is_regular_file(path, ec))
+    throw Error(fmt::format("{}: is not a regular file (a checkpoint is OUT.checkpoint.h5)", path));
+  const h5::File f = h5::File::open_read(path);
+  const Reader r{f, path};
+  if (!f.has_attr("/", "format") || r.text("/", "format") != kFormat)
+    r.fail(fmt::format("not a fiberlab atlas checkpoint (no format = {}; `fiberlab atlas --resume` takes the "
+                       "OUT.checkpoint.h5 an interrupted atlas left)", kFormat));
+  const std::string version = f.has_attr("/", "software_version") ? r.text("/", "software_version") : "?";
+  const std::int64_t format = f.has_attr("/", "checkpoint_version") ? f.attr_int("/", "checkpoint_version") : -1;
+  if (version != FIBERLAB_VERSION || format != kAtlasCheckpointVersion)
+    r.fail(fmt::format("written by fiberlab {} (atlas checkpoint format {}); this is fiberlab {} (format {}): "
+                       "resume it with the version that wrote it",
+                       version, format, FIBERLAB_VERSION, kAtlasCheckpointVersion));
+  AtlasCheckpoint c;
+  c.setup.config_path = r.text("/", "config_path");
+  c.setup.config_yaml = r.text("/", "config_yaml");
+  c.setup.photons_flag = r.text("/", "photons_flag");
+  c.setup.output_name = r.text("/", "output_name");
+  c.setup.report_dir = r.text("/", "report_dir");
+  c.setup.command = r.text("/", "command");
+  if (c.setup.output_name.empty() || c.setup.output_name.find('/') != std::string::npos)
+    r.fail(fmt::format("output_name = \"{}\" must be a file name", c.setup.output_name));
+  try {
+    c.config = atlas_config_of(c.setup);
+  } catch (const Error& e) {
+    r.fail(fmt::format("its stored config is refused: {}", e.what()));
+  }
+  if (atlas_config_identity(c.config) != r.text("/", "identity"))
+    r.fail("its stored config does not give its stored identity (written by another build?)");
+  const std::uint64_t total = f.attr_uint64("/", "fibers_total"), saved = f.attr_uint64("/", "fibers_saved");
+  if (total != c.config.fibers.size() || saved > total)
+    r.fail(fmt::format("fibers_saved = {} of fibers_total = {} disagree with its config's {} fibers", saved, total,
+                       c.config.fibers.size()));
+  if (saved == 0) return c;
+  const Stored stored = read_stored(r, saved, c.config);
+  Cursor at;
+  for (std::size_t i = 0; i < saved; ++i) c.fibers.push_back(read_fiber(r, stored, at, c.config, i));
+  if (at.comparison * comparison_columns().size() != stored.comparisons.size() ||
+      at.fit_value * kFitValues != stored.fits.values.size())
+    r.fail("it holds more comparisons or fitted values than its models");
+  return c;
+}
+
+void check_same_atlas_config(const AtlasCheckpoint& checkpoint, const AtlasConfig& given,
+                             const std::string& checkpoint_file) {
+  AtlasConfig flagged = given;
+  if (!checkpoint.setup.photons_flag.empty()) override_photons(flagged, checkpoint.setup.photons_flag);
+  const std::string a = atlas_config_identity(flagged), b = atlas_config_identity(checkpoint.config);
+  if (a != b)
+    throw Error(fmt::format("{}: the config {} differs from the one this checkpoint was started with (first "
+                            "difference: {}); resume with `fiberlab atlas --resume {}` alone, or delete {} to "
+                            "start again",
+                            checkpoint_file, given.path, first_difference(a, b), checkpoint_file, checkpoint_file));
+}
+
+}  // namespace fiberlab::compare

@@ -1,0 +1,6 @@
+# `fiberlab atlas` checkpoints and --resume (issue 12 part 4): SIGINT, SIGKILL
+# and SIGTERM, refusals, damaged checkpoints, and resumed results
+# bit-identical to an uninterrupted run (tests/cli/atlas_same_results.py).
+add_test(NAME atlas_resume_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_resume.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
+set_tests_properties(atlas_resume_cli PROPERTIES TIMEOUT 300)
