@@ -9,7 +9,6 @@
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
-#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <utility>
@@ -83,20 +82,6 @@ BitsOf<T> load_bits(const std::uint64_t* p) {
 }
 inline void store_bits(std::uint64_t x, std::uint64_t* p) { *p = x; }
 inline void store_bits(const BitsOf<Batch>& x, std::uint64_t* p) { x.store_aligned(p); }
-
-// A double's bits as a 64-bit word and back, and a table lookup per lane.
-inline std::uint64_t to_bits(double x) { return std::bit_cast<std::uint64_t>(x); }
-inline BitsOf<Batch> to_bits(const Batch& x) { return xsimd::bitwise_cast<BitsOf<Batch>>(x); }
-template <class T>
-T from_bits(const BitsOf<T>& b) {
-  if constexpr (std::is_same_v<T, double>) return std::bit_cast<double>(b);
-  else return xsimd::bitwise_cast<T>(b);
-}
-template <class T>
-T gather(const double* table, const BitsOf<T>& index) {
-  if constexpr (std::is_same_v<T, double>) return table[index];
-  else return T::gather(table, xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(index));
-}
 
 // A 3-vector of numbers: one direction, or W directions side by side.
 template <class T>

@@ -7,7 +7,7 @@
 //
 // The sampler: one exact rejection sampler for every incidence, with the same
 // work for every candidate (a fixed block of five uniforms, one log, one
-// square root, three sine-cosine pairs: sim/life_log.h, sim/life_trig.h), so that a SIMD vector of photons never waits
+// square root, three sine-cosine pairs, sim/life_trig.h), so that a SIMD vector of photons never waits
 // on a branch only some of its lanes take.
 //
 // The target density of the offsets is G(x) max(0, -d.m) with x = (dl /
@@ -36,7 +36,6 @@
 // (x from phi, accept with probability -d.m) is used instead.
 #include <optional>
 
-#include "sim/life_log.h"
 #include "sim/life_trig.h"
 #include "sim/roughness_model.h"
 #include "sim/settings.h"
@@ -66,7 +65,7 @@ class GaussianRoughness {
       const auto [u_pick, u1_closed, u2_closed, u_psi, u_accept] = rng.template uniforms<5>(pending);
       const T u1 = LaneRandom<T>::open0(u1_closed), u2 = LaneRandom<T>::open0(u2_closed);
       const MaskOf<T> gamma2 = u_pick * (env.a0 + env.b) < env.b;
-      const T e = -log_positive(u1 * select(gamma2, u2, T(1.0)));
+      const T e = -log(u1 * select(gamma2, u2, T(1.0)));
       const T rho = sqrt(T(2.0) * (env.w0 + e));
       const auto [sp, cp] = sincos_turn(u_psi);
       const Vec3Of<T> m =
