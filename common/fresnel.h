@@ -15,6 +15,25 @@ namespace fresnel_detail {
 inline double select(bool m, double a, double b) { return m ? a : b; }
 }  // namespace fresnel_detail
 
+// Snell's law, the step every function below starts from: cos_i clamped to
+// [0, 1], sin^2 t = sin^2 i / eta_rel^2 (given 1 / eta_rel^2, so callers
+// that hold 1 / eta_rel need no division), total internal reflection where
+// sin^2 t >= 1, and the real refraction cosine (0 under TIR).
+template <class T>
+struct SnellOf {
+  T cos_i, sin2_t, cos_t;
+  decltype(std::declval<T>() >= std::declval<T>()) tir;
+};
+template <class T>
+SnellOf<T> snell_refraction(T cos_i, T inv_eta_rel2) {
+  using std::max;
+  using std::min;
+  using std::sqrt;
+  cos_i = min(T(1.0), max(T(0.0), cos_i));
+  const T sin2_t = max(T(0.0), T(1.0) - cos_i * cos_i) * inv_eta_rel2;
+  return {cos_i, sin2_t, sqrt(max(T(0.0), T(1.0) - sin2_t)), sin2_t >= T(1.0)};
+}
+
 // Fresnel s and p amplitude reflectances r_s and r_p (real, no TIR) with the
 // sign convention of SPEC section 3: r_p = -r_s at normal incidence.
 template <class T>
@@ -32,14 +51,10 @@ using FresnelAmplitudes = FresnelAmplitudesOf<double>;
 template <class T>
 FresnelAmplitudesOf<T> fresnel_amplitudes(T cos_i, T eta_rel) {
   using fresnel_detail::select;
-  using std::max;
-  using std::min;
-  using std::sqrt;
-  cos_i = min(T(1.0), max(T(0.0), cos_i));
-  const T sin2_i = max(T(0.0), T(1.0) - cos_i * cos_i);
-  const T sin2_t = sin2_i / (eta_rel * eta_rel);
-  const auto tir = sin2_t >= T(1.0);
-  const T cos_t = sqrt(max(T(0.0), T(1.0) - sin2_t));
+  const SnellOf<T> snell = snell_refraction(cos_i, T(1.0) / (eta_rel * eta_rel));
+  const T cos_t = snell.cos_t;
+  const auto tir = snell.tir;
+  cos_i = snell.cos_i;
   const T r_s = (cos_i - eta_rel * cos_t) / (cos_i + eta_rel * cos_t);
   const T r_p = (eta_rel * cos_i - cos_t) / (eta_rel * cos_i + cos_t);
   return {select(tir, T(std::numeric_limits<double>::quiet_NaN()), cos_t),
@@ -59,14 +74,10 @@ struct FresnelReflectanceOf {
 template <class T>
 FresnelReflectanceOf<T> fresnel_reflectance(T cos_i, T eta_rel, T inv_eta_rel) {
   using fresnel_detail::select;
-  using std::max;
-  using std::min;
-  using std::sqrt;
-  cos_i = min(T(1.0), max(T(0.0), cos_i));
-  const T sin2_i = max(T(0.0), T(1.0) - cos_i * cos_i);
-  const T sin2_t = sin2_i * (inv_eta_rel * inv_eta_rel);
-  const auto tir = sin2_t >= T(1.0);
-  const T cos_t = sqrt(max(T(0.0), T(1.0) - sin2_t));
+  const SnellOf<T> snell = snell_refraction(cos_i, inv_eta_rel * inv_eta_rel);
+  const T cos_t = snell.cos_t;
+  const auto tir = snell.tir;
+  cos_i = snell.cos_i;
   const T ns = cos_i - eta_rel * cos_t, ds = cos_i + eta_rel * cos_t;
   const T np = eta_rel * cos_i - cos_t, dp = eta_rel * cos_i + cos_t;
   const T dsp = ds * dp;
@@ -105,10 +116,11 @@ FresnelComplexOf<T> fresnel_complex_amplitudes(T cos_i, T eta_rel) {
   using fresnel_detail::select;
   using std::abs;
   using std::sqrt;
-  const T sin2_t = (T(1.0) - cos_i * cos_i) / (eta_rel * eta_rel);
-  const auto tir = sin2_t >= T(1.0);
-  const T root = sqrt(abs(T(1.0) - sin2_t));
-  const T ct_re = select(tir, T(0.0), root), ct_im = select(tir, root, T(0.0));
+  const SnellOf<T> snell = snell_refraction(cos_i, T(1.0) / (eta_rel * eta_rel));
+  const auto tir = snell.tir;
+  cos_i = snell.cos_i;
+  const T ct_re = select(tir, T(0.0), snell.cos_t);
+  const T ct_im = select(tir, sqrt(abs(snell.sin2_t - T(1.0))), T(0.0));
   auto divide = [](T n_re, T n_im, T d_re, T d_im, T& re, T& im) {
     const T inv = T(1.0) / (d_re * d_re + d_im * d_im);
     re = (n_re * d_re + n_im * d_im) * inv;

@@ -53,6 +53,7 @@ inline double min(double a, double b) { return std::min(a, b); }
 inline double max(double a, double b) { return std::max(a, b); }
 inline double asin(double x) { return std::asin(x); }
 inline std::pair<double, double> sincos(double x) { return {std::sin(x), std::cos(x)}; }
+inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
 
 // A mask over doubles as a mask over the random streams' 64-bit words.
 inline bool bits_mask(bool m) { return m; }

@@ -8,7 +8,8 @@
 //   angle is needed.
 // - sincos_small(x) for any x: the kernel below where every lane has
 //   |x| <= pi/4 (the gaussian sampler's offsets for betas up to about 10
-//   degrees), the library's sincos otherwise.
+//   degrees), a reduction by multiples of pi/2 then the kernel where every
+//   lane has |x| <= 2^20, the library's sincos beyond.
 //
 // The kernel is the Taylor series of sin (to x^17) and cos (to x^18) in
 // Horner form with explicit fused multiply-adds. For |x| <= pi/4 the first
@@ -26,10 +27,10 @@ namespace fiberlab::sim::life {
 
 namespace trig_detail {
 
-inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
-inline Batch fma(const Batch& a, const Batch& b, const Batch& c) { return xsimd::fma(a, b, c); }
 inline double round_half_up(double x) { return std::floor(x + 0.5); }
 inline Batch round_half_up(const Batch& x) { return xsimd::floor(x + Batch(0.5)); }
+inline double floor_of(double x) { return std::floor(x); }
+inline Batch floor_of(const Batch& x) { return xsimd::floor(x); }
 
 // sin x and cos x for |x| <= pi/4 (Taylor, see above).
 template <class T>
@@ -59,6 +60,39 @@ template <class T>
   return {s, c};
 }
 
+// (sin, cos) of y + q pi/2 from (s, c) = (sin y, cos y), q in {0, 1, 2, 3,
+// 4}: q = 1: (c, -s); 2: (-s, -c); 3: (-c, s); 0 and 4: (s, c).
+template <class T>
+[[gnu::always_inline]] inline std::pair<T, T> quarter_turns(const T& s, const T& c, const T& q) {
+  const T q4 = select(q == T(4.0), T(0.0), q);
+  const MaskOf<T> odd = (q4 == T(1.0)) | (q4 == T(3.0));
+  const T sin_abs = select(odd, c, s), cos_abs = select(odd, s, c);
+  const MaskOf<T> sin_neg = q4 >= T(2.0), cos_neg = (q4 == T(1.0)) | (q4 == T(2.0));
+  return {select(sin_neg, -sin_abs, sin_abs), select(cos_neg, -cos_abs, cos_abs)};
+}
+
+// pi/2 = kHalfPi1 + kHalfPi2 + kHalfPi3 (each the rounding of what remains).
+inline constexpr double kHalfPi1 = 0x1.921fb54442d18p0;
+inline constexpr double kHalfPi2 = 0x1.1a62633145c07p-54;
+inline constexpr double kHalfPi3 = -0x1.f1976b7ed8fbcp-110;
+// Where the reduction below is used: q < 2^20, so x - q kHalfPi1 is exact
+// (its bits run from 2^0 down to kHalfPi1's last, 2^-52) and the three
+// parts leave an error far below an ulp of y.
+inline constexpr double kReducedLimit = 0x1.0p20;
+
+// (sin x, cos x) for |x| <= kReducedLimit: x = q pi/2 + y with |y| <= pi/4
+// (Cody and Waite's reduction, the products exact in the fused
+// multiply-adds), the kernel on y, then q quarter turns.
+template <class T>
+[[gnu::always_inline]] inline std::pair<T, T> reduced(const T& x) {
+  const T q = round_half_up(x * T(0.6366197723675814));  // x / (pi/2), nearest
+  T y = fma(-q, T(kHalfPi1), x);
+  y = fma(-q, T(kHalfPi2), y);
+  y = fma(-q, T(kHalfPi3), y);
+  const auto [s, c] = kernel(y);
+  return quarter_turns(s, c, q - T(4.0) * floor_of(q * T(0.25)));
+}
+
 }  // namespace trig_detail
 
 // (sin 2 pi u, cos 2 pi u) for u in [0, 1].
@@ -67,19 +101,19 @@ template <class T>
   const T q = trig_detail::round_half_up(T(4.0) * u);  // nearest quarter turn, 0..4
   const T x = (u - T(0.25) * q) * T(6.283185307179586);  // in [-pi/4, pi/4]
   const auto [s, c] = trig_detail::kernel(x);
-  // Rotate by q quarter turns: q = 1: (c, -s); 2: (-s, -c); 3: (-c, s); 0, 4: (s, c).
-  const T q4 = select(q == T(4.0), T(0.0), q);  // u near 1 is a whole turn
-  const MaskOf<T> odd = (q4 == T(1.0)) | (q4 == T(3.0));
-  const T sin_abs = select(odd, c, s), cos_abs = select(odd, s, c);
-  const MaskOf<T> sin_neg = q4 >= T(2.0), cos_neg = (q4 == T(1.0)) | (q4 == T(2.0));
-  return {select(sin_neg, -sin_abs, sin_abs), select(cos_neg, -cos_abs, cos_abs)};
+  return trig_detail::quarter_turns(s, c, q);  // q = 4 (u near 1) is a whole turn
 }
 
-// (sin x, cos x) for any x; fast when every lane has |x| <= pi/4.
+// (sin x, cos x) for any x: the kernel alone when every lane has |x| <=
+// pi/4, the reduction when every lane has |x| <= 2^20 (the sampler's
+// offsets, whatever beta), the library beyond (scalar and vector may then
+// differ in the last bit).
 template <class T>
 [[gnu::always_inline]] inline std::pair<T, T> sincos_small(const T& x) {
-  if (!all(abs(x) <= T(0.7853981633974483))) return sincos(x);
-  return trig_detail::kernel(x);
+  const T a = abs(x);
+  if (all(a <= T(0.7853981633974483))) return trig_detail::kernel(x);
+  if (all(a <= T(trig_detail::kReducedLimit))) return trig_detail::reduced(x);
+  return sincos(x);
 }
 
 }  // namespace fiberlab::sim::life

@@ -35,6 +35,7 @@ void expect_same_photons(const Settings& s, const char* what) {
               },
               counters);
   int differ = 0;
+  double diverged_segments = 0.0;  // over photons whose paths came apart
   TracerCounters reference_counters;
   for (std::uint64_t i = 0; i < n; ++i) {
     ASSERT_EQ(seen[i], 1) << "photon " << i << " reported " << seen[i] << " times";
@@ -48,13 +49,19 @@ void expect_same_photons(const Settings& s, const char* what) {
                       (r.fate == PhotonFate::Truncated ||
                        (std::abs(r.theta - b.theta) <= 1e-7 && std::abs(r.phi - b.phi) <= 1e-7));
     differ += !same;
+    diverged_segments += std::abs(r.segments - b.segments);
   }
   std::printf("%s: %d of %llu photons differ\n", what, differ, static_cast<unsigned long long>(n));
   EXPECT_LE(differ, static_cast<int>(n / 1000)) << what;
-  // The same work, counted lane by lane in the batch.
-  EXPECT_NEAR(counters.events, reference_counters.events, 1e-3 * reference_counters.events) << what;
+  // The same work, counted lane by lane in the batch. A photon whose path
+  // came apart (a light-guided one, after ~100 segments of last-bit drift)
+  // has its events and normals for a different number of segments: at most
+  // a few events per segment (repeated events of the consistency rule) and
+  // about 1.7 candidate normals per event, hence 4 per segment of difference.
+  EXPECT_NEAR(counters.events, reference_counters.events,
+              1e-3 * reference_counters.events + 4.0 * diverged_segments) << what;
   EXPECT_NEAR(counters.normal_draws, reference_counters.normal_draws,
-              1e-3 * reference_counters.normal_draws) << what;
+              1e-3 * reference_counters.normal_draws + 4.0 * diverged_segments) << what;
   EXPECT_EQ(counters.sampler_caps, reference_counters.sampler_caps) << what;
 }
 

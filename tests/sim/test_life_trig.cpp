@@ -44,11 +44,28 @@ TEST(LifeTrig, SmallAnglesMatchTheLibraryToTwoUlps) {
   }
 }
 
-TEST(LifeTrig, LargeAnglesFallBackToTheLibrary) {
-  for (double x : {0.79, -1.0, 3.0, 100.0, -1e4}) {
+TEST(LifeTrig, LargeAnglesMatchTheLibraryToTwoUlps) {
+  // Beyond pi/4 (the gaussian sampler's far offsets): the reduction by
+  // multiples of pi/2. Mutations caught: a quadrant's cosine sign wrong, or
+  // q not taken modulo 4 (errors ~1e-4 and more), pi/2's second part dropped
+  // (sin near multiples of pi/2 off by ~q 6e-17: 1e-14, 45 times the bound).
+  std::mt19937_64 gen(5);
+  std::uniform_real_distribution<double> angle(-100.0, 100.0);
+  std::vector<double> xs = {0.79, -1.0, 3.0, 100.0, -1e4, 0x1.0p20, -0x1.0p20};
+  for (int q = -1000; q <= 1000; ++q) {  // at and next to multiples of pi/2
+    const double x = q * 1.5707963267948966;
+    xs.insert(xs.end(), {x, std::nextafter(x, -INFINITY), std::nextafter(x, INFINITY)});
+  }
+  for (int q = 1; q <= 200; ++q) xs.push_back(q * 4999.3 * 1.5707963267948966);
+  for (int i = 0; i < 200000; ++i) xs.push_back(angle(gen));
+  for (double x : xs) {
     const auto [s, c] = sincos_small(x);
-    EXPECT_EQ(s, std::sin(x));
-    EXPECT_EQ(c, std::cos(x));
+    expect_close(s, std::sin(x), "sin", x);
+    expect_close(c, std::cos(x), "cos", x);
+  }
+  for (double x : {2e6, -1e9}) {  // beyond 2^20: the library itself
+    EXPECT_EQ(sincos_small(x).first, std::sin(x));
+    EXPECT_EQ(sincos_small(x).second, std::cos(x));
   }
 }
 
@@ -75,7 +92,7 @@ TEST(LifeTrig, VectorLanesGiveTheScalarBits) {
   for (int round = 0; round < 10000; ++round) {
     for (int k = 0; k < kBatchWidth; ++k) {
       u[k] = static_cast<double>(gen() >> 11) * 0x1.0p-53;
-      x[k] = (u[k] - 0.5) * 1.5;
+      x[k] = (u[k] - 0.5) * (round % 2 == 0 ? 1.5 : 200.0);  // the kernel, or the reduction
     }
     const auto [vs, vc] = sincos_small(Batch::load_aligned(x));
     const auto [ts, tc] = sincos_turn(Batch::load_aligned(u));
