@@ -108,7 +108,11 @@ set -m
 "$fiberlab" atlas "$work/long.yaml" -o "$work/long.h5" --threads 1 >"$work/out" 2>"$work/err" &
 pid=$!
 set +m
-sleep 1.5
+# Interrupt once the first fiber has started (its progress line is out, so
+# the handlers are installed), not after a fixed delay: under load a fixed
+# 1.5 s could land before the handlers or after the first fiber.
+for _ in $(seq 300); do grep -q "fiber 1 /" "$work/err" 2>/dev/null && break; sleep 0.1; done
+sleep 0.3
 kill -INT "$pid"
 wait "$pid"
 got=$?

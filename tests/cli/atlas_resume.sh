@@ -182,7 +182,9 @@ set -m
 "$fiberlab" atlas "$work/r.yaml" -o "$work/e.h5" --photons 20000000 >"$work/out" 2>"$work/err" &
 pid=$!
 set +m
-sleep 1
+# Once the first fiber has started (handlers installed), not after a fixed delay.
+for _ in $(seq 300); do grep -q "fiber 1 /" "$work/err" 2>/dev/null && break; sleep 0.1; done
+sleep 0.3
 kill -TERM "$pid"
 wait "$pid"
 got=$?
