@@ -62,25 +62,25 @@ Attenuation::Attenuation(double eta, double theta, const std::vector<double>& si
   for (double s : sigma_a) sigma_a_prime_.push_back(s / cos_theta_t);
 }
 
-double Attenuation::f(double gamma_i) const {
-  return fresnel_dielectric(std::clamp(cos_theta_ * std::cos(gamma_i), 0.0, 1.0), eta_);
+double Attenuation::f_cos(double cos_gamma_i) const {
+  return fresnel_dielectric(std::clamp(cos_theta_ * cos_gamma_i, 0.0, 1.0), eta_);
 }
 
-void Attenuation::T(double gamma_i, double* out) const {
-  const double s = std::sin(gamma_i) / eta_p_;
+void Attenuation::T_sin(double sin_gamma_i, double* out) const {
+  const double s = sin_gamma_i / eta_p_;
   const double cos_t = std::sqrt(std::max(0.0, 1.0 - s * s));
   for (std::size_t c = 0; c < sigma_a_prime_.size(); ++c)
     out[c] = segment_transmittance(sigma_a_prime_[c], cos_t, absorption_);
 }
 
-void Attenuation::A(int p, double gamma_i, double* out) const {
-  const double fr = f(gamma_i);
+void Attenuation::A(int p, double cos_gamma_i, double sin_gamma_i, double* out) const {
+  const double fr = f_cos(cos_gamma_i);
   const int C = channels();
   if (p == 0) {
     for (int c = 0; c < C; ++c) out[c] = fr;
     return;
   }
-  T(gamma_i, out);
+  T_sin(sin_gamma_i, out);
   const double base = (1.0 - fr) * (1.0 - fr) * power(fr, p - 1);
   for (int c = 0; c < C; ++c) out[c] = base * power(out[c], p);
 }
@@ -142,7 +142,7 @@ double solve_phi(int p, double eta_p, double e, double a, double b, double phi_a
 }
 
 void add_piece_nodes(int p, double eta_p, double a, double b, int order, double max_len,
-                     std::vector<PathNode>& out) {
+                     std::vector<PathNode>& out, bool want_phi = true) {
   if (!(b > a)) return;
   const int m = std::max(1, static_cast<int>(std::ceil((b - a) / max_len)));
   const double len = (b - a) / m;
@@ -156,7 +156,7 @@ void add_piece_nodes(int p, double eta_p, double a, double b, int order, double 
     const double half = 0.5 * len, mid = c0 + half;
     for (int q = 0; q < order; ++q) {
       const double g = mid + half * gl.x[q];
-      out.push_back({g, 0.5 * half * gl.w[q] * std::cos(g), wrap_angle(Phi(p, g, eta_p))});
+      out.push_back({g, 0.5 * half * gl.w[q] * std::cos(g), want_phi ? wrap_angle(Phi(p, g, eta_p)) : 0.0});
     }
   }
 }
@@ -187,7 +187,8 @@ void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNod
   }
 }
 
-void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out) {
+void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out,
+                 bool want_phi) {
   out.clear();
   const std::vector<double> br = monotonic_breaks(p, eta_p);
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
@@ -195,7 +196,7 @@ void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<Pa
     double slope = std::max(std::abs(dPhi_dgamma(p, a, eta_p)), std::abs(dPhi_dgamma(p, b, eta_p)));
     if (a < 0.0 && b > 0.0) slope = std::max(slope, std::abs(dPhi_dgamma(p, 0.0, eta_p)));
     const double max_len = std::min(kPi / 16, max_dphi / std::max(slope, 1e-12));
-    add_piece_nodes(p, eta_p, a, b, order, max_len, out);
+    add_piece_nodes(p, eta_p, a, b, order, max_len, out, want_phi);
   }
 }
 

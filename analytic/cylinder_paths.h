@@ -10,6 +10,7 @@
 //   f = F(eta, acos(cos theta cos gamma_i)) (3D Fresnel, common/fresnel.h),
 //   T = exp(-sigma_a' 2 cos gamma_t) (chord) or exp(-4 sigma_a' cos^2 gamma_t)
 //   (published), sigma_a' = sigma_a / cos theta_t, sin theta_t = sin theta / eta.
+#include <cmath>
 #include <vector>
 
 #include "analytic/model.h"
@@ -41,11 +42,14 @@ class Attenuation {
   double eta_p() const { return eta_p_; }
   int channels() const { return static_cast<int>(sigma_a_prime_.size()); }
   // f = F(eta, acos(cos theta cos gamma_i)).
-  double f(double gamma_i) const;
+  double f(double gamma_i) const { return f_cos(std::cos(gamma_i)); }
+  double f_cos(double cos_gamma_i) const;
   // T of one internal segment, per channel.
-  void T(double gamma_i, double* out) const;
-  // A(p, gamma_i) per channel (out[0..C)).
-  void A(int p, double gamma_i, double* out) const;
+  void T(double gamma_i, double* out) const { T_sin(std::sin(gamma_i), out); }
+  void T_sin(double sin_gamma_i, double* out) const;
+  // A(p, gamma_i) per channel (out[0..C)), from gamma_i or its cosine and sine.
+  void A(int p, double gamma_i, double* out) const { A(p, std::cos(gamma_i), std::sin(gamma_i), out); }
+  void A(int p, double cos_gamma_i, double sin_gamma_i, double* out) const;
   // Sum of A(p', gamma_i) over every p' > P (P >= 0), per channel, in closed
   // form: (1 - f)^2 f^P T^(P+1) / (1 - f T).
   void A_beyond(int P, double gamma_i, double* out) const;
@@ -68,7 +72,9 @@ struct PathNode {
 void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNode>& out);
 // Composite Gauss-Legendre over gamma_i in (-pi/2, pi/2), split at the fold,
 // with panels over which Phi changes by at most max_dphi.
-void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out);
+// Without want_phi, phi is left 0 (callers that build Phi's phasor themselves).
+void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out,
+                 bool want_phi = true);
 // Bin of a wrapped phi in n uniform bins on [-pi, pi).
 int phi_bin(double phi, int n_phi);
 // Adds the smooth cylinder's lobe p, (1/2) integral of A(p, h) dh, to the phi

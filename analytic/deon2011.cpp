@@ -103,6 +103,9 @@ constexpr double kSmoothBeta = 1e-4;   // beta_azim below this: the smooth N_p
 constexpr double kDeltaBeta = 1e-7;    // beta_long below this: M_p is a delta
 constexpr double kDensityFloor = 1e-3; // density(): floor of both betas
 constexpr double kResidualTol = 1e-6;  // energy left to the uniform residual
+// Per order and theta_r node: bound on a phi bin's change from the Fourier
+// terms left out (see FourierSums).
+constexpr double kFourierTol = 1e-13;
 
 // Energy of every order p > P per channel, (1/2) int sum_{p>P} A dh, by
 // 64-point Gauss-Legendre over gamma_i (the closed-form sum is smooth in gamma).
@@ -143,64 +146,91 @@ void deposit_gaussian(double mu, double beta, const double* mass, int C, int n,
 }
 
 // The sums F_n = sum over nodes of mass e^{-i n Phi} (n = 0..N) of the
-// Fourier deposit of Eq. 11. The nodes are collected first, then the sums
-// run with the nodes innermost: each node's e^{-i n Phi} by the recurrence
-// z_{n+1} = z_n e^{-i Phi} as before, the sum over nodes in independent
-// lanes (vectorized; only the order of the additions differs).
+// Fourier deposit of Eq. 11. The nodes are collected first, in segments (one
+// per order p), then the sums run with the nodes innermost: each node's
+// e^{-i n Phi} by the recurrence z_{n+1} = z_n e^{-i Phi}, the sum over nodes
+// in independent lanes (vectorized).
+//
+// A segment stops at the n beyond which its terms provably cannot move any
+// phi bin by more than `tol`: with masses m_k >= 0, |F_n| <= E = sum_k m_k,
+// and the bin factor |(e^{i n b} - e^{i n a}) / (i n)| <= min(b - a, 2 / n),
+// so the terms n > N change a bin by at most
+//   (E / pi) sum_{n > N} g_n min(b - a, 2 / n),   g_n = exp(-n^2 beta^2 / 2).
+// High orders carry little energy and stop early.
 class FourierSums {
  public:
   void clear(int channels) {
     e_re_.clear();
     e_im_.clear();
     mass_.assign(channels, {});
+    segments_.clear();
   }
-  void add(double phi, const double* mass) {
-    e_re_.push_back(std::cos(phi));
-    e_im_.push_back(-std::sin(phi));
+  // Starts the segment of the nodes added next.
+  void begin_segment() { segments_.push_back(e_re_.size()); }
+  // A node of the given mass per channel and phasor e^{-i Phi} = re + i im.
+  void add(double re, double im, const double* mass) {
+    e_re_.push_back(re);
+    e_im_.push_back(im);
     for (std::size_t c = 0; c < mass_.size(); ++c) mass_[c].push_back(mass[c]);
   }
-  // Adds F_n to f_re/f_im[n * C + c], n = 0..N. Tiles of kTile nodes keep
-  // their z in the first-level cache across the n loop.
-  void coefficients(int N, std::vector<double>& f_re, std::vector<double>& f_im) const {
+  // Adds F_n to f_re/f_im[n * C + c], n = 0..N_segment <= N, where the
+  // segment's N follows from tail[n] = sum_{n' > n} g_n' min(dphi, 2 / n')
+  // (tail.size() == N + 1) and tol as above.
+  void coefficients(int N, const std::vector<double>& tail, double tol, std::vector<double>& f_re,
+                    std::vector<double>& f_im) const {
     const std::size_t K = e_re_.size(), C = mass_.size();
-    for (std::size_t k0 = 0; k0 < K; k0 += kTile) {
-      const std::size_t len = std::min(kTile, K - k0);
-      double zr[kTile], zi[kTile];
-      std::fill(zr, zr + len, 1.0);
-      std::fill(zi, zi + len, 0.0);
-      const double* er = e_re_.data() + k0;
-      const double* ei = e_im_.data() + k0;
-      for (int n = 0; n <= N; ++n) {
-        for (std::size_t c = 0; c < C; ++c) {
-          const double* m = mass_[c].data() + k0;
-          // kLanes partial sums in one vector register each (GCC vector
-          // extension), added up at the end.
-          Lanes sr = {}, si = {};
-          std::size_t k = 0;
-          for (; k + kLanes <= len; k += kLanes) {
-            const Lanes mk = load(m + k);
-            sr += mk * load(zr + k);
-            si += mk * load(zi + k);
-          }
-          double sum_r = 0.0, sum_i = 0.0;
-          for (std::size_t l = 0; l < kLanes; ++l) sum_r += sr[l], sum_i += si[l];
-          for (; k < len; ++k) {
-            sum_r += m[k] * zr[k];
-            sum_i += m[k] * zi[k];
-          }
-          f_re[static_cast<std::size_t>(n) * C + c] += sum_r;
-          f_im[static_cast<std::size_t>(n) * C + c] += sum_i;
-        }
-        for (std::size_t k = 0; k < len; ++k) {
-          const double next_re = zr[k] * er[k] - zi[k] * ei[k];
-          zi[k] = zr[k] * ei[k] + zi[k] * er[k];
-          zr[k] = next_re;
-        }
+    for (std::size_t s = 0; s < segments_.size(); ++s) {
+      const std::size_t b = segments_[s], e = s + 1 < segments_.size() ? segments_[s + 1] : K;
+      double energy = 0.0;
+      for (std::size_t c = 0; c < C; ++c) {
+        double sum = 0.0;
+        for (std::size_t k = b; k < e; ++k) sum += mass_[c][k];
+        energy = std::max(energy, sum);
       }
+      int n_seg = N;
+      while (n_seg > 0 && energy / kPi * tail[n_seg - 1] <= tol) --n_seg;
+      for (std::size_t k0 = b; k0 < e; k0 += kTile) coefficients_tile(k0, std::min(kTile, e - k0), n_seg, f_re, f_im);
     }
   }
 
  private:
+  // Tiles of kTile nodes keep their z in the first-level cache across the n loop.
+  void coefficients_tile(std::size_t k0, std::size_t len, int N, std::vector<double>& f_re,
+                         std::vector<double>& f_im) const {
+    const std::size_t C = mass_.size();
+    double zr[kTile], zi[kTile];
+    std::fill(zr, zr + len, 1.0);
+    std::fill(zi, zi + len, 0.0);
+    const double* er = e_re_.data() + k0;
+    const double* ei = e_im_.data() + k0;
+    for (int n = 0; n <= N; ++n) {
+      for (std::size_t c = 0; c < C; ++c) {
+        const double* m = mass_[c].data() + k0;
+        // kLanes partial sums in one vector register each (GCC vector
+        // extension), added up at the end.
+        Lanes sr = {}, si = {};
+        std::size_t k = 0;
+        for (; k + kLanes <= len; k += kLanes) {
+          const Lanes mk = load(m + k);
+          sr += mk * load(zr + k);
+          si += mk * load(zi + k);
+        }
+        double sum_r = 0.0, sum_i = 0.0;
+        for (std::size_t l = 0; l < kLanes; ++l) sum_r += sr[l], sum_i += si[l];
+        for (; k < len; ++k) {
+          sum_r += m[k] * zr[k];
+          sum_i += m[k] * zi[k];
+        }
+        f_re[static_cast<std::size_t>(n) * C + c] += sum_r;
+        f_im[static_cast<std::size_t>(n) * C + c] += sum_i;
+      }
+      for (std::size_t k = 0; k < len; ++k) {
+        const double next_re = zr[k] * er[k] - zi[k] * ei[k];
+        zi[k] = zr[k] * ei[k] + zi[k] * er[k];
+        zr[k] = next_re;
+      }
+    }
+  }
   static constexpr std::size_t kLanes = 8, kTile = 256;
   typedef double Lanes __attribute__((vector_size(kLanes * sizeof(double))));
   static Lanes load(const double* p) {
@@ -210,7 +240,52 @@ class FourierSums {
   }
   std::vector<double> e_re_, e_im_;
   std::vector<std::vector<double>> mass_;  // [channel][node]
+  std::vector<std::size_t> segments_;      // first node of each segment
 };
+
+// (re + i im)^n for n >= 0 by repeated squaring.
+void complex_power(double& re, double& im, int n) {
+  double r = 1.0, i = 0.0, xr = re, xi = im;
+  for (; n > 0; n >>= 1) {
+    if (n & 1) {
+      const double t = r * xr - i * xi;
+      i = r * xi + i * xr;
+      r = t;
+    }
+    const double t = xr * xr - xi * xi;
+    xi = 2.0 * xr * xi;
+    xr = t;
+  }
+  re = r;
+  im = i;
+}
+
+// Order p's nodes into the Fourier sums: masses weight * A(p, gamma) per
+// channel and the phasor e^{-i Phi(p, gamma)}, from the sine and cosine of
+// gamma alone. Phi = 2 p gamma_t - 2 gamma_i + p pi (cylinder_paths.h) gives
+//   e^{-i Phi} = (-1)^p (cos gamma_t - i sin gamma_t)^(2p) (cos gamma_i + i sin gamma_i)^2,
+// sin gamma_t = sin gamma_i / eta' (|sin gamma_i| <= 1 < eta'): no asin, no
+// wrap of Phi, no sine and cosine of Phi.
+void add_fourier_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
+                       FourierSums& fourier) {
+  const int C = att.channels();
+  double a[16];
+  std::vector<double> a_big;
+  double* mass = a;
+  if (C > 16) a_big.resize(C), mass = a_big.data();
+  const double inv_eta_p = 1.0 / att.eta_p(), sign = (p % 2) ? -1.0 : 1.0;
+  fourier.begin_segment();
+  for (const cylinder::PathNode& nd : nodes) {
+    const double si = std::sin(nd.gamma), ci = std::cos(nd.gamma);
+    att.A(p, ci, si, mass);
+    for (int c = 0; c < C; ++c) mass[c] *= nd.weight;
+    const double st = si * inv_eta_p, ct = std::sqrt(std::max(0.0, 1.0 - st * st));
+    double tr = ct, ti = -st;
+    complex_power(tr, ti, 2 * p);
+    const double ir = ci * ci - si * si, ii = 2.0 * ci * si;  // e^{2 i gamma_i}
+    fourier.add(sign * (tr * ir - ti * ii), sign * (tr * ii + ti * ir), mass);
+  }
+}
 
 // G_0(phi) = (1/2) int D_0(phi - Phi(0, h)) dh = (D_0 * |cos(psi/2)|/4)(phi):
 // the R lobe's azimuthal shape before Eq. 12's direction-dependent Fresnel.
@@ -399,6 +474,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
   std::vector<double> a(C);
   std::vector<double> bin_factor_re, bin_factor_im, bin_sum;  // [n * np + j], see the Fourier deposit
   FourierSums fourier;
+  std::vector<double> fourier_tail;
   // Phi-bin integrals of sum_{p in term} N_p at exit inclination theta_r: [j * C + c].
   auto azimuthal = [&](const Term& t, double theta_r, std::vector<double>& nb) {
     nb.assign(static_cast<std::size_t>(np) * C, 0.0);
@@ -430,20 +506,26 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       } else {
         // Panels over which Phi moves by up to 4 beta: 8 Gauss points resolve the
         // detector to ~1e-12 there (checked against beta / 4 panels).
-        cylinder::panel_nodes(p, att.eta_p(), std::min(4.0 * t.beta, 1.0) / refine_, 8, nodes);
-        for (const auto& nd : nodes) {
-          att.A(p, nd.gamma, a.data());
-          for (int c = 0; c < C; ++c) a[c] *= nd.weight;
-          if (n_fourier > 0) {
-            fourier.add(nd.phi, a.data());
-          } else {
+        cylinder::panel_nodes(p, att.eta_p(), std::min(4.0 * t.beta, 1.0) / refine_, 8, nodes,
+                              n_fourier == 0);
+        if (n_fourier > 0) {
+          add_fourier_nodes(att, p, nodes, fourier);
+        } else {
+          for (const auto& nd : nodes) {
+            att.A(p, nd.gamma, a.data());
+            for (int c = 0; c < C; ++c) a[c] *= nd.weight;
             deposit_gaussian(nd.phi, t.beta, a.data(), C, np, nb);
           }
         }
       }
     }
     if (n_fourier > 0) {
-      fourier.coefficients(n_fourier, f_re, f_im);
+      // tail[n] = sum_{n' > n} g_n' min(dphi, 2 / n'): the truncation bound.
+      fourier_tail.assign(n_fourier + 1, 0.0);
+      for (int n = n_fourier - 1; n >= 0; --n)
+        fourier_tail[n] = fourier_tail[n + 1] + std::exp(-0.5 * (n + 1.0) * (n + 1.0) * t.beta * t.beta) *
+                                                    std::min(dphi, 2.0 / (n + 1.0));
+      fourier.coefficients(n_fourier, fourier_tail, kFourierTol / (refine_ * refine_), f_re, f_im);
       // Eq. 11 in Fourier form: the wrapped Gaussian's coefficients are
       // g_n = exp(-n^2 beta^2 / 2), so the bin mass is
       // F_0 dphi / 2pi + (1/pi) Re sum_{n>=1} F_n g_n (e^{i n b} - e^{i n a}) / (i n).
