@@ -1,6 +1,7 @@
 #include "analytic/deon2011.h"
 
 #include <fmt/core.h>
+#include <xsimd/xsimd.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -173,12 +174,25 @@ class FourierSums {
     e_im_.push_back(im);
     for (std::size_t c = 0; c < mass_.size(); ++c) mass_[c].push_back(mass[c]);
   }
+  // One SIMD batch of nodes: phasors re[l] + i im[l], masses mass[c] lane l.
+  void add_lanes(const double* re, const double* im, const xsimd::batch<double>* mass) {
+    constexpr std::size_t W = xsimd::batch<double>::size;
+    const std::size_t k = e_re_.size();
+    e_re_.insert(e_re_.end(), re, re + W);
+    e_im_.insert(e_im_.end(), im, im + W);
+    for (std::size_t c = 0; c < mass_.size(); ++c) {
+      mass_[c].resize(k + W);
+      mass[c].store_unaligned(mass_[c].data() + k);
+    }
+  }
   // Adds F_n to f_re/f_im[n * C + c], n = 0..N_segment <= N, where the
   // segment's N follows from tail[n] = sum_{n' > n} g_n' min(dphi, 2 / n')
-  // (tail.size() == N + 1) and tol as above.
-  void coefficients(int N, const std::vector<double>& tail, double tol, std::vector<double>& f_re,
-                    std::vector<double>& f_im) const {
+  // (tail.size() == N + 1) and tol as above. Returns the largest N_segment
+  // (F_n = 0 above it).
+  int coefficients(int N, const std::vector<double>& tail, double tol, std::vector<double>& f_re,
+                   std::vector<double>& f_im) const {
     const std::size_t K = e_re_.size(), C = mass_.size();
+    int n_used = 0;
     for (std::size_t s = 0; s < segments_.size(); ++s) {
       const std::size_t b = segments_[s], e = s + 1 < segments_.size() ? segments_[s + 1] : K;
       double energy = 0.0;
@@ -189,8 +203,10 @@ class FourierSums {
       }
       int n_seg = N;
       while (n_seg > 0 && energy / kPi * tail[n_seg - 1] <= tol) --n_seg;
+      n_used = std::max(n_used, n_seg);
       for (std::size_t k0 = b; k0 < e; k0 += kTile) coefficients_tile(k0, std::min(kTile, e - k0), n_seg, f_re, f_im);
     }
+    return n_used;
   }
 
  private:
@@ -243,17 +259,18 @@ class FourierSums {
   std::vector<std::size_t> segments_;      // first node of each segment
 };
 
-// (re + i im)^n for n >= 0 by repeated squaring.
-void complex_power(double& re, double& im, int n) {
-  double r = 1.0, i = 0.0, xr = re, xi = im;
+// (re + i im)^n for n >= 0 by repeated squaring, any number type.
+template <class N>
+void complex_power(N& re, N& im, int n) {
+  N r(1.0), i(0.0), xr = re, xi = im;
   for (; n > 0; n >>= 1) {
     if (n & 1) {
-      const double t = r * xr - i * xi;
+      const N t = r * xr - i * xi;
       i = r * xi + i * xr;
       r = t;
     }
-    const double t = xr * xr - xi * xi;
-    xi = 2.0 * xr * xi;
+    const N t = xr * xr - xi * xi;
+    xi = N(2.0) * xr * xi;
     xr = t;
   }
   re = r;
@@ -265,26 +282,68 @@ void complex_power(double& re, double& im, int n) {
 // gamma alone. Phi = 2 p gamma_t - 2 gamma_i + p pi (cylinder_paths.h) gives
 //   e^{-i Phi} = (-1)^p (cos gamma_t - i sin gamma_t)^(2p) (cos gamma_i + i sin gamma_i)^2,
 // sin gamma_t = sin gamma_i / eta' (|sin gamma_i| <= 1 < eta'): no asin, no
-// wrap of Phi, no sine and cosine of Phi.
+// wrap of Phi, no sine and cosine of Phi. One node per SIMD lane (xsimd).
+template <class N>
+void fourier_node(const cylinder::Attenuation& att, int p, N ci, N si, N weight, N* mass, N& re, N& im) {
+  using std::max;
+  using std::sqrt;
+  att.A(p, ci, si, mass);
+  for (int c = 0; c < att.channels(); ++c) mass[c] *= weight;
+  const N st = si / N(att.eta_p()), ct = sqrt(max(N(0.0), N(1.0) - st * st));
+  N tr = ct, ti = -st;
+  complex_power(tr, ti, 2 * p);
+  const N ir = ci * ci - si * si, ii = N(2.0) * ci * si;  // e^{2 i gamma_i}
+  const N sign((p % 2) ? -1.0 : 1.0);
+  re = sign * (tr * ir - ti * ii);
+  im = sign * (tr * ii + ti * ir);
+}
+
 void add_fourier_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
                        FourierSums& fourier) {
+  using Batch = xsimd::batch<double>;
+  constexpr std::size_t W = Batch::size;
   const int C = att.channels();
-  double a[16];
-  std::vector<double> a_big;
-  double* mass = a;
-  if (C > 16) a_big.resize(C), mass = a_big.data();
-  const double inv_eta_p = 1.0 / att.eta_p(), sign = (p % 2) ? -1.0 : 1.0;
   fourier.begin_segment();
-  for (const cylinder::PathNode& nd : nodes) {
-    const double si = std::sin(nd.gamma), ci = std::cos(nd.gamma);
-    att.A(p, ci, si, mass);
-    for (int c = 0; c < C; ++c) mass[c] *= nd.weight;
-    const double st = si * inv_eta_p, ct = std::sqrt(std::max(0.0, 1.0 - st * st));
-    double tr = ct, ti = -st;
-    complex_power(tr, ti, 2 * p);
-    const double ir = ci * ci - si * si, ii = 2.0 * ci * si;  // e^{2 i gamma_i}
-    fourier.add(sign * (tr * ir - ti * ii), sign * (tr * ii + ti * ir), mass);
+  std::vector<Batch> mass_b(C);
+  std::vector<double> mass(C);
+  alignas(64) double ci[W], si[W], w[W], re[W], im[W];
+  std::size_t k = 0;
+  for (; k + W <= nodes.size(); k += W) {
+    for (std::size_t l = 0; l < W; ++l)
+      ci[l] = nodes[k + l].cos_gamma, si[l] = nodes[k + l].sin_gamma, w[l] = nodes[k + l].weight;
+    Batch bre, bim;
+    fourier_node(att, p, Batch::load_aligned(ci), Batch::load_aligned(si), Batch::load_aligned(w),
+                 mass_b.data(), bre, bim);
+    bre.store_aligned(re);
+    bim.store_aligned(im);
+    fourier.add_lanes(re, im, mass_b.data());
   }
+  for (; k < nodes.size(); ++k) {
+    double r, i;
+    fourier_node(att, p, nodes[k].cos_gamma, nodes[k].sin_gamma, nodes[k].weight, mass.data(), r, i);
+    fourier.add(r, i, mass.data());
+  }
+}
+
+// Eq. 12's Fresnel term F(eta, arccos(wi . wr) / 2) (deon2011::F_half_angle)
+// at every phi point k of a theta_r: wi . wr = a + b cos(phi_k) with
+// a = sin theta_i sin theta_r, b = cos theta_i cos theta_r, and
+// cos(arccos(x) / 2) = sqrt((1 + x) / 2). SIMD lanes (xsimd) through the
+// shared generic Fresnel (common/fresnel.h).
+void half_angle_fresnel(double a, double b, const std::vector<double>& cos_phi, double eta,
+                        std::vector<double>& out) {
+  using Batch = xsimd::batch<double>;
+  constexpr std::size_t W = Batch::size;
+  const std::size_t n = cos_phi.size();
+  out.resize(n);
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    const Batch x = Batch(a) + Batch(b) * Batch::load_unaligned(cos_phi.data() + k);
+    const Batch u = xsimd::sqrt(xsimd::min(Batch(1.0), xsimd::max(Batch(0.0), 0.5 * (1.0 + x))));
+    fresnel_dielectric(u, Batch(eta)).store_unaligned(out.data() + k);
+  }
+  for (; k < n; ++k)
+    out[k] = fresnel_dielectric(std::sqrt(std::clamp(0.5 * (1.0 + a + b * cos_phi[k]), 0.0, 1.0)), eta);
 }
 
 // G_0(phi) = (1/2) int D_0(phi - Phi(0, h)) dh = (D_0 * |cos(psi/2)|/4)(phi):
@@ -463,12 +522,17 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       }
   }
   const double sin_i = std::sin(theta_i), cos_i = std::cos(theta_i);
-  // Eq. 12: F(eta, arccos(wi . wr) / 2) at (theta_r, phi point jq), as
-  // deon2011::F_half_angle computes it.
-  auto f_half = [&](double sin_r, double cos_r, int jq) {
-    const double x = sin_i * sin_r + cos_i * cos_r * cos_ph[jq];
-    return fresnel_dielectric(std::sqrt(std::clamp(0.5 * (1.0 + x), 0.0, 1.0)), params_.eta);
+  // g0 times the phi quadrature weights: row j of the R lobe at theta_r is
+  // sum_q F_jq gw[jq] (Eq. 12's Fresnel F_jq = F(eta, arccos(wi . wr) / 2)).
+  std::vector<double> gw(g0.size()), r_fresnel(g0.size());
+  for (std::size_t jq = 0; jq < g0.size(); ++jq) gw[jq] = 0.5 * dphi * glp.w[jq % kPhiOrder] * g0[jq];
+  auto r_row = [&](double theta_r, std::vector<double>& row) {
+    half_angle_fresnel(sin_i * std::sin(theta_r), cos_i * std::cos(theta_r), cos_ph, params_.eta, r_fresnel);
+    row.assign(np, 0.0);
+    for (int j = 0; j < np; ++j)
+      for (int q = 0; q < kPhiOrder; ++q) row[j] += r_fresnel[j * kPhiOrder + q] * gw[j * kPhiOrder + q];
   };
+  std::vector<double> r_row_buf;
 
   std::vector<cylinder::PathNode> nodes;
   std::vector<double> a(C);
@@ -494,13 +558,9 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     fourier.clear(C);
     for (int p = t.p0; p <= t.p1; ++p) {
       if (p == 0 && r_special) {
-        const double sin_r = std::sin(theta_r), cos_r = std::cos(theta_r);
-        for (int j = 0; j < np; ++j) {
-          double s = 0.0;
-          for (int q = 0; q < kPhiOrder; ++q)
-            s += 0.5 * dphi * glp.w[q] * f_half(sin_r, cos_r, j * kPhiOrder + q) * g0[j * kPhiOrder + q];
-          for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += s;
-        }
+        r_row(theta_r, r_row_buf);
+        for (int j = 0; j < np; ++j)
+          for (int c = 0; c < C; ++c) nb[static_cast<std::size_t>(j) * C + c] += r_row_buf[j];
       } else if (t.beta < kSmoothBeta) {
         cylinder::add_smooth_lobe(att, p, np, nb);
       } else {
@@ -525,7 +585,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       for (int n = n_fourier - 1; n >= 0; --n)
         fourier_tail[n] = fourier_tail[n + 1] + std::exp(-0.5 * (n + 1.0) * (n + 1.0) * t.beta * t.beta) *
                                                     std::min(dphi, 2.0 / (n + 1.0));
-      fourier.coefficients(n_fourier, fourier_tail, kFourierTol / (refine_ * refine_), f_re, f_im);
+      const int n_used = fourier.coefficients(n_fourier, fourier_tail, kFourierTol / (refine_ * refine_), f_re, f_im);
       // Eq. 11 in Fourier form: the wrapped Gaussian's coefficients are
       // g_n = exp(-n^2 beta^2 / 2), so the bin mass is
       // F_0 dphi / 2pi + (1/pi) Re sum_{n>=1} F_n g_n (e^{i n b} - e^{i n a}) / (i n).
@@ -543,7 +603,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
             bin_factor_im[static_cast<std::size_t>(n) * np + j] = d.imag();
           }
       }
-      for (int n = 1; n <= n_fourier; ++n) {
+      for (int n = 1; n <= n_used; ++n) {
         const double g = std::exp(-0.5 * n * n * t.beta * t.beta) / kPi;
         for (int c = 0; c < C; ++c) {
           f_re[static_cast<std::size_t>(n) * C + c] *= g;
@@ -554,7 +614,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
       // innermost (contiguous, independent: vectorized) per channel.
       for (int c = 0; c < C; ++c) {
         bin_sum.assign(np, f_re[c] * dphi / kTwoPi);
-        for (int n = 1; n <= n_fourier; ++n) {
+        for (int n = 1; n <= n_used; ++n) {
           const double fr = f_re[static_cast<std::size_t>(n) * C + c];
           const double fi = f_im[static_cast<std::size_t>(n) * C + c];
           const double* d_re = &bin_factor_re[static_cast<std::size_t>(n) * np];
@@ -633,15 +693,11 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     }
     if (t.p0 == 0 && t.p1 == 0 && r_special && !t.residual && !params_.specular_theta_d) {
       // R with Eq. 12: F depends on (theta_r, phi) itself: direct 2D quadrature.
-      std::vector<double> row(np);
       for (const ThetaPoint& pt : tp) {
-        const double sin_r = std::sin(pt.theta), cos_r = std::cos(pt.theta);
+        r_row(pt.theta, r_row_buf);
         for (int j = 0; j < np; ++j) {
-          double s = 0.0;
-          for (int q = 0; q < kPhiOrder; ++q)
-            s += 0.5 * dphi * glp.w[q] * f_half(sin_r, cos_r, j * kPhiOrder + q) * g0[j * kPhiOrder + q];
           double* o = &lobe_out[(static_cast<std::size_t>(pt.i) * np + j) * C];
-          for (int c = 0; c < C; ++c) o[c] += pt.w * s;
+          for (int c = 0; c < C; ++c) o[c] += pt.w * r_row_buf[j];
         }
       }
       continue;
