@@ -210,41 +210,87 @@ class FourierSums {
   }
 
  private:
-  // Tiles of kTile nodes keep their z in the first-level cache across the n loop.
+  // Tiles of kTile nodes keep their z in the first-level cache across the n
+  // loop. Up to 4 channels run in one pass over the nodes (a template on the
+  // count keeps their sums in registers), more one channel at a time.
   void coefficients_tile(std::size_t k0, std::size_t len, int N, std::vector<double>& f_re,
                          std::vector<double>& f_im) const {
+    switch (mass_.size()) {
+      case 1: return tile_fused<1>(k0, len, N, f_re, f_im);
+      case 2: return tile_fused<2>(k0, len, N, f_re, f_im);
+      case 3: return tile_fused<3>(k0, len, N, f_re, f_im);
+      case 4: return tile_fused<4>(k0, len, N, f_re, f_im);
+      default:
+        for (std::size_t c = 0; c < mass_.size(); ++c) tile_channel(c, k0, len, N, f_re, f_im);
+    }
+  }
+  template <std::size_t C>
+  void tile_fused(std::size_t k0, std::size_t len, int N, std::vector<double>& f_re,
+                  std::vector<double>& f_im) const {
+    double zr[kTile], zi[kTile];
+    std::fill(zr, zr + len, 1.0);
+    std::fill(zi, zi + len, 0.0);
+    const double* er = e_re_.data() + k0;
+    const double* ei = e_im_.data() + k0;
+    const double* m[C];
+    for (std::size_t c = 0; c < C; ++c) m[c] = mass_[c].data() + k0;
+    for (int n = 0; n <= N; ++n) {
+      // kLanes partial sums in one vector register each (GCC vector
+      // extension), added up at the end; z advanced to z e^{-i Phi} in the
+      // same pass.
+      Lanes sr[C] = {}, si[C] = {};
+      std::size_t k = 0;
+      for (; k + kLanes <= len; k += kLanes) {
+        const Lanes a = load(zr + k), b = load(zi + k);
+        for (std::size_t c = 0; c < C; ++c) {
+          const Lanes mk = load(m[c] + k);
+          sr[c] += mk * a;
+          si[c] += mk * b;
+        }
+        const Lanes cr = load(er + k), ci = load(ei + k);
+        store(zr + k, a * cr - b * ci);
+        store(zi + k, a * ci + b * cr);
+      }
+      double sum_r[C], sum_i[C];
+      for (std::size_t c = 0; c < C; ++c) {
+        sum_r[c] = sum_i[c] = 0.0;
+        for (std::size_t l = 0; l < kLanes; ++l) sum_r[c] += sr[c][l], sum_i[c] += si[c][l];
+      }
+      for (; k < len; ++k) {
+        for (std::size_t c = 0; c < C; ++c) {
+          sum_r[c] += m[c][k] * zr[k];
+          sum_i[c] += m[c][k] * zi[k];
+        }
+        const double next_re = zr[k] * er[k] - zi[k] * ei[k];
+        zi[k] = zr[k] * ei[k] + zi[k] * er[k];
+        zr[k] = next_re;
+      }
+      for (std::size_t c = 0; c < C; ++c) {
+        f_re[static_cast<std::size_t>(n) * C + c] += sum_r[c];
+        f_im[static_cast<std::size_t>(n) * C + c] += sum_i[c];
+      }
+    }
+  }
+  void tile_channel(std::size_t c, std::size_t k0, std::size_t len, int N, std::vector<double>& f_re,
+                    std::vector<double>& f_im) const {
     const std::size_t C = mass_.size();
     double zr[kTile], zi[kTile];
     std::fill(zr, zr + len, 1.0);
     std::fill(zi, zi + len, 0.0);
     const double* er = e_re_.data() + k0;
     const double* ei = e_im_.data() + k0;
+    const double* m = mass_[c].data() + k0;
     for (int n = 0; n <= N; ++n) {
-      for (std::size_t c = 0; c < C; ++c) {
-        const double* m = mass_[c].data() + k0;
-        // kLanes partial sums in one vector register each (GCC vector
-        // extension), added up at the end.
-        Lanes sr = {}, si = {};
-        std::size_t k = 0;
-        for (; k + kLanes <= len; k += kLanes) {
-          const Lanes mk = load(m + k);
-          sr += mk * load(zr + k);
-          si += mk * load(zi + k);
-        }
-        double sum_r = 0.0, sum_i = 0.0;
-        for (std::size_t l = 0; l < kLanes; ++l) sum_r += sr[l], sum_i += si[l];
-        for (; k < len; ++k) {
-          sum_r += m[k] * zr[k];
-          sum_i += m[k] * zi[k];
-        }
-        f_re[static_cast<std::size_t>(n) * C + c] += sum_r;
-        f_im[static_cast<std::size_t>(n) * C + c] += sum_i;
-      }
+      double sum_r = 0.0, sum_i = 0.0;
       for (std::size_t k = 0; k < len; ++k) {
+        sum_r += m[k] * zr[k];
+        sum_i += m[k] * zi[k];
         const double next_re = zr[k] * er[k] - zi[k] * ei[k];
         zi[k] = zr[k] * ei[k] + zi[k] * er[k];
         zr[k] = next_re;
       }
+      f_re[static_cast<std::size_t>(n) * C + c] += sum_r;
+      f_im[static_cast<std::size_t>(n) * C + c] += sum_i;
     }
   }
   static constexpr std::size_t kLanes = 8, kTile = 256;
@@ -254,6 +300,7 @@ class FourierSums {
     std::memcpy(&v, p, sizeof v);
     return v;
   }
+  static void store(double* p, Lanes v) { std::memcpy(p, &v, sizeof v); }
   std::vector<double> e_re_, e_im_;
   std::vector<std::vector<double>> mass_;  // [channel][node]
   std::vector<std::size_t> segments_;      // first node of each segment
@@ -348,8 +395,31 @@ void half_angle_fresnel(double a, double b, const std::vector<double>& cos_phi, 
 
 // G_0(phi) = (1/2) int D_0(phi - Phi(0, h)) dh = (D_0 * |cos(psi/2)|/4)(phi):
 // the R lobe's azimuthal shape before Eq. 12's direction-dependent Fresnel.
-double G0(double phi, double beta, double refine) {
-  if (beta < kSmoothBeta) return std::abs(std::cos(0.5 * phi)) * 0.25;
+//
+// For beta >= kG0SeriesBeta by its Fourier series: |cos(psi/2)| =
+// 2/pi + sum_{k>=1} (-1)^(k+1) 4 / (pi (4k^2 - 1)) cos(k psi), and the
+// detector multiplies coefficient k by g_k = exp(-k^2 beta^2 / 2), so
+//   G_0(phi) = 1/4 [2/pi + sum_k (-1)^(k+1) 4 g_k / (pi (4k^2 - 1)) cos(k phi)],
+// summed to the K = ceil(8.9 / beta) with g_K < 1e-17 (the terms beyond add
+// up to < 1e-20); cos(k phi) by the Chebyshev recurrence (rounding ~K^2 1e-16
+// on terms that shrink as g_k / k^2). Narrower detectors: the quadrature below.
+constexpr double kG0SeriesBeta = 0.005;
+double G0_series(double phi, double beta) {
+  const int K = static_cast<int>(std::ceil(8.9 / beta));
+  const double c1 = std::cos(phi);
+  double c_prev = 1.0, c = c1, s = 2.0 / kPi;
+  for (int k = 1; k <= K; ++k) {
+    const double g = std::exp(-0.5 * k * k * beta * beta);
+    s += ((k % 2) ? 4.0 : -4.0) * g / (kPi * (4.0 * k * k - 1.0)) * c;
+    const double c_next = 2.0 * c1 * c - c_prev;
+    c_prev = c;
+    c = c_next;
+  }
+  return 0.25 * s;
+}
+
+// By composite Gauss-Legendre over psi, split at the kinks of |cos(psi/2)|.
+double G0_quadrature(double phi, double beta, double refine) {
   const double a = phi - 8.5 * beta, b = phi + 8.5 * beta;
   std::vector<double> cuts{a};
   // |cos(psi/2)| has kinks at psi = pi + 2 pi k: split there.
@@ -373,6 +443,11 @@ double G0(double phi, double beta, double refine) {
     }
   }
   return s;
+}
+
+double G0(double phi, double beta, double refine) {
+  if (beta < kSmoothBeta) return std::abs(std::cos(0.5 * phi)) * 0.25;
+  return beta >= kG0SeriesBeta ? G0_series(phi, beta) : G0_quadrature(phi, beta, refine);
 }
 
 // One group of orders sharing M_p and the detector: a single p, or (open)
