@@ -620,12 +620,15 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
     const cylinder::Attenuation att(params_.eta, 0.5 * (theta_r - theta_i), params_.sigma_a,
                                     params_.absorption);
     // Wide detectors: deposit through the Fourier series of Eq. 11 (terms up
-    // to g_n < 1e-17) when that is shorter than the erfc window per node.
+    // to g_n < 1e-17) unless it is 64x longer than the erfc window per node
+    // (the same sum either way; measured at 180 phi bins, 3 channels: the
+    // Fourier deposit is 7x faster at beta 3 deg, 4x at 2 deg, 2x at 1 deg,
+    // and 1.6x slower at 0.5 deg, where the erfc window is 4 bins).
     int n_fourier = 0;
     if (t.beta >= kSmoothBeta) {
       const int n_max = static_cast<int>(std::ceil(8.9 / t.beta));
       const double window = 17.0 * t.beta / dphi;
-      if (n_max <= 4.0 * window) n_fourier = n_max;
+      if (n_max <= 64.0 * window) n_fourier = n_max;
     }
     // F_n = sum over nodes of mass e^{-i n Phi}, real and imaginary parts apart
     // (plain arithmetic: std::complex's NaN-checking products are 3x slower).
