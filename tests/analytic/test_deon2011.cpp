@@ -346,15 +346,15 @@ double direct_bin(const ModelParams& m, const BinGrid& grid, int lobe, int p_las
 }  // namespace
 
 TEST(Deon2011, BinsMatchADirectEvaluation) {
-  // The benchmark's configuration (bench_analytic FullPredict: beta_azim 5
-  // deg, which takes the Fourier deposit; published Eq. 12 for R), one
-  // channel, the last lobe's explicit orders capped at 5 (the uniform
-  // remainder after p = 5 carries ~1e-5 here, above the 1e-6 that would stop
-  // earlier, so the model's last order is 5: checked below).
+  // The benchmark's configuration (bench_analytic FullPredict; published
+  // Eq. 12 for R) with beta_azim 5 deg, and 2 deg (both take the Fourier
+  // deposit at 180 phi bins), one channel, the last lobe's explicit orders
+  // capped at 5 (the uniform remainder after p = 5 carries ~1e-5 here, above
+  // the 1e-6 that would stop earlier, so the model's last order is 5:
+  // checked below).
   ModelParams m;
   m.sigma_a = {0.2};
   m.beta_long = {deg_to_rad(5.0), deg_to_rad(2.5), deg_to_rad(10.0)};
-  m.beta_azim = {deg_to_rad(5.0)};
   m.alpha = {deg_to_rad(-6.0), deg_to_rad(3.0), deg_to_rad(12.0), 0.0};
   m.max_order = 5;
   const double ti = deg_to_rad(30.5);
@@ -370,23 +370,26 @@ TEST(Deon2011, BinsMatchADirectEvaluation) {
     ASSERT_GT(res, 1e-6);  // so p = 5 is the model's last explicit order
   }
   const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
-  const auto bins = Deon2011(m).bin_probabilities(grid, ti, 0.0);
   int checked = 0;
-  for (int lobe = 0; lobe < 4; ++lobe) {
-    const double peak = m.alpha[lobe] - ti;  // theta_r of M_p's peak
-    for (int di : {0, 3})
-      for (int j : {20, 60, 88, 100, 140}) {
-        const int i = grid.theta_bin(peak) + di;
-        const double want = direct_bin(m, grid, lobe, 5, ti, i, j);
-        const double got = bins[(static_cast<std::size_t>(lobe) * 90 + i) * 180 + j];
-        // The model's theta_r interpolation (~1e-12 here, measured against
-        // set_refinement(3)), its Fourier truncation (bound 1e-13 per order
-        // and theta_r node) and both sides' quadrature (<< 1e-12) stay far
-        // below 1e-11 absolute; bins here are 1e-6 .. 1e-2. Measured: at
-        // most 1.2e-12.
-        EXPECT_NEAR(got, want, 1e-11) << lobe << " " << i << " " << j;
-        ++checked;
-      }
+  for (double beta_azim : {5.0, 2.0}) {
+    m.beta_azim = {deg_to_rad(beta_azim)};
+    const auto bins = Deon2011(m).bin_probabilities(grid, ti, 0.0);
+    for (int lobe = 0; lobe < 4; ++lobe) {
+      const double peak = m.alpha[lobe] - ti;  // theta_r of M_p's peak
+      for (int di : {0, 3})
+        for (int j : beta_azim == 5.0 ? std::vector<int>{20, 60, 88, 100, 140} : std::vector<int>{45, 95, 125}) {
+          const int i = grid.theta_bin(peak) + di;
+          const double want = direct_bin(m, grid, lobe, 5, ti, i, j);
+          const double got = bins[(static_cast<std::size_t>(lobe) * 90 + i) * 180 + j];
+          // The model's theta_r interpolation (~1e-12 here, measured against
+          // set_refinement(3)), its Fourier truncation (bound 1e-13 per order
+          // and theta_r node) and both sides' quadrature (<< 1e-12) stay far
+          // below 1e-11 absolute; bins here are 1e-6 .. 1e-2. Measured: at
+          // most 1.2e-12.
+          EXPECT_NEAR(got, want, 1e-11) << beta_azim << " " << lobe << " " << i << " " << j;
+          ++checked;
+        }
+    }
   }
-  EXPECT_EQ(checked, 40);
+  EXPECT_EQ(checked, 64);
 }
