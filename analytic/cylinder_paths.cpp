@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 #include "analytic/quadrature.h"
 #include "common/fresnel.h"
@@ -15,14 +16,6 @@ double eta_prime(double eta, double theta) {
   const double s = std::sin(theta);
   const double c = std::max(std::cos(theta), 1e-300);
   return std::sqrt(eta * eta - s * s) / c;
-}
-
-double segment_transmittance(double sigma_a_prime, double cos_gamma_t, Absorption absorption) {
-  // Chord: 2 cos(gamma_t); published (Marschner 2003 s4.3, the garbled "law of
-  // cosines" sentence): 2 (1 + cos 2 gamma_t) = 4 cos^2(gamma_t), not a chord.
-  const double length =
-      absorption == Absorption::Chord ? 2.0 * cos_gamma_t : 4.0 * cos_gamma_t * cos_gamma_t;
-  return std::exp(-sigma_a_prime * length);
 }
 
 double Phi(int p, double gamma_i, double eta_p) {
@@ -42,17 +35,6 @@ double fold_gamma(int p, double eta_p) {
   return std::asin(std::sqrt(std::clamp(s2, 0.0, 1.0)));
 }
 
-namespace {
-// x^n for an integer n >= 0 by repeated squaring (a few multiplications
-// instead of std::pow's exp and log; within ~2 log2(n) ulp).
-double power(double x, int n) {
-  double r = 1.0;
-  for (; n > 0; n >>= 1, x *= x)
-    if (n & 1) r *= x;
-  return r;
-}
-}  // namespace
-
 Attenuation::Attenuation(double eta, double theta, const std::vector<double>& sigma_a,
                          Absorption absorption)
     : eta_(eta), cos_theta_(std::cos(theta)), eta_p_(eta_prime(eta, theta)),
@@ -62,37 +44,14 @@ Attenuation::Attenuation(double eta, double theta, const std::vector<double>& si
   for (double s : sigma_a) sigma_a_prime_.push_back(s / cos_theta_t);
 }
 
-double Attenuation::f(double gamma_i) const {
-  return fresnel_dielectric(std::clamp(cos_theta_ * std::cos(gamma_i), 0.0, 1.0), eta_);
-}
-
-void Attenuation::T(double gamma_i, double* out) const {
-  const double s = std::sin(gamma_i) / eta_p_;
-  const double cos_t = std::sqrt(std::max(0.0, 1.0 - s * s));
-  for (std::size_t c = 0; c < sigma_a_prime_.size(); ++c)
-    out[c] = segment_transmittance(sigma_a_prime_[c], cos_t, absorption_);
-}
-
-void Attenuation::A(int p, double gamma_i, double* out) const {
-  const double fr = f(gamma_i);
-  const int C = channels();
-  if (p == 0) {
-    for (int c = 0; c < C; ++c) out[c] = fr;
-    return;
-  }
-  T(gamma_i, out);
-  const double base = (1.0 - fr) * (1.0 - fr) * power(fr, p - 1);
-  for (int c = 0; c < C; ++c) out[c] = base * power(out[c], p);
-}
-
 void Attenuation::A_beyond(int P, double gamma_i, double* out) const {
   const double fr = f(gamma_i);
   T(gamma_i, out);
-  const double base = (1.0 - fr) * (1.0 - fr) * power(fr, P);
+  const double base = (1.0 - fr) * (1.0 - fr) * integer_power(fr, P);
   for (int c = 0; c < channels(); ++c) {
     const double denom = 1.0 - fr * out[c];
     // f T -> 1 only when f -> 1, where (1 - f)^2 / (1 - f T) -> 0.
-    out[c] = denom > 1e-300 ? base * power(out[c], P + 1) / denom : 0.0;
+    out[c] = denom > 1e-300 ? base * integer_power(out[c], P + 1) / denom : 0.0;
   }
 }
 
@@ -141,9 +100,12 @@ double solve_phi(int p, double eta_p, double e, double a, double b, double phi_a
   return x;
 }
 
+constexpr int kMaxPieceOrder = 64;
+
 void add_piece_nodes(int p, double eta_p, double a, double b, int order, double max_len,
-                     std::vector<PathNode>& out) {
+                     std::vector<PathNode>& out, bool want_phi = true) {
   if (!(b > a)) return;
+  if (order > kMaxPieceOrder) throw std::logic_error("cylinder path nodes: Gauss-Legendre order above 64");
   const int m = std::max(1, static_cast<int>(std::ceil((b - a) / max_len)));
   const double len = (b - a) / m;
   // Short pieces (high orders p cross a bin edge every few 1e-3 rad of
@@ -151,12 +113,18 @@ void add_piece_nodes(int p, double eta_p, double a, double b, int order, double 
   // over their length: fewer points there (error ~ len^(2n), len < 0.005).
   if (len < 0.005) order = std::min(order, 3);
   const GaussLegendre& gl = gauss_legendre(order);
+  // cos and sin of gamma = mid + half x_q by angle addition: one sine and
+  // cosine per panel instead of one per node (to ~1 ulp).
+  const double half = 0.5 * len;
+  double cq[kMaxPieceOrder], sq[kMaxPieceOrder];
+  for (int q = 0; q < order; ++q) cq[q] = std::cos(half * gl.x[q]), sq[q] = std::sin(half * gl.x[q]);
   for (int k = 0; k < m; ++k) {
-    const double c0 = a + k * len;
-    const double half = 0.5 * len, mid = c0 + half;
+    const double mid = a + k * len + half;
+    const double cm = std::cos(mid), sm = std::sin(mid);
     for (int q = 0; q < order; ++q) {
       const double g = mid + half * gl.x[q];
-      out.push_back({g, 0.5 * half * gl.w[q] * std::cos(g), wrap_angle(Phi(p, g, eta_p))});
+      const double cg = cm * cq[q] - sm * sq[q], sg = sm * cq[q] + cm * sq[q];
+      out.push_back({g, 0.5 * half * gl.w[q] * cg, want_phi ? wrap_angle(Phi(p, g, eta_p)) : 0.0, cg, sg});
     }
   }
 }
@@ -187,7 +155,8 @@ void smooth_nodes(int p, double eta_p, int n_phi, int order, std::vector<PathNod
   }
 }
 
-void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out) {
+void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<PathNode>& out,
+                 bool want_phi) {
   out.clear();
   const std::vector<double> br = monotonic_breaks(p, eta_p);
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
@@ -195,7 +164,7 @@ void panel_nodes(int p, double eta_p, double max_dphi, int order, std::vector<Pa
     double slope = std::max(std::abs(dPhi_dgamma(p, a, eta_p)), std::abs(dPhi_dgamma(p, b, eta_p)));
     if (a < 0.0 && b > 0.0) slope = std::max(slope, std::abs(dPhi_dgamma(p, 0.0, eta_p)));
     const double max_len = std::min(kPi / 16, max_dphi / std::max(slope, 1e-12));
-    add_piece_nodes(p, eta_p, a, b, order, max_len, out);
+    add_piece_nodes(p, eta_p, a, b, order, max_len, out, want_phi);
   }
 }
 
