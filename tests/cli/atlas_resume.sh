@@ -142,8 +142,12 @@ fi
 #     its copy of OUT: a signal during a file's write ends at once): exit
 #     143, one line saying so; the checkpoint (removed only after the
 #     report) has every fiber; the resume runs none and writes OUT and the
-#     report again. Skipped when the run ends before the signal.
-FIBERLAB_PYTHON=/usr/bin/python3 interrupt_after_checkpoint n TERM n_report/report_data.h5
+#     report again. Skipped when the run ends before the signal. The signal
+#     goes once atlas_tables.md is written, the last file before the plots
+#     (report_data.h5, the one before, was followed by that file's own
+#     write: a signal landing in it ended the run without its line, once in
+#     a loaded CI run).
+FIBERLAB_PYTHON=/usr/bin/python3 interrupt_after_checkpoint n TERM n_report/atlas_tables.md
 if [ "$got" = 0 ]; then
   echo "skipped (SIGTERM after OUT): the run finished before the signal"
 elif [ "$got" != 143 ] || [ ! -s "$work/n.checkpoint.h5" ] || ! tail -n 1 "$work/n.err" | grep -qx \
