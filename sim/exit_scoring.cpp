@@ -60,9 +60,12 @@ void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, s
     Batch::batch_bool_type in_range;
     const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
     settled_bin(phi, (phi + Batch(kPi)) / Batch(kTwoPi), n_phi, grid_.phi_edges).store_aligned(phi_bin + i);
+    // Lanes out of the vector wrap's range take the scalar one. Photons that
+    // did not exit (truncated) have no direction (NaN): their bins are never
+    // read, and a NaN must not reach phi_bin's conversion to int.
     if (!xsimd::all(in_range))
       for (int k = i; k < std::min(i + W, f.n); ++k)
-        phi_bin[k] = grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k]));
+        phi_bin[k] = f.exited[k] ? grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k])) : 0;
   }
 }
 
