@@ -8,6 +8,7 @@
 #include <string>
 
 #include <fmt/core.h>
+#include <xsimd/xsimd.hpp>
 
 #include "analytic/cylinder_paths.h"
 #include "analytic/model_registry.h"
@@ -230,6 +231,8 @@ double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prim
 
 Projection project(double eta, double theta, bool exact_roots, Absorption absorption) {
   Projection proj;
+  proj.eta = eta;
+  proj.theta = theta;
   proj.eta_p = eta_prime(eta, theta);
   proj.eta_pp = eta_double_prime(eta, theta);
   const double s = std::sin(theta) / eta;
@@ -341,6 +344,68 @@ void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_
   }
 }
 
+namespace {
+
+// gamma_i in [a, b] where a phi function monotonic on [a, b] (values fa, fb
+// at the ends) crosses `target`: Newton safeguarded by bisection. It stops
+// when a step is below 1e-13 rad: Newton's next step would be ~1e-26 /
+// |phi'| (quadratic convergence), while phi near 2 pi carries a rounding
+// error of ~1e-15, so a tighter stop only makes the iterate wander inside
+// the rounding (the version before asked for 1e-15 and ran its 100 steps at
+// most crossings: half of predict's time).
+template <class PhiOf, class SlopeOf>
+double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, double a, double b, double fa,
+                double fb) {
+  const bool increasing = fb > fa;
+  double x0 = a, x1 = b, x = a + (b - a) * (target - fa) / (fb - fa);
+  for (int it = 0; it < 100 && x1 - x0 > 1e-15; ++it) {
+    const double r = phi_of(x) - target;
+    if (r == 0.0) return x;
+    if ((r < 0.0) == increasing) x0 = x; else x1 = x;
+    const double d = slope_of(x);
+    double xn = d != 0.0 ? x - r / d : 0.5 * (x0 + x1);
+    if (!(xn > x0 && xn < x1)) xn = 0.5 * (x0 + x1);
+    if (std::abs(xn - x) < 1e-13) return xn;
+    x = xn;
+  }
+  return x;
+}
+
+// Adds weight * A(p, h) of every node to its phi bin: bins[bin[k] * C + c].
+// A (section 4.3, Appendix B) from the shared cylinder::Attenuation:
+// Appendix B's F(eta', eta'', gamma) is the 3D Fresnel reflectance at
+// cos(i) = cos(theta_d) cos(gamma) (test BravaisFresnelEqualsThreeDimensionalFresnel),
+// and leaving the fiber F(1/eta', 1/eta'', gamma_t) is the same number
+// (the reflectance of a dielectric interface is the same from both sides),
+// so A(p, h) = (1 - f)^2 f^(p-1) T^p with one f. Eight nodes per SIMD
+// batch (xsimd), the remainder one by one.
+void add_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
+               const std::vector<int>& bin, std::vector<double>& bins) {
+  using Batch = xsimd::batch<double>;
+  constexpr std::size_t W = Batch::size;
+  const int C = att.channels();
+  std::vector<Batch> mass_b(C);
+  alignas(64) double ci[W], si[W], w[W], mass[W];
+  std::size_t k = 0;
+  for (; k + W <= nodes.size(); k += W) {
+    for (std::size_t l = 0; l < W; ++l)
+      ci[l] = nodes[k + l].cos_gamma, si[l] = nodes[k + l].sin_gamma, w[l] = nodes[k + l].weight;
+    att.A(p, Batch::load_aligned(ci), Batch::load_aligned(si), mass_b.data());
+    const Batch wb = Batch::load_aligned(w);
+    for (int c = 0; c < C; ++c) {
+      (wb * mass_b[c]).store_aligned(mass);
+      for (std::size_t l = 0; l < W; ++l) bins[static_cast<std::size_t>(bin[k + l]) * C + c] += mass[l];
+    }
+  }
+  std::vector<double> a(C);
+  for (; k < nodes.size(); ++k) {
+    att.A(p, nodes[k].cos_gamma, nodes[k].sin_gamma, a.data());
+    for (int c = 0; c < C; ++c) bins[static_cast<std::size_t>(bin[k]) * C + c] += nodes[k].weight * a[c];
+  }
+}
+
+}  // namespace
+
 void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
               const CausticParams* cp, int n_phi, std::vector<double>& out) {
   const std::size_t C = sigma_a.size();
@@ -353,87 +418,52 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
     return proj.exact_roots ? Phi(p, x, e) : b1 * x - b3 * x * x * x + p * kPi;
   };
   auto slope_of = [&](double x) { return proj.exact_roots ? dPhi_dgamma(p, x, e) : b1 - d3 * x * x; };
-  std::vector<double> sigma_prime(C);
-  for (std::size_t ch = 0; ch < C; ++ch) sigma_prime[ch] = sigma_a[ch] / proj.cos_theta_t;
   // Monotonic pieces: split at the fold (dphi/dgamma = 0), if any.
   double fold = -1.0;
   if (proj.exact_roots) {
     fold = cylinder::fold_gamma(p, e);
   } else if (p >= 1) {
-    const double c = c_of(e), B = 6.0 * p * c / kPi - 2.0, C3 = 24.0 * p * c / kPi3;
-    if (B > 0.0 && std::sqrt(B / C3) < half_pi) fold = std::sqrt(B / C3);
+    if (b1 > 0.0 && std::sqrt(b1 / d3) < half_pi) fold = std::sqrt(b1 / d3);
   }
   std::vector<double> br = fold > 0.0 && fold < half_pi ? std::vector<double>{-half_pi, -fold, fold, half_pi}
                                                          : std::vector<double>{-half_pi, half_pi};
   const bool glints = p == 2 && cp && cp->w_c > 0.0;
   const Glint gl = glints ? glint_of(proj, *cp) : Glint{};
-  std::vector<double> cuts, tr(C);
+  // Quadrature nodes over gamma_i: each piece between consecutive crossings
+  // of a bin edge exits into one bin and carries a smooth integrand; long
+  // pieces in panels of at most pi/64, 5 points per panel (3 on panels
+  // shorter than 0.005 rad: one bin's worth of h).
+  static thread_local std::vector<cylinder::PathNode> nodes;
+  static thread_local std::vector<int> node_bin;
+  static thread_local std::vector<double> cuts;
+  nodes.clear();
+  node_bin.clear();
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
     const double a = br[k], b = br[k + 1];
     const double fa = phi_of(a), fb = phi_of(b);
     const double lo = std::min(fa, fb), hi = std::max(fa, fb);
-    const bool increasing = fb > fa;
     cuts.assign(1, a);
     for (long m = static_cast<long>(std::ceil((lo + kPi) / delta)); -kPi + m * delta < hi; ++m) {
       const double target = -kPi + m * delta;
-      if (target <= lo) continue;
-      // Bisection safeguarded Newton on the monotonic piece.
-      double x0 = a, x1 = b, x = a + (b - a) * (target - fa) / (fb - fa);
-      for (int it = 0; it < 100 && x1 - x0 > 1e-15; ++it) {
-        const double r = phi_of(x) - target;
-        if ((r < 0.0) == increasing) x0 = x; else x1 = x;
-        const double d = slope_of(x);
-        double xn = d != 0.0 ? x - r / d : 0.5 * (x0 + x1);
-        if (!(xn > x0 && xn < x1)) xn = 0.5 * (x0 + x1);
-        if (std::abs(xn - x) < 1e-15) { x = xn; break; }
-        x = xn;
-      }
-      cuts.push_back(x);
+      if (target > lo) cuts.push_back(crossing(phi_of, slope_of, target, a, b, fa, fb));
     }
     cuts.push_back(b);
     std::sort(cuts.begin(), cuts.end());
     for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
-      const double len = cuts[q + 1] - cuts[q];
-      if (!(len > 0.0)) continue;
-      // Long pieces in panels of at most pi/64; short ones (most, one bin's
-      // worth of h) need few points: the integrand is smooth on each.
-      const int panels = std::max(1, static_cast<int>(std::ceil(len / (kPi / 64))));
-      const int order = len / panels < 0.005 ? 3 : 5;
-      const GaussLegendre& rule = gauss_legendre(order);
-      const double plen = len / panels;
-      for (int pn = 0; pn < panels; ++pn) {
-        const double mid = cuts[q] + (pn + 0.5) * plen;
-        for (int n = 0; n < order; ++n) {
-          const double x = mid + 0.5 * plen * rule.x[n];
-          const double sin_x = std::sin(x), cos_x = std::cos(x);  // cos > 0 inside the pieces
-          const double w = 0.25 * plen * rule.w[n] * cos_x;  // (1/2) dh = (1/2) cos(gamma) dgamma
-          const double ph = wrap_angle(phi_of(x));
-          const int j = std::clamp(static_cast<int>(std::floor((ph + kPi) / delta)), 0, n_phi - 1);
-          // A(p, h) (section 4.3): Fresnel and gamma_t once for every channel;
-          // gamma_t = asin(h / eta') through its sine and cosine only.
-          const double f_in = F_of(e, proj.eta_pp, sin_x, cos_x);
-          double base = f_in, cos_t = 0.0;
-          if (p > 0) {
-            const double sin_t = sin_x / e;
-            cos_t = std::sqrt(1.0 - sin_t * sin_t);
-            const double f_out = F_of(1.0 / e, 1.0 / proj.eta_pp, sin_t, cos_t);
-            base = (1.0 - f_in) * (1.0 - f_in);
-            for (int k = 1; k < p; ++k) base *= f_out;
-          }
-          if (glints) base *= caustic_removal(gl, *cp, ph);
-          double* bin = &out[static_cast<std::size_t>(j) * C];
-          for (std::size_t ch = 0; ch < C; ++ch) {
-            double t = 1.0;
-            if (p > 0) {
-              const double t1 = cylinder::segment_transmittance(sigma_prime[ch], cos_t, proj.absorption);
-              for (int k = 0; k < p; ++k) t *= t1;
-            }
-            bin[ch] += w * base * t;
-          }
-        }
-      }
+      const std::size_t first = nodes.size();
+      cylinder::piece_nodes(cuts[q], cuts[q + 1], 5, kPi / 64, nodes);
+      if (nodes.size() == first) continue;
+      // The piece's bin, from its middle (every node of it exits there).
+      const int j = cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi);
+      node_bin.resize(nodes.size(), j);
+      // Section 5.2.2: the caustic's removal factor at each node's phi.
+      if (glints)
+        for (std::size_t n = first; n < nodes.size(); ++n)
+          nodes[n].weight *= caustic_removal(gl, *cp, wrap_angle(phi_of(nodes[n].gamma)));
     }
   }
+  const cylinder::Attenuation att(proj.eta, proj.theta, sigma_a, proj.absorption);
+  add_nodes(att, p, nodes, node_bin, out);
   if (!glints || gl.t == 0.0) return;
   // The glints: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their bin masses in
   // closed form (images 2 pi away included; N_TRT wraps phi - phi_c).

@@ -121,6 +121,8 @@ double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prim
 // The 2D problem N is solved in: the Bravais indices at theta_d, cos(theta_t)
 // for sigma_a' and the solver choices.
 struct Projection {
+  double eta = 1.55;     // the index the projection was made with
+  double theta = 0.0;    // the inclination theta_d
   double eta_p = 1.55;   // eta'(eta, theta_d)
   double eta_pp = 1.55;  // eta''(eta, theta_d)
   double cos_theta_t = 1.0;  // sin(theta_t) = sin(theta_d) / eta
