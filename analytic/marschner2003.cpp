@@ -447,8 +447,10 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
       const double target = -kPi + m * delta;
       if (target > lo) cuts.push_back(crossing(phi_of, slope_of, target, a, b, fa, fb));
     }
+    // The targets ascend, so the crossings ascend in gamma where phi
+    // increases and descend where it decreases.
+    if (fb < fa) std::reverse(cuts.begin() + 1, cuts.end());
     cuts.push_back(b);
-    std::sort(cuts.begin(), cuts.end());
     for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
       const std::size_t first = nodes.size();
       cylinder::piece_nodes(cuts[q], cuts[q + 1], 5, kPi / 64, nodes);
