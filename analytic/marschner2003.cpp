@@ -576,13 +576,19 @@ class Marschner2003 final : public Model {
   // The default per-bin 6 x 6 Gauss-Legendre rule cannot see a Gaussian M of
   // beta = 0.1 deg inside a 2 deg bin, nor the 1/sqrt caustics of N_TRT. Here:
   // theta_r is split at the bin edges and every beta/2 (in theta_r) over
-  // +-8 standard deviations around each lobe's centre -theta_i + alpha[p];
-  // phi is split at the bin edges, every min(2 deg, w_c/2), and (for the
-  // unsmoothed TRT of a circular fiber) at the caustics +-phi_c(theta_d) of
-  // the phi function in use; each piece gets a 4-point Gauss-Legendre rule,
-  // in phi after x = a + (b-a)(1 - cos(pi u))/2, which makes a 1/sqrt
-  // singularity at a piece end smooth. With eccentricity != 1 and w_c == 0 the
-  // caustics move with phi_h and are not split at (integrable, less accurate).
+  // +-8 standard deviations around each lobe's centre -theta_i + alpha[p],
+  // 4 Gauss-Legendre points per piece; M_p and the geometry factor of Eq. 9
+  // once per theta_r node. N's phi-bin integrals, where N depends on theta_d
+  // only (a circular fiber; R and TT of any fiber): exact integrals over h
+  // (N_p_bins), for R and TT interpolated in theta_r between exact
+  // evaluations (add_interpolated), for TRT (caustics that cross bin edges
+  // make its bins kink in theta_r) at every node. Where N_TRT depends on phi
+  // itself (eccentricity, section 5.2.3): density() at points in phi, split at
+  // the bin edges and every min(2 deg, w_c/2); each piece gets a 4-point
+  // Gauss-Legendre rule in u after phi = a + (b-a)(1 - cos(pi u))/2, which
+  // makes a 1/sqrt singularity at a piece end smooth. With w_c == 0 the
+  // caustics move with phi_h and are not split at (integrable, less
+  // accurate).
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
                                         double phi_i) const override {
     const int nt = grid.n_theta(), np = grid.n_phi(), L = params_.lobes;
@@ -610,8 +616,10 @@ class Marschner2003 final : public Model {
       }
       std::sort(tk.begin(), tk.end());
       tk.erase(std::unique(tk.begin(), tk.end()), tk.end());
-      const bool split_caustic = p_lo <= 2 && p_hi >= 2 && !(params_.w_c > 0.0) &&
-                                 params_.eccentricity == 1.0;
+      // Eccentricity changes N_TRT only (section 5.2.3: eta* "to the code
+      // that computes N_TRT"): a lobe without p = 2 takes the circular
+      // fiber's phi-bin integrals over h whatever the eccentricity.
+      const bool by_h = params_.eccentricity == 1.0 || p_hi < 2;
       std::vector<ThetaPoint> points[3];  // per order p: theta_r nodes of the circular fiber
       for (std::size_t s = 0; s + 1 < tk.size(); ++s) {
         const double t0 = tk[s], t1 = tk[s + 1];
@@ -632,7 +640,7 @@ class Marschner2003 final : public Model {
             negligible = M < 1e-13 * m3::g(beta, 0.0);
           }
           if (negligible) continue;
-          if (params_.eccentricity == 1.0) {
+          if (by_h) {
             // Circular fiber: N depends on theta_d only; M and the geometry
             // factor once per theta_r node, N's phi-bin integrals either
             // interpolated (below, after the nodes) or exact per node.
@@ -656,32 +664,19 @@ class Marschner2003 final : public Model {
             }
             continue;
           }
-          std::vector<double> caustics;
-          if (split_caustic) {
-            const m3::Caustic c = m3::caustic(m3::project(params_.eta, 0.5 * (tr - theta_i),
-                                                          params_.exact_roots,
-                                                          params_.absorption));
-            if (c.exists) caustics = {-c.phi_c, c.phi_c};
-          }
           for (int j = 0; j < np; ++j) {
             const double f0 = grid.phi_edges[j], f1 = grid.phi_edges[j + 1];
-            std::vector<double> fk{f0, f1};
-            for (double c : caustics)
-              if (c > f0 && c < f1) fk.push_back(c);
-            std::sort(fk.begin(), fk.end());
             double* bin = &out[((static_cast<std::size_t>(lobe) * nt + i) * np + j) * C];
-            for (std::size_t q = 0; q + 1 < fk.size(); ++q) {
-              const int n_sub = std::max(1, static_cast<int>(std::ceil((fk[q + 1] - fk[q]) / phi_step)));
-              const double width = (fk[q + 1] - fk[q]) / n_sub;
-              for (int sub = 0; sub < n_sub; ++sub) {
-                const double lo = fk[q] + sub * width;
-                for (int b = 0; b < 4; ++b) {
-                  const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
-                  const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
-                  const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
-                  density(lobe, theta_i, phi_i, tr, ph, value);
-                  for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
-                }
+            const int n_sub = std::max(1, static_cast<int>(std::ceil((f1 - f0) / phi_step)));
+            const double width = (f1 - f0) / n_sub;
+            for (int sub = 0; sub < n_sub; ++sub) {
+              const double lo = f0 + sub * width;
+              for (int b = 0; b < 4; ++b) {
+                const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
+                const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
+                const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
+                density(lobe, theta_i, phi_i, tr, ph, value);
+                for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
               }
             }
           }

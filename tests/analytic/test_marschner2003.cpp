@@ -764,6 +764,7 @@ TEST(Marschner2003, BinsMatchADirectEvaluation) {
   // standard deviations either side of each order's centre), of
   // M_p cos^2(theta_r) / cos^2(theta_d) (Eq. 9, SPEC s7) times
   // direct_phi_bins at theta_d; all 180 phi bins of two theta bins per lobe.
+  // Also R and TT of an eccentric fiber (a = 0.9).
   ModelParams params;
   params.eta = kEta;
   params.sigma_a = {0.2, 0.4, 0.8};
@@ -774,6 +775,10 @@ TEST(Marschner2003, BinsMatchADirectEvaluation) {
   const std::size_t C = 3, row = 180 * C;
   const std::vector<double> fast = make_marschner2003(params)->bin_probabilities(grid, ti, 0.0);
   const std::vector<double> per_node = make_marschner2003_reference(params)->bin_probabilities(grid, ti, 0.0);
+  // Eccentricity changes N_TRT only (section 5.2.3): R and TT of an
+  // eccentric fiber are the circle's.
+  params.eccentricity = 0.9;
+  const std::vector<double> eccentric = make_marschner2003(params)->bin_probabilities(grid, ti, 0.0);
   const GaussLegendre& gl = gauss_legendre(4);
   int checked = 0;
   for (int p = 0; p < 3; ++p) {
@@ -808,6 +813,9 @@ TEST(Marschner2003, BinsMatchADirectEvaluation) {
         // theta_r (2e-7 of the lobe's largest bin at worst over the cases of
         // InterpolatedThetaMatchesPerNodeReference; measured here: 1e-9).
         EXPECT_NEAR(fast[k], want[x], (p < 2 ? 1e-8 : 1e-12) * largest) << p << " " << i << " " << x;
+        if (p < 2) {
+          EXPECT_NEAR(eccentric[k], want[x], 1e-8 * largest) << p << " " << i << " " << x;
+        }
         ++checked;
       }
     }
