@@ -317,11 +317,25 @@ Glint glint_of(const Projection& proj, const CausticParams& cp) {
   return gl;
 }
 
-// The factor that removes the caustic from N_TRT at exit angle phi.
-double caustic_removal(const Glint& gl, const CausticParams& cp, double phi) {
-  const double g0 = g(cp.w_c, 0.0);
-  const double x_minus = wrap_angle(phi - gl.phi_c), x_plus = wrap_angle(phi + gl.phi_c);
-  return (1.0 - gl.t * g(cp.w_c, x_minus) / g0) * (1.0 - gl.t * g(cp.w_c, x_plus) / g0);
+// x wrapped to [-pi, pi) (up to rounding at the ends), for any number type.
+template <class N>
+N wrap_pi(N x) {
+  using std::floor;
+  return x - N(kTwoPi) * floor((x + N(kPi)) * N(1.0 / kTwoPi));
+}
+
+// The factor that removes the caustic from N_TRT at exit angle phi (section
+// 5.2.2): (1 - t g(w_c; phi - phi_c) / g(w_c; 0)) (1 - t g(w_c; phi + phi_c) /
+// g(w_c; 0)), the differences wrapped to [-pi, pi). Generic over the number
+// type: a double, or an xsimd batch of exit angles (exp and floor found by
+// argument-dependent lookup).
+template <class N>
+N caustic_removal(const Glint& gl, const CausticParams& cp, N phi) {
+  using std::exp;
+  const N x_minus = wrap_pi(phi - N(gl.phi_c)) * N(1.0 / cp.w_c);
+  const N x_plus = wrap_pi(phi + N(gl.phi_c)) * N(1.0 / cp.w_c);
+  return (N(1.0) - N(gl.t) * exp(N(-0.5) * x_minus * x_minus)) *
+         (N(1.0) - N(gl.t) * exp(N(-0.5) * x_plus * x_plus));
 }
 
 }  // namespace
@@ -371,7 +385,9 @@ double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, dou
   return x;
 }
 
-// Adds weight * A(p, h) of every node to its phi bin: bins[bin[k] * C + c].
+// Adds weight * A(p, h) of every node to its phi bin: bins[bin[k] * C + c];
+// with a glint (section 5.2.2) also times the caustic's removal factor at the
+// node's exit angle (PathNode::phi, unwrapped).
 // A (section 4.3, Appendix B) from the shared cylinder::Attenuation:
 // Appendix B's F(eta', eta'', gamma) is the 3D Fresnel reflectance at
 // cos(i) = cos(theta_d) cos(gamma) (test BravaisFresnelEqualsThreeDimensionalFresnel),
@@ -380,18 +396,22 @@ double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, dou
 // so A(p, h) = (1 - f)^2 f^(p-1) T^p with one f. Eight nodes per SIMD
 // batch (xsimd), the remainder one by one.
 void add_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
-               const std::vector<int>& bin, std::vector<double>& bins) {
+               const std::vector<int>& bin, const Glint* glint, const CausticParams* cp,
+               std::vector<double>& bins) {
   using Batch = xsimd::batch<double>;
   constexpr std::size_t W = Batch::size;
   const int C = att.channels();
   std::vector<Batch> mass_b(C);
-  alignas(64) double ci[W], si[W], w[W], mass[W];
+  alignas(64) double ci[W], si[W], w[W], ph[W], mass[W];
   std::size_t k = 0;
   for (; k + W <= nodes.size(); k += W) {
-    for (std::size_t l = 0; l < W; ++l)
-      ci[l] = nodes[k + l].cos_gamma, si[l] = nodes[k + l].sin_gamma, w[l] = nodes[k + l].weight;
+    for (std::size_t l = 0; l < W; ++l) {
+      const cylinder::PathNode& nd = nodes[k + l];
+      ci[l] = nd.cos_gamma, si[l] = nd.sin_gamma, w[l] = nd.weight, ph[l] = nd.phi;
+    }
     att.A(p, Batch::load_aligned(ci), Batch::load_aligned(si), mass_b.data());
-    const Batch wb = Batch::load_aligned(w);
+    Batch wb = Batch::load_aligned(w);
+    if (glint) wb *= caustic_removal(*glint, *cp, Batch::load_aligned(ph));
     for (int c = 0; c < C; ++c) {
       (wb * mass_b[c]).store_aligned(mass);
       for (std::size_t l = 0; l < W; ++l) bins[static_cast<std::size_t>(bin[k + l]) * C + c] += mass[l];
@@ -400,7 +420,8 @@ void add_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylind
   std::vector<double> a(C);
   for (; k < nodes.size(); ++k) {
     att.A(p, nodes[k].cos_gamma, nodes[k].sin_gamma, a.data());
-    for (int c = 0; c < C; ++c) bins[static_cast<std::size_t>(bin[k]) * C + c] += nodes[k].weight * a[c];
+    const double wk = nodes[k].weight * (glint ? caustic_removal(*glint, *cp, nodes[k].phi) : 1.0);
+    for (int c = 0; c < C; ++c) bins[static_cast<std::size_t>(bin[k]) * C + c] += wk * a[c];
   }
 }
 
@@ -458,29 +479,27 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
       // The piece's bin, from its middle (every node of it exits there).
       const int j = cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi);
       node_bin.resize(nodes.size(), j);
-      // Section 5.2.2: the caustic's removal factor at each node's phi.
+      // Section 5.2.2: the caustic's removal factor needs each node's phi.
       if (glints)
-        for (std::size_t n = first; n < nodes.size(); ++n)
-          nodes[n].weight *= caustic_removal(gl, *cp, wrap_angle(phi_of(nodes[n].gamma)));
+        for (std::size_t n = first; n < nodes.size(); ++n) nodes[n].phi = phi_of(nodes[n].gamma);
     }
   }
   const cylinder::Attenuation att(proj.eta, proj.theta, sigma_a, proj.absorption);
-  add_nodes(att, p, nodes, node_bin, out);
+  add_nodes(att, p, nodes, node_bin, glints && gl.t != 0.0 ? &gl : nullptr, cp, out);
   if (!glints || gl.t == 0.0) return;
   // The glints: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their bin masses in
-  // closed form (images 2 pi away included; N_TRT wraps phi - phi_c).
+  // closed form (images 2 pi away included; N_TRT wraps phi - phi_c), the
+  // same for every channel.
+  std::vector<double> edges(n_phi + 1), mass(n_phi, 0.0);
+  for (int j = 0; j <= n_phi; ++j) edges[j] = -kPi + j * delta;
+  for (int img = -1; img <= 1; ++img) {
+    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp->w_c, mass.data());
+    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp->w_c, mass.data());
+  }
   for (std::size_t ch = 0; ch < C; ++ch) {
     const double a2 = A(2, gl.gamma_c, e, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
     const double scale = gl.t * cp->k_g * a2 * gl.dh;
-    if (scale == 0.0) continue;
-    for (int j = 0; j < n_phi; ++j) {
-      const double e0 = -kPi + j * delta, e1 = e0 + delta;
-      double mass = 0.0;
-      for (int img = -1; img <= 1; ++img)
-        mass += gaussian_interval_mass(e0, e1, gl.phi_c + kTwoPi * img, cp->w_c) +
-                gaussian_interval_mass(e0, e1, -gl.phi_c + kTwoPi * img, cp->w_c);
-      out[static_cast<std::size_t>(j) * C + ch] += scale * mass;
-    }
+    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * mass[j];
   }
 }
 
