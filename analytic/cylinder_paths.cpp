@@ -76,19 +76,32 @@ constexpr int kMaxPieceOrder = 64;
 
 void piece_nodes(double a, double b, int order, double max_len, std::vector<PathNode>& out) {
   if (!(b > a)) return;
-  if (order > kMaxPieceOrder) throw std::logic_error("cylinder path nodes: Gauss-Legendre order above 64");
+  if (order < 1 || order > kMaxPieceOrder)
+    throw std::logic_error("cylinder path nodes: Gauss-Legendre order outside 1..64");
   const int m = std::max(1, static_cast<int>(std::ceil((b - a) / max_len)));
   const double len = (b - a) / m;
   // Short pieces (high orders p cross a bin edge every few 1e-3 rad of
   // gamma) carry an integrand that is a low-degree polynomial to rounding
   // over their length: fewer points there (error ~ len^(2n), len < 0.005).
   if (len < 0.005) order = std::min(order, 3);
-  const GaussLegendre& gl = gauss_legendre(order);
+  // gauss_legendre() takes a lock; its rules never move once made, so each
+  // thread keeps pointers to them (this runs once per piece: ~10^5 times per
+  // Marschner 2003 prediction).
+  static thread_local const GaussLegendre* rules[kMaxPieceOrder + 1] = {};
+  if (!rules[order]) rules[order] = &gauss_legendre(order);
+  const GaussLegendre& gl = *rules[order];
   // cos and sin of gamma = mid + half x_q by angle addition: one sine and
-  // cosine per panel instead of one per node (to ~1 ulp).
+  // cosine per panel instead of one per node (to ~1 ulp). Those of half x_q
+  // for half of the nodes only: the rule is symmetric (x_{n-1-q} = -x_q and
+  // the middle node 0, exactly), cos even and sin odd (exactly, in libm too).
   const double half = 0.5 * len;
   double cq[kMaxPieceOrder], sq[kMaxPieceOrder];
-  for (int q = 0; q < order; ++q) cq[q] = std::cos(half * gl.x[q]), sq[q] = std::sin(half * gl.x[q]);
+  for (int q = 0; q < order; ++q) {
+    const int mirror = order - 1 - q;
+    if (mirror == q) cq[q] = 1.0, sq[q] = 0.0;
+    else if (mirror < q) cq[q] = cq[mirror], sq[q] = -sq[mirror];
+    else cq[q] = std::cos(half * gl.x[q]), sq[q] = std::sin(half * gl.x[q]);
+  }
   for (int k = 0; k < m; ++k) {
     const double mid = a + k * len + half;
     const double cm = std::cos(mid), sm = std::sin(mid);
