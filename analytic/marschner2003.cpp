@@ -367,11 +367,12 @@ namespace {
 // error of ~1e-15, so a tighter stop only makes the iterate wander inside
 // the rounding (the version before asked for 1e-15 and ran its 100 steps at
 // most crossings: half of predict's time).
+// `guess` is used where it lies inside (a, b); else linear interpolation.
 template <class PhiOf, class SlopeOf>
 double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, double a, double b, double fa,
-                double fb) {
+                double fb, double guess) {
   const bool increasing = fb > fa;
-  double x0 = a, x1 = b, x = a + (b - a) * (target - fa) / (fb - fa);
+  double x0 = a, x1 = b, x = guess > a && guess < b ? guess : a + (b - a) * (target - fa) / (fb - fa);
   for (int it = 0; it < 100 && x1 - x0 > 1e-15; ++it) {
     const double r = phi_of(x) - target;
     if (r == 0.0) return x;
@@ -385,8 +386,8 @@ double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, dou
   return x;
 }
 
-// Adds weight * A(p, h) of every node to its phi bin: bins[bin[k] * C + c];
-// with a glint (section 5.2.2) also times the caustic's removal factor at the
+// Per node k (of n): weight * A(p, h) per channel c, out[c * n + k]; with
+// a glint (section 5.2.2) also times the caustic's removal factor at the
 // node's exit angle (PathNode::phi, unwrapped).
 // A (section 4.3, Appendix B) from the shared cylinder::Attenuation:
 // Appendix B's F(eta', eta'', gamma) is the 3D Fresnel reflectance at
@@ -395,16 +396,17 @@ double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, dou
 // (the reflectance of a dielectric interface is the same from both sides),
 // so A(p, h) = (1 - f)^2 f^(p-1) T^p with one f. Eight nodes per SIMD
 // batch (xsimd), the remainder one by one.
-void add_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
-               const std::vector<int>& bin, const Glint* glint, const CausticParams* cp,
-               std::vector<double>& bins) {
+void node_masses(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
+                 const Glint* glint, const CausticParams* cp, std::vector<double>& out) {
   using Batch = xsimd::batch<double>;
   constexpr std::size_t W = Batch::size;
   const int C = att.channels();
+  const std::size_t n = nodes.size();
+  out.resize(C * n);
   std::vector<Batch> mass_b(C);
-  alignas(64) double ci[W], si[W], w[W], ph[W], mass[W];
+  alignas(64) double ci[W], si[W], w[W], ph[W];
   std::size_t k = 0;
-  for (; k + W <= nodes.size(); k += W) {
+  for (; k + W <= n; k += W) {
     for (std::size_t l = 0; l < W; ++l) {
       const cylinder::PathNode& nd = nodes[k + l];
       ci[l] = nd.cos_gamma, si[l] = nd.sin_gamma, w[l] = nd.weight, ph[l] = nd.phi;
@@ -412,16 +414,13 @@ void add_nodes(const cylinder::Attenuation& att, int p, const std::vector<cylind
     att.A(p, Batch::load_aligned(ci), Batch::load_aligned(si), mass_b.data());
     Batch wb = Batch::load_aligned(w);
     if (glint) wb *= caustic_removal(*glint, *cp, Batch::load_aligned(ph));
-    for (int c = 0; c < C; ++c) {
-      (wb * mass_b[c]).store_aligned(mass);
-      for (std::size_t l = 0; l < W; ++l) bins[static_cast<std::size_t>(bin[k + l]) * C + c] += mass[l];
-    }
+    for (int c = 0; c < C; ++c) (wb * mass_b[c]).store_unaligned(&out[c * n + k]);
   }
   std::vector<double> a(C);
-  for (; k < nodes.size(); ++k) {
+  for (; k < n; ++k) {
     att.A(p, nodes[k].cos_gamma, nodes[k].sin_gamma, a.data());
     const double wk = nodes[k].weight * (glint ? caustic_removal(*glint, *cp, nodes[k].phi) : 1.0);
-    for (int c = 0; c < C; ++c) bins[static_cast<std::size_t>(bin[k]) * C + c] += wk * a[c];
+    for (int c = 0; c < C; ++c) out[c * n + k] = wk * a[c];
   }
 }
 
@@ -454,52 +453,75 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
   // of a bin edge exits into one bin and carries a smooth integrand; long
   // pieces in panels of at most pi/64, 5 points per panel (3 on panels
   // shorter than 0.005 rad: one bin's worth of h).
+  struct Piece {
+    std::size_t end;  // one past its last node
+    int bin;          // the phi bin every node of it exits into
+  };
   static thread_local std::vector<cylinder::PathNode> nodes;
-  static thread_local std::vector<int> node_bin;
-  static thread_local std::vector<double> cuts;
+  static thread_local std::vector<Piece> pieces;
+  static thread_local std::vector<double> cuts, mass;
   nodes.clear();
-  node_bin.clear();
+  pieces.clear();
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
     const double a = br[k], b = br[k + 1];
     const double fa = phi_of(a), fb = phi_of(b);
     const double lo = std::min(fa, fb), hi = std::max(fa, fb);
+    const bool increasing = fb > fa;
+    // The targets ascend, so the crossings ascend in gamma from a where phi
+    // increases and descend from b where it decreases: each is bracketed by
+    // the one before and the piece's far end, and Newton starts from a
+    // Newton step off the one before.
+    double prev = increasing ? a : b, f_prev = increasing ? fa : fb;
     cuts.assign(1, a);
     for (long m = static_cast<long>(std::ceil((lo + kPi) / delta)); -kPi + m * delta < hi; ++m) {
       const double target = -kPi + m * delta;
-      if (target > lo) cuts.push_back(crossing(phi_of, slope_of, target, a, b, fa, fb));
+      if (!(target > lo)) continue;
+      const double slope = slope_of(prev);
+      const double guess = slope != 0.0 ? prev + (target - f_prev) / slope : prev;
+      prev = increasing ? crossing(phi_of, slope_of, target, prev, b, f_prev, fb, guess)
+                        : crossing(phi_of, slope_of, target, a, prev, fa, f_prev, guess);
+      f_prev = target;
+      cuts.push_back(prev);
     }
-    // The targets ascend, so the crossings ascend in gamma where phi
-    // increases and descend where it decreases.
-    if (fb < fa) std::reverse(cuts.begin() + 1, cuts.end());
+    if (!increasing) std::reverse(cuts.begin() + 1, cuts.end());
     cuts.push_back(b);
     for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
       const std::size_t first = nodes.size();
       cylinder::piece_nodes(cuts[q], cuts[q + 1], 5, kPi / 64, nodes);
       if (nodes.size() == first) continue;
-      // The piece's bin, from its middle (every node of it exits there).
-      const int j = cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi);
-      node_bin.resize(nodes.size(), j);
+      // The piece's bin, from its middle.
+      pieces.push_back({nodes.size(), cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi)});
       // Section 5.2.2: the caustic's removal factor needs each node's phi.
       if (glints)
         for (std::size_t n = first; n < nodes.size(); ++n) nodes[n].phi = phi_of(nodes[n].gamma);
     }
   }
   const cylinder::Attenuation att(proj.eta, proj.theta, sigma_a, proj.absorption);
-  add_nodes(att, p, nodes, node_bin, glints && gl.t != 0.0 ? &gl : nullptr, cp, out);
+  node_masses(att, p, nodes, glints && gl.t != 0.0 ? &gl : nullptr, cp, mass);
+  // Each piece's sum into its bin.
+  const std::size_t n = nodes.size();
+  for (std::size_t c = 0; c < C; ++c) {
+    std::size_t k = 0;
+    for (const Piece& pc : pieces) {
+      double sum = 0.0;
+      for (; k < pc.end; ++k) sum += mass[c * n + k];
+      out[static_cast<std::size_t>(pc.bin) * C + c] += sum;
+    }
+  }
   if (!glints || gl.t == 0.0) return;
   // The glints: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their bin masses in
   // closed form (images 2 pi away included; N_TRT wraps phi - phi_c), the
   // same for every channel.
-  std::vector<double> edges(n_phi + 1), mass(n_phi, 0.0);
+  std::vector<double> edges(n_phi + 1), glint_mass(n_phi, 0.0);
   for (int j = 0; j <= n_phi; ++j) edges[j] = -kPi + j * delta;
   for (int img = -1; img <= 1; ++img) {
-    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp->w_c, mass.data());
-    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp->w_c, mass.data());
+    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
+    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
   }
   for (std::size_t ch = 0; ch < C; ++ch) {
     const double a2 = A(2, gl.gamma_c, e, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
     const double scale = gl.t * cp->k_g * a2 * gl.dh;
-    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * mass[j];
+    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * glint_mass[j];
   }
 }
 
