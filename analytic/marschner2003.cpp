@@ -219,14 +219,30 @@ double T(double sigma_a_prime, double gamma_t, Absorption absorption) {
   return cylinder::segment_transmittance(sigma_a_prime, std::cos(gamma_t), absorption);
 }
 
-double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
-         Absorption absorption) {
+namespace {
+// The part of A(p, h) that is the same for every channel: its Fresnel
+// factors and the refraction angle the attenuation T needs.
+struct PathFresnel {
+  double fresnel;      // A(0) = F(eta', eta'', gamma_i); p > 0: (1 - F_in)^2 F_out^(p-1)
+  double cos_gamma_t;  // cos(gamma_t), sin(gamma_t) = h / eta' (p > 0)
+};
+PathFresnel path_fresnel(int p, double gamma_i, double eta_p, double eta_pp) {
   const double f_in = F(eta_p, eta_pp, gamma_i);
-  if (p == 0) return f_in;
+  if (p == 0) return {f_in, 0.0};
   const double gamma_t = gamma_t_exact(gamma_i, eta_p);
   const double f_out = F(1.0 / eta_p, 1.0 / eta_pp, gamma_t);
-  const double t = T(sigma_a_prime, gamma_t, absorption);
-  return (1.0 - f_in) * (1.0 - f_in) * std::pow(f_out, p - 1) * std::pow(t, p);
+  return {(1.0 - f_in) * (1.0 - f_in) * std::pow(f_out, p - 1), std::cos(gamma_t)};
+}
+// A(p, h) from its channel-independent part and one channel's sigma_a'.
+double A_of(int p, const PathFresnel& pf, double sigma_a_prime, Absorption absorption) {
+  if (p == 0) return pf.fresnel;
+  return pf.fresnel * std::pow(cylinder::segment_transmittance(sigma_a_prime, pf.cos_gamma_t, absorption), p);
+}
+}  // namespace
+
+double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
+         Absorption absorption) {
+  return A_of(p, path_fresnel(p, gamma_i, eta_p, eta_pp), sigma_a_prime, absorption);
 }
 
 Projection project(double eta, double theta, bool exact_roots, Absorption absorption) {
@@ -254,9 +270,11 @@ void N_p(int p, double phi, const Projection& proj, const std::vector<double>& s
     const double slope = proj.exact_roots ? dPhi_dgamma(p, gamma_i, proj.eta_p)
                                           : dPhi_cubic_dgamma(p, gamma_i, proj.eta_p);
     const double jac = std::cos(gamma_i) / (2.0 * std::max(std::abs(slope), kMinSlope));
+    // A(p, h): its Fresnel factors once for every channel.
+    const PathFresnel pf = path_fresnel(p, gamma_i, proj.eta_p, proj.eta_pp);
     for (std::size_t ch = 0; ch < sigma_a.size(); ++ch) {
       const double sigma_prime = sigma_a[ch] / proj.cos_theta_t;
-      out[ch] += A(p, gamma_i, proj.eta_p, proj.eta_pp, sigma_prime, proj.absorption) * jac;
+      out[ch] += A_of(p, pf, sigma_prime, proj.absorption) * jac;
     }
   }
 }
@@ -349,11 +367,11 @@ void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_
   if (gl.t == 0.0) return;
   const double remove = caustic_removal(gl, cp, phi);
   const double g_minus = g(cp.w_c, wrap_angle(phi - gl.phi_c)), g_plus = g(cp.w_c, wrap_angle(phi + gl.phi_c));
+  // "A(2, theta, phi)" in the garbled procedure: we evaluate A(2, h) at the
+  // path that forms the caustic, h_c (h = 0 past the merge).
+  const PathFresnel pf = path_fresnel(2, gl.gamma_c, proj.eta_p, proj.eta_pp);
   for (std::size_t ch = 0; ch < sigma_a.size(); ++ch) {
-    // "A(2, theta, phi)" in the garbled procedure: we evaluate A(2, h) at the
-    // path that forms the caustic, h_c (h = 0 past the merge).
-    const double a2 = A(2, gl.gamma_c, proj.eta_p, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t,
-                        proj.absorption);
+    const double a2 = A_of(2, pf, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
     out[ch] = out[ch] * remove + gl.t * cp.k_g * a2 * gl.dh * (g_minus + g_plus);
   }
 }
