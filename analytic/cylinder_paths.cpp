@@ -72,6 +72,47 @@ void add_smooth_lobe(const Attenuation& att, int p, int n_phi, std::vector<doubl
   }
 }
 
+constexpr int kMaxPieceOrder = 64;
+
+void piece_nodes(double a, double b, int order, double max_len, std::vector<PathNode>& out) {
+  if (!(b > a)) return;
+  if (order < 1 || order > kMaxPieceOrder)
+    throw std::logic_error("cylinder path nodes: Gauss-Legendre order outside 1..64");
+  const int m = std::max(1, static_cast<int>(std::ceil((b - a) / max_len)));
+  const double len = (b - a) / m;
+  // Short pieces (high orders p cross a bin edge every few 1e-3 rad of
+  // gamma) carry an integrand that is a low-degree polynomial to rounding
+  // over their length: fewer points there (error ~ len^(2n), len < 0.005).
+  if (len < 0.005) order = std::min(order, 3);
+  // gauss_legendre() takes a lock; its rules never move once made, so each
+  // thread keeps pointers to them (this runs once per piece: ~10^5 times per
+  // Marschner 2003 prediction).
+  static thread_local const GaussLegendre* rules[kMaxPieceOrder + 1] = {};
+  if (!rules[order]) rules[order] = &gauss_legendre(order);
+  const GaussLegendre& gl = *rules[order];
+  // cos and sin of gamma = mid + half x_q by angle addition: one sine and
+  // cosine per panel instead of one per node (to ~1 ulp). Those of half x_q
+  // for half of the nodes only: the rule is symmetric (x_{n-1-q} = -x_q and
+  // the middle node 0, exactly), cos even and sin odd (exactly, in libm too).
+  const double half = 0.5 * len;
+  double cq[kMaxPieceOrder], sq[kMaxPieceOrder];
+  for (int q = 0; q < order; ++q) {
+    const int mirror = order - 1 - q;
+    if (mirror == q) cq[q] = 1.0, sq[q] = 0.0;
+    else if (mirror < q) cq[q] = cq[mirror], sq[q] = -sq[mirror];
+    else cq[q] = std::cos(half * gl.x[q]), sq[q] = std::sin(half * gl.x[q]);
+  }
+  for (int k = 0; k < m; ++k) {
+    const double mid = a + k * len + half;
+    const double cm = std::cos(mid), sm = std::sin(mid);
+    for (int q = 0; q < order; ++q) {
+      const double g = mid + half * gl.x[q];
+      const double cg = cm * cq[q] - sm * sq[q], sg = sm * cq[q] + cm * sq[q];
+      out.push_back({g, 0.5 * half * gl.w[q] * cg, 0.0, cg, sg});
+    }
+  }
+}
+
 namespace {
 
 // The monotonic pieces of Phi(p, .) on [-pi/2, pi/2].
@@ -100,33 +141,12 @@ double solve_phi(int p, double eta_p, double e, double a, double b, double phi_a
   return x;
 }
 
-constexpr int kMaxPieceOrder = 64;
-
 void add_piece_nodes(int p, double eta_p, double a, double b, int order, double max_len,
                      std::vector<PathNode>& out, bool want_phi = true) {
-  if (!(b > a)) return;
-  if (order > kMaxPieceOrder) throw std::logic_error("cylinder path nodes: Gauss-Legendre order above 64");
-  const int m = std::max(1, static_cast<int>(std::ceil((b - a) / max_len)));
-  const double len = (b - a) / m;
-  // Short pieces (high orders p cross a bin edge every few 1e-3 rad of
-  // gamma) carry an integrand that is a low-degree polynomial to rounding
-  // over their length: fewer points there (error ~ len^(2n), len < 0.005).
-  if (len < 0.005) order = std::min(order, 3);
-  const GaussLegendre& gl = gauss_legendre(order);
-  // cos and sin of gamma = mid + half x_q by angle addition: one sine and
-  // cosine per panel instead of one per node (to ~1 ulp).
-  const double half = 0.5 * len;
-  double cq[kMaxPieceOrder], sq[kMaxPieceOrder];
-  for (int q = 0; q < order; ++q) cq[q] = std::cos(half * gl.x[q]), sq[q] = std::sin(half * gl.x[q]);
-  for (int k = 0; k < m; ++k) {
-    const double mid = a + k * len + half;
-    const double cm = std::cos(mid), sm = std::sin(mid);
-    for (int q = 0; q < order; ++q) {
-      const double g = mid + half * gl.x[q];
-      const double cg = cm * cq[q] - sm * sq[q], sg = sm * cq[q] + cm * sq[q];
-      out.push_back({g, 0.5 * half * gl.w[q] * cg, want_phi ? wrap_angle(Phi(p, g, eta_p)) : 0.0, cg, sg});
-    }
-  }
+  const std::size_t first = out.size();
+  piece_nodes(a, b, order, max_len, out);
+  if (want_phi)
+    for (std::size_t k = first; k < out.size(); ++k) out[k].phi = wrap_angle(Phi(p, out[k].gamma, eta_p));
 }
 
 }  // namespace

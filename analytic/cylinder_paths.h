@@ -112,6 +112,11 @@ struct PathNode {
   double gamma, weight, phi;
   double cos_gamma = 0.0, sin_gamma = 0.0;  // set by smooth_nodes and panel_nodes
 };
+// Appends composite Gauss-Legendre nodes of (1/2) integral over gamma in
+// [a, b] (panels of at most max_len, `order` <= 64 points each, 3 where a
+// panel is shorter than 0.005) with phi left 0: the building block of the
+// two functions below, public for Marschner 2003's phi function of Eq. 10.
+void piece_nodes(double a, double b, int order, double max_len, std::vector<PathNode>& out);
 // Nodes split at every crossing of Phi(p, .) with an edge of n_phi uniform
 // bins on [-pi, pi) and at the fold: each node's phi is strictly inside one
 // bin and each piece carries a smooth integrand. `order` points per piece.

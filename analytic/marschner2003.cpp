@@ -8,6 +8,7 @@
 #include <string>
 
 #include <fmt/core.h>
+#include <xsimd/xsimd.hpp>
 
 #include "analytic/cylinder_paths.h"
 #include "analytic/model_registry.h"
@@ -218,18 +219,36 @@ double T(double sigma_a_prime, double gamma_t, Absorption absorption) {
   return cylinder::segment_transmittance(sigma_a_prime, std::cos(gamma_t), absorption);
 }
 
-double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
-         Absorption absorption) {
+namespace {
+// The part of A(p, h) that is the same for every channel: its Fresnel
+// factors and the refraction angle the attenuation T needs.
+struct PathFresnel {
+  double fresnel;      // A(0) = F(eta', eta'', gamma_i); p > 0: (1 - F_in)^2 F_out^(p-1)
+  double cos_gamma_t;  // cos(gamma_t), sin(gamma_t) = h / eta' (p > 0)
+};
+PathFresnel path_fresnel(int p, double gamma_i, double eta_p, double eta_pp) {
   const double f_in = F(eta_p, eta_pp, gamma_i);
-  if (p == 0) return f_in;
+  if (p == 0) return {f_in, 0.0};
   const double gamma_t = gamma_t_exact(gamma_i, eta_p);
   const double f_out = F(1.0 / eta_p, 1.0 / eta_pp, gamma_t);
-  const double t = T(sigma_a_prime, gamma_t, absorption);
-  return (1.0 - f_in) * (1.0 - f_in) * std::pow(f_out, p - 1) * std::pow(t, p);
+  return {(1.0 - f_in) * (1.0 - f_in) * std::pow(f_out, p - 1), std::cos(gamma_t)};
+}
+// A(p, h) from its channel-independent part and one channel's sigma_a'.
+double A_of(int p, const PathFresnel& pf, double sigma_a_prime, Absorption absorption) {
+  if (p == 0) return pf.fresnel;
+  return pf.fresnel * std::pow(cylinder::segment_transmittance(sigma_a_prime, pf.cos_gamma_t, absorption), p);
+}
+}  // namespace
+
+double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prime,
+         Absorption absorption) {
+  return A_of(p, path_fresnel(p, gamma_i, eta_p, eta_pp), sigma_a_prime, absorption);
 }
 
 Projection project(double eta, double theta, bool exact_roots, Absorption absorption) {
   Projection proj;
+  proj.eta = eta;
+  proj.theta = theta;
   proj.eta_p = eta_prime(eta, theta);
   proj.eta_pp = eta_double_prime(eta, theta);
   const double s = std::sin(theta) / eta;
@@ -251,9 +270,11 @@ void N_p(int p, double phi, const Projection& proj, const std::vector<double>& s
     const double slope = proj.exact_roots ? dPhi_dgamma(p, gamma_i, proj.eta_p)
                                           : dPhi_cubic_dgamma(p, gamma_i, proj.eta_p);
     const double jac = std::cos(gamma_i) / (2.0 * std::max(std::abs(slope), kMinSlope));
+    // A(p, h): its Fresnel factors once for every channel.
+    const PathFresnel pf = path_fresnel(p, gamma_i, proj.eta_p, proj.eta_pp);
     for (std::size_t ch = 0; ch < sigma_a.size(); ++ch) {
       const double sigma_prime = sigma_a[ch] / proj.cos_theta_t;
-      out[ch] += A(p, gamma_i, proj.eta_p, proj.eta_pp, sigma_prime, proj.absorption) * jac;
+      out[ch] += A_of(p, pf, sigma_prime, proj.absorption) * jac;
     }
   }
 }
@@ -314,11 +335,25 @@ Glint glint_of(const Projection& proj, const CausticParams& cp) {
   return gl;
 }
 
-// The factor that removes the caustic from N_TRT at exit angle phi.
-double caustic_removal(const Glint& gl, const CausticParams& cp, double phi) {
-  const double g0 = g(cp.w_c, 0.0);
-  const double x_minus = wrap_angle(phi - gl.phi_c), x_plus = wrap_angle(phi + gl.phi_c);
-  return (1.0 - gl.t * g(cp.w_c, x_minus) / g0) * (1.0 - gl.t * g(cp.w_c, x_plus) / g0);
+// x wrapped to [-pi, pi) (up to rounding at the ends), for any number type.
+template <class N>
+N wrap_pi(N x) {
+  using std::floor;
+  return x - N(kTwoPi) * floor((x + N(kPi)) * N(1.0 / kTwoPi));
+}
+
+// The factor that removes the caustic from N_TRT at exit angle phi (section
+// 5.2.2): (1 - t g(w_c; phi - phi_c) / g(w_c; 0)) (1 - t g(w_c; phi + phi_c) /
+// g(w_c; 0)), the differences wrapped to [-pi, pi). Generic over the number
+// type: a double, or an xsimd batch of exit angles (exp and floor found by
+// argument-dependent lookup).
+template <class N>
+N caustic_removal(const Glint& gl, const CausticParams& cp, N phi) {
+  using std::exp;
+  const N x_minus = wrap_pi(phi - N(gl.phi_c)) * N(1.0 / cp.w_c);
+  const N x_plus = wrap_pi(phi + N(gl.phi_c)) * N(1.0 / cp.w_c);
+  return (N(1.0) - N(gl.t) * exp(N(-0.5) * x_minus * x_minus)) *
+         (N(1.0) - N(gl.t) * exp(N(-0.5) * x_plus * x_plus));
 }
 
 }  // namespace
@@ -332,14 +367,82 @@ void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_
   if (gl.t == 0.0) return;
   const double remove = caustic_removal(gl, cp, phi);
   const double g_minus = g(cp.w_c, wrap_angle(phi - gl.phi_c)), g_plus = g(cp.w_c, wrap_angle(phi + gl.phi_c));
+  // "A(2, theta, phi)" in the garbled procedure: we evaluate A(2, h) at the
+  // path that forms the caustic, h_c (h = 0 past the merge).
+  const PathFresnel pf = path_fresnel(2, gl.gamma_c, proj.eta_p, proj.eta_pp);
   for (std::size_t ch = 0; ch < sigma_a.size(); ++ch) {
-    // "A(2, theta, phi)" in the garbled procedure: we evaluate A(2, h) at the
-    // path that forms the caustic, h_c (h = 0 past the merge).
-    const double a2 = A(2, gl.gamma_c, proj.eta_p, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t,
-                        proj.absorption);
+    const double a2 = A_of(2, pf, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
     out[ch] = out[ch] * remove + gl.t * cp.k_g * a2 * gl.dh * (g_minus + g_plus);
   }
 }
+
+namespace {
+
+// gamma_i in [a, b] where a phi function monotonic on [a, b] (values fa, fb
+// at the ends) crosses `target`: Newton safeguarded by bisection. It stops
+// when a step is below 1e-13 rad: Newton's next step would be ~1e-26 /
+// |phi'| (quadratic convergence), while phi near 2 pi carries a rounding
+// error of ~1e-15, so a tighter stop only makes the iterate wander inside
+// the rounding (the version before asked for 1e-15 and ran its 100 steps at
+// most crossings: half of predict's time).
+// `guess` is used where it lies inside (a, b); else linear interpolation.
+template <class PhiOf, class SlopeOf>
+double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, double a, double b, double fa,
+                double fb, double guess) {
+  const bool increasing = fb > fa;
+  double x0 = a, x1 = b, x = guess > a && guess < b ? guess : a + (b - a) * (target - fa) / (fb - fa);
+  for (int it = 0; it < 100 && x1 - x0 > 1e-15; ++it) {
+    const double r = phi_of(x) - target;
+    if (r == 0.0) return x;
+    if ((r < 0.0) == increasing) x0 = x; else x1 = x;
+    const double d = slope_of(x);
+    double xn = d != 0.0 ? x - r / d : 0.5 * (x0 + x1);
+    if (!(xn > x0 && xn < x1)) xn = 0.5 * (x0 + x1);
+    if (std::abs(xn - x) < 1e-13) return xn;
+    x = xn;
+  }
+  return x;
+}
+
+// Per node k (of n): weight * A(p, h) per channel c, out[c * n + k]; with
+// a glint (section 5.2.2) also times the caustic's removal factor at the
+// node's exit angle (PathNode::phi, unwrapped).
+// A (section 4.3, Appendix B) from the shared cylinder::Attenuation:
+// Appendix B's F(eta', eta'', gamma) is the 3D Fresnel reflectance at
+// cos(i) = cos(theta_d) cos(gamma) (test BravaisFresnelEqualsThreeDimensionalFresnel),
+// and leaving the fiber F(1/eta', 1/eta'', gamma_t) is the same number
+// (the reflectance of a dielectric interface is the same from both sides),
+// so A(p, h) = (1 - f)^2 f^(p-1) T^p with one f. Eight nodes per SIMD
+// batch (xsimd), the remainder one by one.
+void node_masses(const cylinder::Attenuation& att, int p, const std::vector<cylinder::PathNode>& nodes,
+                 const Glint* glint, const CausticParams* cp, std::vector<double>& out) {
+  using Batch = xsimd::batch<double>;
+  constexpr std::size_t W = Batch::size;
+  const int C = att.channels();
+  const std::size_t n = nodes.size();
+  out.resize(C * n);
+  std::vector<Batch> mass_b(C);
+  alignas(64) double ci[W], si[W], w[W], ph[W];
+  std::size_t k = 0;
+  for (; k + W <= n; k += W) {
+    for (std::size_t l = 0; l < W; ++l) {
+      const cylinder::PathNode& nd = nodes[k + l];
+      ci[l] = nd.cos_gamma, si[l] = nd.sin_gamma, w[l] = nd.weight, ph[l] = nd.phi;
+    }
+    att.A(p, Batch::load_aligned(ci), Batch::load_aligned(si), mass_b.data());
+    Batch wb = Batch::load_aligned(w);
+    if (glint) wb *= caustic_removal(*glint, *cp, Batch::load_aligned(ph));
+    for (int c = 0; c < C; ++c) (wb * mass_b[c]).store_unaligned(&out[c * n + k]);
+  }
+  std::vector<double> a(C);
+  for (; k < n; ++k) {
+    att.A(p, nodes[k].cos_gamma, nodes[k].sin_gamma, a.data());
+    const double wk = nodes[k].weight * (glint ? caustic_removal(*glint, *cp, nodes[k].phi) : 1.0);
+    for (int c = 0; c < C; ++c) out[c * n + k] = wk * a[c];
+  }
+}
+
+}  // namespace
 
 void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
               const CausticParams* cp, int n_phi, std::vector<double>& out) {
@@ -353,102 +456,90 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
     return proj.exact_roots ? Phi(p, x, e) : b1 * x - b3 * x * x * x + p * kPi;
   };
   auto slope_of = [&](double x) { return proj.exact_roots ? dPhi_dgamma(p, x, e) : b1 - d3 * x * x; };
-  std::vector<double> sigma_prime(C);
-  for (std::size_t ch = 0; ch < C; ++ch) sigma_prime[ch] = sigma_a[ch] / proj.cos_theta_t;
   // Monotonic pieces: split at the fold (dphi/dgamma = 0), if any.
   double fold = -1.0;
   if (proj.exact_roots) {
     fold = cylinder::fold_gamma(p, e);
   } else if (p >= 1) {
-    const double c = c_of(e), B = 6.0 * p * c / kPi - 2.0, C3 = 24.0 * p * c / kPi3;
-    if (B > 0.0 && std::sqrt(B / C3) < half_pi) fold = std::sqrt(B / C3);
+    if (b1 > 0.0 && std::sqrt(b1 / d3) < half_pi) fold = std::sqrt(b1 / d3);
   }
   std::vector<double> br = fold > 0.0 && fold < half_pi ? std::vector<double>{-half_pi, -fold, fold, half_pi}
                                                          : std::vector<double>{-half_pi, half_pi};
   const bool glints = p == 2 && cp && cp->w_c > 0.0;
   const Glint gl = glints ? glint_of(proj, *cp) : Glint{};
-  std::vector<double> cuts, tr(C);
+  // Quadrature nodes over gamma_i: each piece between consecutive crossings
+  // of a bin edge exits into one bin and carries a smooth integrand; long
+  // pieces in panels of at most pi/64, 5 points per panel (3 on panels
+  // shorter than 0.005 rad: one bin's worth of h).
+  struct Piece {
+    std::size_t end;  // one past its last node
+    int bin;          // the phi bin every node of it exits into
+  };
+  static thread_local std::vector<cylinder::PathNode> nodes;
+  static thread_local std::vector<Piece> pieces;
+  static thread_local std::vector<double> cuts, mass;
+  nodes.clear();
+  pieces.clear();
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
     const double a = br[k], b = br[k + 1];
     const double fa = phi_of(a), fb = phi_of(b);
     const double lo = std::min(fa, fb), hi = std::max(fa, fb);
     const bool increasing = fb > fa;
+    // The targets ascend, so the crossings ascend in gamma from a where phi
+    // increases and descend from b where it decreases: each is bracketed by
+    // the one before and the piece's far end, and Newton starts from a
+    // Newton step off the one before.
+    double prev = increasing ? a : b, f_prev = increasing ? fa : fb;
     cuts.assign(1, a);
     for (long m = static_cast<long>(std::ceil((lo + kPi) / delta)); -kPi + m * delta < hi; ++m) {
       const double target = -kPi + m * delta;
-      if (target <= lo) continue;
-      // Bisection safeguarded Newton on the monotonic piece.
-      double x0 = a, x1 = b, x = a + (b - a) * (target - fa) / (fb - fa);
-      for (int it = 0; it < 100 && x1 - x0 > 1e-15; ++it) {
-        const double r = phi_of(x) - target;
-        if ((r < 0.0) == increasing) x0 = x; else x1 = x;
-        const double d = slope_of(x);
-        double xn = d != 0.0 ? x - r / d : 0.5 * (x0 + x1);
-        if (!(xn > x0 && xn < x1)) xn = 0.5 * (x0 + x1);
-        if (std::abs(xn - x) < 1e-15) { x = xn; break; }
-        x = xn;
-      }
-      cuts.push_back(x);
+      if (!(target > lo)) continue;
+      const double slope = slope_of(prev);
+      const double guess = slope != 0.0 ? prev + (target - f_prev) / slope : prev;
+      prev = increasing ? crossing(phi_of, slope_of, target, prev, b, f_prev, fb, guess)
+                        : crossing(phi_of, slope_of, target, a, prev, fa, f_prev, guess);
+      f_prev = target;
+      cuts.push_back(prev);
     }
+    if (!increasing) std::reverse(cuts.begin() + 1, cuts.end());
     cuts.push_back(b);
-    std::sort(cuts.begin(), cuts.end());
     for (std::size_t q = 0; q + 1 < cuts.size(); ++q) {
-      const double len = cuts[q + 1] - cuts[q];
-      if (!(len > 0.0)) continue;
-      // Long pieces in panels of at most pi/64; short ones (most, one bin's
-      // worth of h) need few points: the integrand is smooth on each.
-      const int panels = std::max(1, static_cast<int>(std::ceil(len / (kPi / 64))));
-      const int order = len / panels < 0.005 ? 3 : 5;
-      const GaussLegendre& rule = gauss_legendre(order);
-      const double plen = len / panels;
-      for (int pn = 0; pn < panels; ++pn) {
-        const double mid = cuts[q] + (pn + 0.5) * plen;
-        for (int n = 0; n < order; ++n) {
-          const double x = mid + 0.5 * plen * rule.x[n];
-          const double sin_x = std::sin(x), cos_x = std::cos(x);  // cos > 0 inside the pieces
-          const double w = 0.25 * plen * rule.w[n] * cos_x;  // (1/2) dh = (1/2) cos(gamma) dgamma
-          const double ph = wrap_angle(phi_of(x));
-          const int j = std::clamp(static_cast<int>(std::floor((ph + kPi) / delta)), 0, n_phi - 1);
-          // A(p, h) (section 4.3): Fresnel and gamma_t once for every channel;
-          // gamma_t = asin(h / eta') through its sine and cosine only.
-          const double f_in = F_of(e, proj.eta_pp, sin_x, cos_x);
-          double base = f_in, cos_t = 0.0;
-          if (p > 0) {
-            const double sin_t = sin_x / e;
-            cos_t = std::sqrt(1.0 - sin_t * sin_t);
-            const double f_out = F_of(1.0 / e, 1.0 / proj.eta_pp, sin_t, cos_t);
-            base = (1.0 - f_in) * (1.0 - f_in);
-            for (int k = 1; k < p; ++k) base *= f_out;
-          }
-          if (glints) base *= caustic_removal(gl, *cp, ph);
-          double* bin = &out[static_cast<std::size_t>(j) * C];
-          for (std::size_t ch = 0; ch < C; ++ch) {
-            double t = 1.0;
-            if (p > 0) {
-              const double t1 = cylinder::segment_transmittance(sigma_prime[ch], cos_t, proj.absorption);
-              for (int k = 0; k < p; ++k) t *= t1;
-            }
-            bin[ch] += w * base * t;
-          }
-        }
-      }
+      const std::size_t first = nodes.size();
+      cylinder::piece_nodes(cuts[q], cuts[q + 1], 5, kPi / 64, nodes);
+      if (nodes.size() == first) continue;
+      // The piece's bin, from its middle.
+      pieces.push_back({nodes.size(), cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi)});
+      // Section 5.2.2: the caustic's removal factor needs each node's phi.
+      if (glints)
+        for (std::size_t n = first; n < nodes.size(); ++n) nodes[n].phi = phi_of(nodes[n].gamma);
+    }
+  }
+  const cylinder::Attenuation att(proj.eta, proj.theta, sigma_a, proj.absorption);
+  node_masses(att, p, nodes, glints && gl.t != 0.0 ? &gl : nullptr, cp, mass);
+  // Each piece's sum into its bin.
+  const std::size_t n = nodes.size();
+  for (std::size_t c = 0; c < C; ++c) {
+    std::size_t k = 0;
+    for (const Piece& pc : pieces) {
+      double sum = 0.0;
+      for (; k < pc.end; ++k) sum += mass[c * n + k];
+      out[static_cast<std::size_t>(pc.bin) * C + c] += sum;
     }
   }
   if (!glints || gl.t == 0.0) return;
   // The glints: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their bin masses in
-  // closed form (images 2 pi away included; N_TRT wraps phi - phi_c).
+  // closed form (images 2 pi away included; N_TRT wraps phi - phi_c), the
+  // same for every channel.
+  std::vector<double> edges(n_phi + 1), glint_mass(n_phi, 0.0);
+  for (int j = 0; j <= n_phi; ++j) edges[j] = -kPi + j * delta;
+  for (int img = -1; img <= 1; ++img) {
+    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
+    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
+  }
   for (std::size_t ch = 0; ch < C; ++ch) {
     const double a2 = A(2, gl.gamma_c, e, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
     const double scale = gl.t * cp->k_g * a2 * gl.dh;
-    if (scale == 0.0) continue;
-    for (int j = 0; j < n_phi; ++j) {
-      const double e0 = -kPi + j * delta, e1 = e0 + delta;
-      double mass = 0.0;
-      for (int img = -1; img <= 1; ++img)
-        mass += gaussian_interval_mass(e0, e1, gl.phi_c + kTwoPi * img, cp->w_c) +
-                gaussian_interval_mass(e0, e1, -gl.phi_c + kTwoPi * img, cp->w_c);
-      out[static_cast<std::size_t>(j) * C + ch] += scale * mass;
-    }
+    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * glint_mass[j];
   }
 }
 
@@ -544,13 +635,19 @@ class Marschner2003 final : public Model {
   // The default per-bin 6 x 6 Gauss-Legendre rule cannot see a Gaussian M of
   // beta = 0.1 deg inside a 2 deg bin, nor the 1/sqrt caustics of N_TRT. Here:
   // theta_r is split at the bin edges and every beta/2 (in theta_r) over
-  // +-8 standard deviations around each lobe's centre -theta_i + alpha[p];
-  // phi is split at the bin edges, every min(2 deg, w_c/2), and (for the
-  // unsmoothed TRT of a circular fiber) at the caustics +-phi_c(theta_d) of
-  // the phi function in use; each piece gets a 4-point Gauss-Legendre rule,
-  // in phi after x = a + (b-a)(1 - cos(pi u))/2, which makes a 1/sqrt
-  // singularity at a piece end smooth. With eccentricity != 1 and w_c == 0 the
-  // caustics move with phi_h and are not split at (integrable, less accurate).
+  // +-8 standard deviations around each lobe's centre -theta_i + alpha[p],
+  // 4 Gauss-Legendre points per piece; M_p and the geometry factor of Eq. 9
+  // once per theta_r node. N's phi-bin integrals, where N depends on theta_d
+  // only (a circular fiber; R and TT of any fiber): exact integrals over h
+  // (N_p_bins), for R and TT interpolated in theta_r between exact
+  // evaluations (add_interpolated), for TRT (caustics that cross bin edges
+  // make its bins kink in theta_r) at every node. Where N_TRT depends on phi
+  // itself (eccentricity, section 5.2.3): density() at points in phi, split at
+  // the bin edges and every min(2 deg, w_c/2); each piece gets a 4-point
+  // Gauss-Legendre rule in u after phi = a + (b-a)(1 - cos(pi u))/2, which
+  // makes a 1/sqrt singularity at a piece end smooth. With w_c == 0 the
+  // caustics move with phi_h and are not split at (integrable, less
+  // accurate).
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
                                         double phi_i) const override {
     const int nt = grid.n_theta(), np = grid.n_phi(), L = params_.lobes;
@@ -578,8 +675,10 @@ class Marschner2003 final : public Model {
       }
       std::sort(tk.begin(), tk.end());
       tk.erase(std::unique(tk.begin(), tk.end()), tk.end());
-      const bool split_caustic = p_lo <= 2 && p_hi >= 2 && !(params_.w_c > 0.0) &&
-                                 params_.eccentricity == 1.0;
+      // Eccentricity changes N_TRT only (section 5.2.3: eta* "to the code
+      // that computes N_TRT"): a lobe without p = 2 takes the circular
+      // fiber's phi-bin integrals over h whatever the eccentricity.
+      const bool by_h = params_.eccentricity == 1.0 || p_hi < 2;
       std::vector<ThetaPoint> points[3];  // per order p: theta_r nodes of the circular fiber
       for (std::size_t s = 0; s + 1 < tk.size(); ++s) {
         const double t0 = tk[s], t1 = tk[s + 1];
@@ -600,7 +699,7 @@ class Marschner2003 final : public Model {
             negligible = M < 1e-13 * m3::g(beta, 0.0);
           }
           if (negligible) continue;
-          if (params_.eccentricity == 1.0) {
+          if (by_h) {
             // Circular fiber: N depends on theta_d only; M and the geometry
             // factor once per theta_r node, N's phi-bin integrals either
             // interpolated (below, after the nodes) or exact per node.
@@ -624,32 +723,19 @@ class Marschner2003 final : public Model {
             }
             continue;
           }
-          std::vector<double> caustics;
-          if (split_caustic) {
-            const m3::Caustic c = m3::caustic(m3::project(params_.eta, 0.5 * (tr - theta_i),
-                                                          params_.exact_roots,
-                                                          params_.absorption));
-            if (c.exists) caustics = {-c.phi_c, c.phi_c};
-          }
           for (int j = 0; j < np; ++j) {
             const double f0 = grid.phi_edges[j], f1 = grid.phi_edges[j + 1];
-            std::vector<double> fk{f0, f1};
-            for (double c : caustics)
-              if (c > f0 && c < f1) fk.push_back(c);
-            std::sort(fk.begin(), fk.end());
             double* bin = &out[((static_cast<std::size_t>(lobe) * nt + i) * np + j) * C];
-            for (std::size_t q = 0; q + 1 < fk.size(); ++q) {
-              const int n_sub = std::max(1, static_cast<int>(std::ceil((fk[q + 1] - fk[q]) / phi_step)));
-              const double width = (fk[q + 1] - fk[q]) / n_sub;
-              for (int sub = 0; sub < n_sub; ++sub) {
-                const double lo = fk[q] + sub * width;
-                for (int b = 0; b < 4; ++b) {
-                  const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
-                  const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
-                  const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
-                  density(lobe, theta_i, phi_i, tr, ph, value);
-                  for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
-                }
+            const int n_sub = std::max(1, static_cast<int>(std::ceil((f1 - f0) / phi_step)));
+            const double width = (f1 - f0) / n_sub;
+            for (int sub = 0; sub < n_sub; ++sub) {
+              const double lo = f0 + sub * width;
+              for (int b = 0; b < 4; ++b) {
+                const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
+                const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
+                const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
+                density(lobe, theta_i, phi_i, tr, ph, value);
+                for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
               }
             }
           }

@@ -57,7 +57,8 @@ namespace fiberlab::analytic {
 std::unique_ptr<Model> make_marschner2003(const ModelParams& params);
 // The same model whose bin_probabilities() evaluates N's phi-bin integrals
 // exactly at every theta_r quadrature node (no interpolation in theta_r):
-// ~10x slower, the reference the interpolation is tested against.
+// ~2x slower (90 x 180 bins, beta 5 deg), the reference the interpolation is
+// tested against.
 std::unique_ptr<Model> make_marschner2003_reference(const ModelParams& params);
 
 namespace marschner2003 {
@@ -121,6 +122,8 @@ double A(int p, double gamma_i, double eta_p, double eta_pp, double sigma_a_prim
 // The 2D problem N is solved in: the Bravais indices at theta_d, cos(theta_t)
 // for sigma_a' and the solver choices.
 struct Projection {
+  double eta = 1.55;     // the index the projection was made with
+  double theta = 0.0;    // the inclination theta_d
   double eta_p = 1.55;   // eta'(eta, theta_d)
   double eta_pp = 1.55;  // eta''(eta, theta_d)
   double cos_theta_t = 1.0;  // sin(theta_t) = sin(theta_d) / eta
@@ -170,10 +173,13 @@ void N_TRT(double phi, const Projection& proj, const std::vector<double>& sigma_
 // over the h whose exit angle (the phi function in use, Eq. 10 or Eq. 3)
 // falls in bin j: exact, caustics included, with no root finding (the h
 // range is split where the phi function crosses a bin edge and at its fold;
-// Gauss-Legendre on each piece). For p = 2 with caustic_params->w_c > 0 the
-// procedure of section 5.2.2: the removal factor per h, and the two glint
-// Gaussians' bin masses in closed form. Used by bin_probabilities() for
-// circular fibers (eccentricity makes N depend on phi_h).
+// Gauss-Legendre on each piece, cylinder::piece_nodes; A(p, h) by the
+// shared cylinder::Attenuation, whose 3D Fresnel equals F above). For p = 2
+// with caustic_params->w_c > 0 the procedure of section 5.2.2: the removal
+// factor per h, and the two glint Gaussians' bin masses in closed form.
+// Used by bin_probabilities() for circular fibers, and for R and TT of any
+// fiber (eccentricity makes N_TRT depend on phi_h, and only N_TRT).
+// proj.eta and proj.theta must be those it was made with (project()).
 void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
               const CausticParams* caustic_params, int n_phi, std::vector<double>& out);
 

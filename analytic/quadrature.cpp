@@ -74,6 +74,22 @@ double gaussian_interval_mass(double a, double b, double mu, double beta) {
   return 1.0 - 0.5 * (std::erfc(-za) + std::erfc(zb));
 }
 
+void add_gaussian_interval_masses(const double* edges, int n, double mu, double beta, double* out,
+                                  std::size_t stride) {
+  if (n <= 0) return;
+  const double s = 1.0 / (std::sqrt(2.0) * beta);
+  // tail[k] = erfc(|z_k|): the erfc gaussian_interval_mass takes at edge k.
+  std::vector<double> z(n + 1), tail(n + 1);
+  for (int k = 0; k <= n; ++k) z[k] = (edges[k] - mu) * s, tail[k] = std::erfc(std::abs(z[k]));
+  for (int j = 0; j < n; ++j) {
+    double m;
+    if (z[j] >= 0.0) m = 0.5 * (tail[j] - tail[j + 1]);
+    else if (z[j + 1] <= 0.0) m = 0.5 * (tail[j + 1] - tail[j]);
+    else m = 1.0 - 0.5 * (tail[j] + tail[j + 1]);
+    out[j * stride] += m;
+  }
+}
+
 }  // namespace fiberlab::analytic
 
 namespace fiberlab::analytic {

@@ -2,6 +2,7 @@
 // Quadrature rules shared by the analytic models: Gauss-Legendre nodes and
 // weights on [-1, 1] (computed once per order by Newton's method on P_n, exact
 // to rounding) and the wrapped-Gaussian bin integral of d'Eon 2011 Eq. 11.
+#include <cstddef>
 #include <vector>
 
 namespace fiberlab::analytic {
@@ -17,6 +18,11 @@ const GaussLegendre& gauss_legendre(int n);
 // beta centred on mu: (erf((b-mu)/(sqrt2 beta)) - erf((a-mu)/(sqrt2 beta)))/2,
 // computed with erfc in the tails so that tiny masses keep their relative accuracy.
 double gaussian_interval_mass(double a, double b, double mu, double beta);
+// The same for n consecutive intervals [edges[j], edges[j + 1]], added to
+// out[j * stride] (j < n): each value equal to gaussian_interval_mass's, with
+// one erfc per edge instead of two per interval.
+void add_gaussian_interval_masses(const double* edges, int n, double mu, double beta, double* out,
+                                  std::size_t stride = 1);
 
 }  // namespace fiberlab::analytic
 

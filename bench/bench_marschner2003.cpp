@@ -60,11 +60,17 @@ BENCHMARK(BM_Density)
     ->Args({0, 1, 1});
 
 void BM_BinProbabilities(benchmark::State& state) {
-  const auto model = make_marschner2003(bench_params(state.range(0) != 0, true, 1.0));
+  const double ecc = state.range(1) != 0 ? 0.85 : 1.0;
+  const auto model = make_marschner2003(bench_params(state.range(0) != 0, true, ecc));
   const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
   for (auto _ : state) benchmark::DoNotOptimize(model->bin_probabilities(grid, 0.5, 0.0));
 }
-BENCHMARK(BM_BinProbabilities)->ArgName("exact")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_BinProbabilities)
+    ->ArgNames({"exact", "ecc"})
+    ->Args({0, 0})
+    ->Args({1, 0})
+    ->Args({0, 1})
+    ->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
