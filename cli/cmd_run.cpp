@@ -125,19 +125,19 @@ Job set_up(const RunOptions& o, const sim::ProcessGroup& group) {
 }
 
 // The finished run: OUT.h5 written atomically, the checkpoint removed.
-sim::ResultFile write_output(const sim::Simulation& simulation, const Job& job) {
+void write_output(const sim::Simulation& simulation, const Job& job) {
   const sim::Settings& s = simulation.settings();
   sim::ResultWriter w(s.output, sim::result_header(s, simulation.grid()));
-  for (std::size_t k = 0; k < job.state.tallies.size(); ++k) w.write(k, job.state.tallies[k].exact());
+  for (std::size_t k = 0; k < job.state.tallies.size(); ++k) w.write(k, job.state.tallies[k]);
   if (job.target_error > 0) w.file().set_attr("/", "target_error", job.target_error);
   w.commit();
   std::filesystem::remove(sim::checkpoint_path(s.output));
-  return sim::make_result(s, simulation.grid(), job.state.tallies);
 }
 
-void report(const RunOptions& o, const Job& job, const sim::ResultFile& result,
+void report(const RunOptions& o, const Job& job, const sim::Simulation& simulation,
             const sim::RunStatistics& stats) {
   if (o.quiet) return;
+  const sim::ResultFile result = sim::make_result(simulation.settings(), simulation.grid(), job.state.tallies);
   print_summary(stdout, result);
   if (job.target_error > 0) {
     for (std::size_t k = 0; k < job.state.tallies.size(); ++k) {
@@ -215,11 +215,10 @@ void run(const RunOptions& o) {
       exit_code = 128 + sig;
       return;
     }
-    sim::ResultFile result;
     on_all_ranks(group, [&] {
-      if (group.is_root()) result = write_output(*simulation, job);
+      if (group.is_root()) write_output(*simulation, job);
     });
-    if (group.is_root()) report(o, job, result, stats);
+    if (group.is_root()) report(o, job, *simulation, stats);
   } catch (const sim::FailedElsewhere&) {
     exit_code = 2;  // rank 0 reports
   }

@@ -8,10 +8,12 @@
 #include <new>
 
 #include "cli/commands.h"
+#include "common/allocator_tuning.h"
 #include "common/error.h"
 #include "common/h5_file.h"
 
 int main(int argc, char** argv) {
+  fiberlab::keep_freed_memory_for_reuse();
   fiberlab::h5::prepare_hdf5();
   CLI::App app{"fiberlab " FIBERLAB_VERSION
                ": Monte Carlo ground truth for light scattering by single fibers"};

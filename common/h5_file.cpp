@@ -128,22 +128,27 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
   check_write(H5Dflush(set.id()), file, "cannot write " + name, path);
 }
 
-// Reads or writes slab i (index i along the first dimension) of a dataset.
+// Reads or writes the block of a dataset at leading indices `at` (one index:
+// slab at[0] along the first dimension; two: its row at[1] along the second).
 template <typename T>
-void slab_io(hid_t file, const std::string& path, const std::string& name, hsize_t i,
+void slab_io(hid_t file, const std::string& path, const std::string& name, const Dims& at,
              std::vector<T>* read_into, const std::vector<T>* write_from, hid_t mem_type) {
   Handle set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name,
                        path);
   Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path);
   const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 1) throw Error(fmt::format("{}: {} is not an array", path, name));
+  if (rank < static_cast<int>(at.size()))
+    throw Error(fmt::format("{}: {} is not an array of rank >= {}", path, name, at.size()));
   Dims dims(rank);
   H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
-  if (i >= dims[0])
-    throw Error(fmt::format("{}: {} has {} slabs, not {}", path, name, dims[0], i + 1));
   Dims start(rank, 0), count = dims;
-  start[0] = i;
-  count[0] = 1;
+  for (std::size_t d = 0; d < at.size(); ++d) {
+    if (at[d] >= dims[d])
+      throw Error(fmt::format("{}: {} has {} entries along dimension {}, not {}", path, name,
+                              dims[d], d, at[d] + 1));
+    start[d] = at[d];
+    count[d] = 1;
+  }
   hsize_t n = 1;
   for (hsize_t d : count) n *= d;
   check(H5Sselect_hyperslab(space.id(), H5S_SELECT_SET, start.data(), nullptr, count.data(),
@@ -449,22 +454,31 @@ void File::create_dataset(const std::string& name, const Dims& dims, Type type) 
 }
 
 void File::write_slab(const std::string& name, hsize_t i, const std::vector<double>& data) {
-  slab_io<double>(handle_.id(), path_, name, i, nullptr, &data, H5T_NATIVE_DOUBLE);
+  slab_io<double>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_DOUBLE);
+}
+
+void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data) {
+  slab_io<double>(handle_.id(), path_, name, {i, j}, nullptr, &data, H5T_NATIVE_DOUBLE);
+}
+
+void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j,
+                          const std::vector<std::uint64_t>& data) {
+  slab_io<std::uint64_t>(handle_.id(), path_, name, {i, j}, nullptr, &data, H5T_NATIVE_UINT64);
 }
 
 void File::write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data) {
-  slab_io<std::uint64_t>(handle_.id(), path_, name, i, nullptr, &data, H5T_NATIVE_UINT64);
+  slab_io<std::uint64_t>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_UINT64);
 }
 
 std::vector<double> File::read_slab_doubles(const std::string& name, hsize_t i) const {
   std::vector<double> v;
-  slab_io<double>(handle_.id(), path_, name, i, &v, nullptr, H5T_NATIVE_DOUBLE);
+  slab_io<double>(handle_.id(), path_, name, {i}, &v, nullptr, H5T_NATIVE_DOUBLE);
   return v;
 }
 
 std::vector<std::uint64_t> File::read_slab_uint64s(const std::string& name, hsize_t i) const {
   std::vector<std::uint64_t> v;
-  slab_io<std::uint64_t>(handle_.id(), path_, name, i, &v, nullptr, H5T_NATIVE_UINT64);
+  slab_io<std::uint64_t>(handle_.id(), path_, name, {i}, &v, nullptr, H5T_NATIVE_UINT64);
   return v;
 }
 

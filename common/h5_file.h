@@ -72,6 +72,11 @@ class File {
   void create_dataset(const std::string& name, const Dims& dims, Type type);
   void write_slab(const std::string& name, hsize_t i, const std::vector<double>& data);
   void write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data);
+  // Row j (index j along the second dimension) of slab i: a part of a slab,
+  // so that a slab need not be in memory at once.
+  void write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data);
+  void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
+                      const std::vector<std::uint64_t>& data);
   std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;
   std::vector<std::uint64_t> read_slab_uint64s(const std::string& name, hsize_t i) const;
   Dims dims(const std::string& name) const;  // of a dataset

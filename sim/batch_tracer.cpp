@@ -33,8 +33,11 @@ struct Pool {
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
   enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
-  alignas(64) double col[kColumns][kPoolLanes];
-  alignas(64) std::uint64_t bits[kBitColumns][kPoolLanes];
+  // W spare lanes past the end: new photons are written a whole vector at a
+  // time from any lane (Pool::launch_state).
+  static constexpr int kLanes = kPoolLanes + W;
+  alignas(64) double col[kColumns][kLanes];
+  alignas(64) std::uint64_t bits[kBitColumns][kLanes];
 
   template <class T, class Light>
   life::PhotonState<T, Light> load_state(int o) const {
@@ -60,28 +63,38 @@ struct Pool {
     return s;
   }
 
-  template <class T, class Light>
+  // The state of lanes [o, o + W) (T a vector; o a multiple of W unless
+  // kAligned is false) or of lane o (T = double).
+  template <class T, class Light, bool kAligned = true>
   void store_state(int o, const life::PhotonState<T, Light>& s) {
-    store(s.px, col[kPx] + o);
-    store(s.py, col[kPy] + o);
-    store(s.d.x, col[kDx] + o);
-    store(s.d.y, col[kDy] + o);
-    store(s.d.z, col[kDz] + o);
-    store(s.inside, col[kInside] + o);
-    store(s.path, col[kPath] + o);
-    store(s.segments, col[kSegments] + o);
-    store(s.events_here, col[kEventsHere] + o);
-    store(s.tries, col[kTries] + o);
-    store(s.weight, col[kWeight] + o);
-    store(s.code, col[kCode] + o);
-    for (int k = 0; k < 4; ++k) store_bits(s.rng.word(k), bits[kS0 + k] + o);
+    const auto put = [&](const auto& x, auto* column) {
+      if constexpr (kAligned) {
+        if constexpr (std::is_same_v<std::decay_t<decltype(*column)>, double>) store(x, column + o);
+        else store_bits(x, column + o);
+      } else {
+        life::store_unaligned(x, column + o);
+      }
+    };
+    put(s.px, col[kPx]);
+    put(s.py, col[kPy]);
+    put(s.d.x, col[kDx]);
+    put(s.d.y, col[kDy]);
+    put(s.d.z, col[kDz]);
+    put(s.inside, col[kInside]);
+    put(s.path, col[kPath]);
+    put(s.segments, col[kSegments]);
+    put(s.events_here, col[kEventsHere]);
+    put(s.tries, col[kTries]);
+    put(s.weight, col[kWeight]);
+    put(s.code, col[kCode]);
+    for (int k = 0; k < 4; ++k) put(s.rng.word(k), bits[kS0 + k]);
     if constexpr (Light::kPolarized) {
-      store(s.light.q, col[kQ] + o);
-      store(s.light.u, col[kU] + o);
-      store(s.light.v, col[kV] + o);
-      store(s.light.e1.x, col[kE1x] + o);
-      store(s.light.e1.y, col[kE1y] + o);
-      store(s.light.e1.z, col[kE1z] + o);
+      put(s.light.q, col[kQ]);
+      put(s.light.u, col[kU]);
+      put(s.light.v, col[kV]);
+      put(s.light.e1.x, col[kE1x]);
+      put(s.light.e1.y, col[kE1y]);
+      put(s.light.e1.z, col[kE1z]);
     }
   }
 
@@ -91,6 +104,13 @@ struct Pool {
     for (int c = 0; c < kBitColumns; ++c) bits[c][to] = bits[c][from];
   }
 };
+
+// 0, 1, ..., W - 1 as stream words.
+life::BitsOf<Batch> lane_photon_offsets() {
+  alignas(64) std::uint64_t idx[W];
+  for (int i = 0; i < W; ++i) idx[i] = static_cast<std::uint64_t>(i);
+  return life::BitsOf<Batch>::load_aligned(idx);
+}
 
 Batch lane_index() {
   alignas(64) double idx[W];
@@ -143,6 +163,22 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const Batch iota = lane_index();
   life::LifeCounts<Batch> counts;
 
+  // New photons into lanes [o, o + W), photons first, first + 1, ...: the
+  // Source's streams and impact parameters and the life's start, a vector at
+  // a time (a fixed incident direction). Lanes past the photons wanted are
+  // free lanes (or the pool's spare ones): what is written there is never read.
+  const bool vector_launch = source.fixed_direction();
+  const Vec3 d_fixed = -direction_from_angles(theta_i, phi_i);
+  const life::Vec3Of<Batch> d_lanes{Batch(d_fixed.x()), Batch(d_fixed.y()), Batch(d_fixed.z())};
+  auto launch_vector = [&](int o, std::uint64_t first_photon) {
+    const life::BitsOf<Batch> photon = life::BitsOf<Batch>(first_photon) + lane_photon_offsets();
+    const auto lanes = source.template launch_lanes<Batch>(photon);
+    Batch pv, pw;
+    ellipse.entry_point_in_beam(beam, lanes.h, pv, pw);
+    pool.store_state<Batch, Light, false>(o, life::start_photon<Light>(pv, pw, d_lanes, lanes.rng));
+    Batch(phi_i).store_unaligned(pool.col[Pool::kPhiI] + o);
+    photon.store_unaligned(pool.bits[Pool::kPhoton] + o);
+  };
   // A new photon into lane i: the Source's launch, the life's start.
   auto launch = [&](int i, std::uint64_t photon) {
     const LaunchedPhoton p = source.launch(photon);
@@ -175,7 +211,17 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   int n_active = 0;
   alignas(64) bool finished[kPoolLanes];  // lanes that finished this step
   while (true) {
-    while (n_active < kPoolLanes && next < end) launch(n_active++, next++);
+    if (vector_launch) {
+      while (n_active < kPoolLanes && next < end) {
+        launch_vector(n_active, next);
+        const int n = static_cast<int>(std::min<std::uint64_t>(
+            std::min(W, kPoolLanes - n_active), end - next));
+        n_active += n;
+        next += n;
+      }
+    } else {
+      while (n_active < kPoolLanes && next < end) launch(n_active++, next++);
+    }
     if (n_active == 0) break;
     for (int o = 0; o < n_active; o += W) {
       const MaskOf<Batch> live = (iota + Batch(o)) < Batch(n_active);

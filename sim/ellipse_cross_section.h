@@ -89,9 +89,19 @@ class EllipseCrossSection {
     return Eigen::Vector2d(d.y() / rv_, d.z() / rw_).normalized();
   }
   Point2 entry_point_in_beam(const Eigen::Vector2d& g, double h) const {
-    const Eigen::Vector2d g_perp(-g.y(), g.x());
-    const Eigen::Vector2d q = h * g_perp - std::sqrt(std::max(0.0, 1.0 - h * h)) * g;
-    return Point2(rv_ * q.x(), rw_ * q.y());
+    double pv, pw;
+    entry_point_in_beam(g, h, pv, pw);
+    return Point2(pv, pw);
+  }
+  // The same for one photon or a vector of them: q = h g_perp - sqrt(1 - h^2) g
+  // on the unit circle, g_perp = (-g_w, g_v), scaled to the ellipse. Written
+  // with explicit fused multiply-adds so that both round alike.
+  template <class T>
+  void entry_point_in_beam(const Eigen::Vector2d& g, const T& h, T& pv, T& pw) const {
+    using namespace life;
+    const T s = sqrt(max(T(0.0), fma(-h, h, T(1.0))));
+    pv = T(rv_) * fma(h, T(-g.y()), -(s * T(g.x())));
+    pw = T(rw_) * fma(h, T(g.x()), -(s * T(g.y())));
   }
 
  private:

@@ -76,19 +76,38 @@ std::vector<ExactTally::Word> ExactTally::lobe_moments() const {
   return m;
 }
 
+void ExactTally::lobe(int l, ExactLobe& out) const {
+  const std::size_t bins = static_cast<std::size_t>(shape.n_theta) * shape.n_phi;
+  const std::size_t first = static_cast<std::size_t>(l) * bins, C = shape.channels;
+  out.count.assign(count.begin() + first, count.begin() + first + bins);
+  out.weight_sum.assign(weight_sum.begin() + first * C, weight_sum.begin() + (first + bins) * C);
+  out.weight_sq_sum.assign(weight_sq_sum.begin() + first * C,
+                           weight_sq_sum.begin() + (first + bins) * C);
+}
+
 std::vector<double> ExactTally::to_double(const std::vector<Word>& v) {
-  std::vector<double> out(v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(v[i]) / kScale;
+  std::vector<double> out;
+  to_double(v, out);
   return out;
 }
 
+void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out) {
+  out.resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(v[i]) / kScale;
+}
+
 std::vector<std::uint64_t> ExactTally::to_pairs(const std::vector<Word>& v) {
-  std::vector<std::uint64_t> out(2 * v.size());
+  std::vector<std::uint64_t> out;
+  to_pairs(v, out);
+  return out;
+}
+
+void ExactTally::to_pairs(const std::vector<Word>& v, std::vector<std::uint64_t>& out) {
+  out.resize(2 * v.size());
   for (std::size_t i = 0; i < v.size(); ++i) {
     out[2 * i] = static_cast<std::uint64_t>(v[i] >> 64);
     out[2 * i + 1] = static_cast<std::uint64_t>(v[i]);
   }
-  return out;
 }
 
 std::vector<ExactTally::Word> ExactTally::from_pairs(const std::vector<std::uint64_t>& v) {

@@ -20,6 +20,22 @@ struct TallyShape {
   friend bool operator==(const TallyShape&, const TallyShape&) = default;
 };
 
+// One lobe of a direction's bin sums, in file order: count [theta][phi],
+// weight_sum and weight_sq_sum [theta][phi][channel]. The result writer
+// streams a direction one lobe at a time (sim/result_stream.h), so that
+// writing needs no copy of a whole tally.
+struct ExactLobe {
+  std::vector<std::uint64_t> count;
+  std::vector<unsigned __int128> weight_sum, weight_sq_sum;
+};
+
+// A direction's photons and energy ledger (SPEC section 4) as exact words
+// ([lobe][channel] for exited, [channel] for the others).
+struct ExactLedger {
+  std::uint64_t photons = 0;
+  std::vector<unsigned __int128> exited, absorbed, truncated, lost;
+};
+
 struct ExactTally {
   using Word = unsigned __int128;  // every sum is >= 0
   static constexpr double kScale = 0x1.0p60;
@@ -47,9 +63,15 @@ struct ExactTally {
   // [lobe][channel], S1 first, then S2. What --target-error judges.
   std::vector<Word> lobe_moments() const;
 
+  void lobe(int l, ExactLobe& out) const;  // lobe l's bins, into out (resized)
+  ExactLedger ledger() const { return {photons, exited, absorbed, truncated, lost}; }
+
   static std::vector<double> to_double(const std::vector<Word>& v);
   // Two uint64 per word, (high, low): how files store them.
   static std::vector<std::uint64_t> to_pairs(const std::vector<Word>& v);
+  // The same into `out` (resized), so that a caller can reuse its buffer.
+  static void to_double(const std::vector<Word>& v, std::vector<double>& out);
+  static void to_pairs(const std::vector<Word>& v, std::vector<std::uint64_t>& out);
   static std::vector<Word> from_pairs(const std::vector<std::uint64_t>& v);
 };
 

@@ -82,6 +82,21 @@ BitsOf<T> load_bits(const std::uint64_t* p) {
 }
 inline void store_bits(std::uint64_t x, std::uint64_t* p) { *p = x; }
 inline void store_bits(const BitsOf<Batch>& x, std::uint64_t* p) { x.store_aligned(p); }
+// The same at any address (a vector of lanes starting anywhere in a column).
+inline void store_unaligned(double x, double* p) { *p = x; }
+inline void store_unaligned(const Batch& x, double* p) { x.store_unaligned(p); }
+inline void store_unaligned(std::uint64_t x, std::uint64_t* p) { *p = x; }
+inline void store_unaligned(const BitsOf<Batch>& x, std::uint64_t* p) { x.store_unaligned(p); }
+
+// A whole number in [0, 2^53) as a stream word, and back (exact both ways).
+inline std::uint64_t to_bits(double x) { return static_cast<std::uint64_t>(x); }
+inline BitsOf<Batch> to_bits(const Batch& x) {
+  return xsimd::bitwise_cast<BitsOf<Batch>>(xsimd::to_int(x));
+}
+inline double to_double(std::uint64_t x) { return static_cast<double>(x); }
+inline Batch to_double(const BitsOf<Batch>& x) {
+  return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x));
+}
 
 // A 3-vector of numbers: one direction, or W directions side by side.
 template <class T>

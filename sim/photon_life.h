@@ -57,12 +57,17 @@ struct PhotonState {
   LossRecord<T> losses;  // weight removed by the model's event weights
 };
 
-// A photon arriving along d at the entry point p, with its stream.
+// Photons arriving along d at the entry points (pv, pw), with their streams.
+template <class Light, class T>
+PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
+                                   const LaneRandom<T>& rng) {
+  const T zero(0.0);
+  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {}};
+}
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
                                         const LaneRandom<double>& rng) {
-  const Vec3Of<double> dir(d);
-  return {p.x(), p.y(), dir, 0.0, 0.0, 0.0, 0.0, 0.0, 1.0, double(kAtBoundary), rng, Light(dir), {}};
+  return start_photon<Light, double>(p.x(), p.y(), Vec3Of<double>(d), rng);
 }
 
 template <class Model, class T>

@@ -29,12 +29,30 @@ struct RandomState {
 
 namespace life {
 
+// SplitMix64 (Steele, Lea & Flood 2014) on one word or a vector of words.
+template <class Bits>
+Bits splitmix(Bits z) {
+  z = z + Bits(0x9e3779b97f4a7c15ULL);
+  z = (z ^ (z >> 30)) * Bits(0xbf58476d1ce4e5b9ULL);
+  z = (z ^ (z >> 27)) * Bits(0x94d049bb133111ebULL);
+  return z ^ (z >> 31);
+}
+
 template <class T>
 class LaneRandom {
  public:
   using Bits = BitsOf<T>;
   LaneRandom() = default;
   LaneRandom(Bits s0, Bits s1, Bits s2, Bits s3) : s_{s0, s1, s2, s3} {}
+  // The stream of photon `photon` (one per lane) of the direction whose
+  // streams share `key` (PhotonRandom::stream_key): SplitMix64 applied to
+  // (key ^ photon), then four more times, one state word each.
+  static LaneRandom seeded(std::uint64_t key, const Bits& photon) {
+    Bits x = splitmix(Bits(key) ^ photon);
+    Bits s[4];
+    for (auto& w : s) w = x = splitmix(x);
+    return {s[0], s[1], s[2], s[3]};
+  }
   const Bits& word(int k) const { return s_[k]; }
 
   // Uniform in [0, 1) where m (other lanes: any value, stream untouched).
@@ -114,7 +132,8 @@ class PhotonRandom {
       : PhotonRandom(stream_key(seed, theta_i, phi_i), photon) {}
   // The same from a precomputed stream_key: the state is SplitMix64 applied
   // to (key ^ photon), then four more times.
-  PhotonRandom(std::uint64_t key, std::uint64_t photon) : core_(seeded(key, photon)) {}
+  PhotonRandom(std::uint64_t key, std::uint64_t photon)
+      : core_(life::LaneRandom<double>::seeded(key, photon)) {}
 
   // What the streams of one incident direction share: SplitMix64 over the
   // seed and the bit patterns of theta_i and phi_i (-0 counted as +0, every
@@ -127,12 +146,7 @@ class PhotonRandom {
     if (std::isnan(a)) return 0x7ff8000000000000ULL;
     return std::bit_cast<std::uint64_t>(a + 0.0);  // -0 + 0 = +0
   }
-  static std::uint64_t splitmix(std::uint64_t z) {
-    z += 0x9e3779b97f4a7c15ULL;
-    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-    return z ^ (z >> 31);
-  }
+  static std::uint64_t splitmix(std::uint64_t z) { return life::splitmix(z); }
 
   // Uniform in [0, 1).
   double uniform() { return core_.uniform(true); }
@@ -153,13 +167,6 @@ class PhotonRandom {
   }
 
  private:
-  static life::LaneRandom<double> seeded(std::uint64_t key, std::uint64_t photon) {
-    std::uint64_t s[4];
-    std::uint64_t x = splitmix(key ^ photon);
-    for (auto& w : s) w = x = splitmix(x);
-    return {s[0], s[1], s[2], s[3]};
-  }
-
   life::LaneRandom<double> core_;
   double spare_ = 0.0;
   bool has_spare_ = false;

@@ -2,6 +2,8 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
+
 #include "common/error.h"
 #include "common/result_layout.h"
 
@@ -77,23 +79,48 @@ ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
 }
 
 void ResultWriter::write(std::size_t k, const ExactTally& t) {
-  if (!(t.shape == shape_) || k >= photons_.size())
+  write_direction(k, t.shape, t.ledger(), [&](int l, ExactLobe& lobe) { t.lobe(l, lobe); });
+}
+
+void ResultWriter::write(std::size_t k, const Tally& t) {
+  write_direction(k, t.shape(), t.exact_ledger(),
+                  [&](int l, ExactLobe& lobe) { t.exact_lobe(l, lobe); });
+}
+
+// One direction, a lobe at a time: a lobe is a whole number of chunks of the
+// bin datasets (h5::File's chunking), so each is compressed once. Counts
+// (whose chunks span lobes) are gathered and written once per direction.
+void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
+                                   const ExactLedger& ledger, const LobeSource& lobe_of) {
+  if (!(shape == shape_) || k >= photons_.size())
     throw Error("internal error: writing a tally of the wrong shape or direction");
   h5::File& f = *file_;
-  photons_[k] = t.photons;
-  f.write_slab("/tally/weight_sum", k, ExactTally::to_double(t.weight_sum));
-  f.write_slab("/tally/weight_sq_sum", k, ExactTally::to_double(t.weight_sq_sum));
-  f.write_slab("/tally/count", k, t.count);
-  f.write_slab("/ledger/exited", k, ExactTally::to_double(t.exited));
-  f.write_slab("/ledger/absorbed", k, ExactTally::to_double(t.absorbed));
-  f.write_slab("/ledger/truncated", k, ExactTally::to_double(t.truncated));
-  f.write_slab("/ledger/lost", k, ExactTally::to_double(t.lost));
-  f.write_slab("/exact/weight_sum", k, ExactTally::to_pairs(t.weight_sum));
-  f.write_slab("/exact/weight_sq_sum", k, ExactTally::to_pairs(t.weight_sq_sum));
-  f.write_slab("/exact/exited", k, ExactTally::to_pairs(t.exited));
-  f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(t.absorbed));
-  f.write_slab("/exact/truncated", k, ExactTally::to_pairs(t.truncated));
-  f.write_slab("/exact/lost", k, ExactTally::to_pairs(t.lost));
+  photons_[k] = ledger.photons;
+  const std::size_t per_lobe = static_cast<std::size_t>(shape_.n_theta) * shape_.n_phi;
+  counts_.resize(shape_.bins());
+  for (int l = 0; l < shape_.lobes; ++l) {
+    lobe_of(l, lobe_);
+    std::copy(lobe_.count.begin(), lobe_.count.end(), counts_.begin() + l * per_lobe);
+    write_lobe("/tally/weight_sum", "/exact/weight_sum", k, l, lobe_.weight_sum);
+    write_lobe("/tally/weight_sq_sum", "/exact/weight_sq_sum", k, l, lobe_.weight_sq_sum);
+  }
+  f.write_slab("/tally/count", k, counts_);
+  f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
+  f.write_slab("/ledger/absorbed", k, ExactTally::to_double(ledger.absorbed));
+  f.write_slab("/ledger/truncated", k, ExactTally::to_double(ledger.truncated));
+  f.write_slab("/ledger/lost", k, ExactTally::to_double(ledger.lost));
+  f.write_slab("/exact/exited", k, ExactTally::to_pairs(ledger.exited));
+  f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(ledger.absorbed));
+  f.write_slab("/exact/truncated", k, ExactTally::to_pairs(ledger.truncated));
+  f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
+}
+
+void ResultWriter::write_lobe(const char* float_name, const char* exact_name, std::size_t k,
+                              int lobe, const std::vector<ExactTally::Word>& sums) {
+  ExactTally::to_double(sums, doubles_);
+  file_->write_slab_row(float_name, k, static_cast<hsize_t>(lobe), doubles_);
+  ExactTally::to_pairs(sums, pairs_);
+  file_->write_slab_row(exact_name, k, static_cast<hsize_t>(lobe), pairs_);
 }
 
 void ResultWriter::commit() {

@@ -10,6 +10,7 @@
 // uint64 pairs (high, low) of an unsigned 128-bit integer; the value is
 // integer / 2^60. The float64 datasets are these integers / 2^60 rounded once.
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,6 +19,7 @@
 #include "common/h5_file.h"
 #include "sim/exact_tally.h"
 #include "sim/result_file.h"
+#include "sim/tally.h"
 
 namespace fiberlab::sim {
 
@@ -32,15 +34,28 @@ class ResultWriter {
   // written now). The file appears at `path` only on commit().
   ResultWriter(const std::string& path, const ResultFile& header,
                const DirectionSeeds& direction_seeds = {});
-  void write(std::size_t k, const ExactTally& t);  // each direction once
+  // Each direction once, from exact sums or from a run's tally read in place.
+  void write(std::size_t k, const ExactTally& t);
+  void write(std::size_t k, const Tally& t);
   h5::File& file() { return *file_; }              // for extra groups (checkpoints)
   void commit();  // writes /tally/photons, closes, renames into place
 
  private:
+  using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
+  void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
+                       const LobeSource& lobe_of);
+  void write_lobe(const char* float_name, const char* exact_name, std::size_t k, int lobe,
+                  const std::vector<ExactTally::Word>& sums);
+
   AtomicOutput out_;
   std::optional<h5::File> file_;
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
+  // Buffers reused across lobes and directions: fresh memory costs a page
+  // fault per 4 KiB, which on these machines cost more than the writing.
+  ExactLobe lobe_;
+  std::vector<std::uint64_t> counts_, pairs_;
+  std::vector<double> doubles_;
 };
 
 // Writes a whole run (one ExactTally per direction) atomically.

@@ -76,12 +76,34 @@ class Source {
   // stratified, the stratum's 12 bits followed by u's first 41 bits, so h is
   // exact, uniform in its stratum and never 1.
   double impact_parameter(std::uint64_t photon, double u) const {
-    std::uint64_t x = static_cast<std::uint64_t>(u * 0x1.0p53);  // 53 random bits
-    if (photon < stratified_end_) x = ((photon % kStrata) << 41) | (x >> 12);
-    return static_cast<double>(x) * 0x1.0p-52 - 1.0;
+    return impact_parameter_of<double>(photon, u);
+  }
+
+  // The streams and impact parameters of photons `photon` (one per lane: T a
+  // vector) when the direction is fixed: launch(), W photons at a time.
+  template <class T>
+  struct Lanes {
+    life::LaneRandom<T> rng;
+    T h;
+  };
+  template <class T>
+  Lanes<T> launch_lanes(const life::BitsOf<T>& photon) const {
+    auto rng = life::LaneRandom<T>::seeded(key_, photon);
+    const T u = rng.uniform(life::MaskOf<T>(true));
+    return {rng, impact_parameter_of<T>(photon, u)};
   }
 
  private:
+  template <class T>
+  T impact_parameter_of(const life::BitsOf<T>& photon, const T& u) const {
+    using Bits = life::BitsOf<T>;
+    using life::select;  // and xsimd's, by argument-dependent lookup
+    static_assert(kStrata == 1 << 12, "a stratum is 12 bits");
+    const Bits x = life::to_bits(u * T(0x1.0p53));  // 53 random bits
+    const Bits strata = ((photon & Bits(kStrata - 1)) << 41) | (x >> 12);
+    return life::to_double(select(photon < Bits(stratified_end_), strata, x)) * T(0x1.0p-52) - T(1.0);
+  }
+
   std::uint64_t key_;
   double theta_i_, phi_i_;
   bool uniform_;

@@ -84,28 +84,55 @@ void Tally::add(const Tally& o) {
 
 ExactTally Tally::exact() const {
   ExactTally e(shape());
-  e.photons = photons_;
-  const std::size_t C = channels_;
-  const Fixed* cells = this->cells();
-  for (std::size_t b = 0; b < e.count.size(); ++b) {
-    if (!touched_[b / kPageBins]) continue;  // zero, as e starts
-    const Fixed* cell = cells + b * block();
-    e.count[b] = static_cast<std::uint64_t>(cell[0]);
+  ExactLobe lobe;
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
+  for (int l = 0; l < lobes_; ++l) {
+    exact_lobe(l, lobe);
+    std::copy(lobe.count.begin(), lobe.count.end(), e.count.begin() + l * per_lobe);
+    std::copy(lobe.weight_sum.begin(), lobe.weight_sum.end(), e.weight_sum.begin() + l * per_lobe * C);
+    std::copy(lobe.weight_sq_sum.begin(), lobe.weight_sq_sum.end(),
+              e.weight_sq_sum.begin() + l * per_lobe * C);
+  }
+  ExactLedger ledger = exact_ledger();
+  e.photons = ledger.photons;
+  e.exited = std::move(ledger.exited);
+  e.absorbed = std::move(ledger.absorbed);
+  e.truncated = std::move(ledger.truncated);
+  e.lost = std::move(ledger.lost);
+  return e;
+}
+
+void Tally::exact_lobe(int l, ExactLobe& out) const {
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
+  out.count.assign(per_lobe, 0);
+  out.weight_sum.assign(per_lobe * C, 0);
+  out.weight_sq_sum.assign(per_lobe * C, 0);
+  const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
+  for (std::size_t i = 0; i < per_lobe; ++i) {
+    if (!touched_[(first + i) / kPageBins]) continue;  // zero, as out starts
+    const Fixed* cell = cells() + (first + i) * block();
+    out.count[i] = static_cast<std::uint64_t>(cell[0]);
     for (std::size_t c = 0; c < C; ++c) {
-      e.weight_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
-      e.weight_sq_sum[b * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
+      out.weight_sum[i * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
+      out.weight_sq_sum[i * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
     }
   }
-  // The ledger's exited and absorbed are derived from the bins (exact).
+}
+
+// The ledger's exited and absorbed are derived from the bins (exact).
+ExactLedger Tally::exact_ledger() const {
+  ExactLedger e;
+  e.photons = photons_;
+  const std::size_t C = channels_;
   const std::vector<Fixed> exited = exited_fixed();
-  for (std::size_t i = 0; i < exited.size(); ++i) e.exited[i] = static_cast<ExactTally::Word>(exited[i]);
+  for (Fixed x : exited) e.exited.push_back(static_cast<ExactTally::Word>(x));
   for (std::size_t c = 0; c < C; ++c) {
     Fixed absorbed = static_cast<Fixed>(photons_) << 60;
     for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
     absorbed -= truncated_[c] + lost_[c];
-    e.absorbed[c] = static_cast<ExactTally::Word>(absorbed);
-    e.truncated[c] = static_cast<ExactTally::Word>(truncated_[c]);
-    e.lost[c] = static_cast<ExactTally::Word>(lost_[c]);
+    e.absorbed.push_back(static_cast<ExactTally::Word>(absorbed));
+    e.truncated.push_back(static_cast<ExactTally::Word>(truncated_[c]));
+    e.lost.push_back(static_cast<ExactTally::Word>(lost_[c]));
   }
   return e;
 }
@@ -177,15 +204,7 @@ std::vector<Tally::Fixed> Tally::exited_fixed() const {
 
 std::vector<double> Tally::exited() const { return to_double(exited_fixed()); }
 
-std::vector<double> Tally::absorbed() const {
-  const std::vector<Fixed> exited = exited_fixed();
-  std::vector<Fixed> absorbed(channels_, static_cast<Fixed>(photons_) << 60);
-  for (int c = 0; c < channels_; ++c) {
-    for (int l = 0; l < lobes_; ++l) absorbed[c] -= exited[static_cast<std::size_t>(l) * channels_ + c];
-    absorbed[c] -= truncated_[c] + lost_[c];
-  }
-  return to_double(absorbed);
-}
+std::vector<double> Tally::absorbed() const { return ExactTally::to_double(exact_ledger().absorbed); }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
 std::vector<double> Tally::lost() const { return to_double(lost_); }
 

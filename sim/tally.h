@@ -75,6 +75,10 @@ class Tally {
   // and back (a checkpoint's partial sums before resuming).
   TallyShape shape() const { return {lobes_, n_theta_, n_phi_, channels_}; }
   ExactTally exact() const;
+  // The same, a part at a time, read in place (what the result writer
+  // streams): lobe l's bins, and the photons and ledger.
+  void exact_lobe(int l, ExactLobe& out) const;
+  ExactLedger exact_ledger() const;
   void add(const ExactTally& e);
 
   std::uint64_t photons() const { return photons_; }

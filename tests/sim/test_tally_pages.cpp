@@ -1,13 +1,19 @@
 // Tally (sim/tally.h) keeps its sums on lazily zeroed pages and visits only
-// the pages it wrote when adding, clearing, copying and exporting. Oracle: the
-// same sums kept densely by this test, in plain 128-bit integers.
+// the pages it wrote when adding, clearing, copying and exporting, and the
+// result writer (sim/result_stream.h) reads it in place, a lobe at a time.
+// Oracle: the same sums kept densely by this test, in plain 128-bit integers.
 #include <gtest/gtest.h>
 
 #include <cstdint>
 #include <random>
 #include <vector>
 
+#include "sim/checkpoint.h"
+#include "sim/result_stream.h"
 #include "sim/tally.h"
+
+#include "tests/sim/sim_test_support.h"
+#include "tests/unique_temp_dir.h"
 
 namespace fiberlab::sim {
 namespace {
@@ -20,6 +26,7 @@ struct DenseSums {
   std::vector<std::uint64_t> count = std::vector<std::uint64_t>(kLobes * kTheta * kPhi, 0);
   std::vector<ExactTally::Word> s1 = std::vector<ExactTally::Word>(count.size() * kChannels, 0);
   std::vector<ExactTally::Word> s2 = s1;
+  std::vector<ExactTally::Word> truncated = std::vector<ExactTally::Word>(kChannels, 0);
   std::uint64_t photons = 0;
 };
 
@@ -32,7 +39,7 @@ void score(Tally& t, DenseSums& d, int n, std::uint32_t seed) {
   std::uniform_int_distribution<int> lobe(0, kLobes - 1), theta(20, 30), phi(0, kPhi - 1);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (int i = 0; i < n; ++i) {
-    const int l = lobe(g), a = theta(g), p = phi(g);
+    const int l = lobe(g), a = theta(g) + 15 * l, p = phi(g);  // rows 20-75: lobes touch different pages
     const double w[kChannels] = {u(g), u(g), u(g)};
     t.score_exit(l, a, p, w);
     const std::size_t b = (static_cast<std::size_t>(l) * kTheta + a) * kPhi + p;
@@ -42,8 +49,14 @@ void score(Tally& t, DenseSums& d, int n, std::uint32_t seed) {
       d.s2[b * kChannels + c] += fixed(w[c] * w[c]);
     }
   }
-  t.add_launched(n);
-  d.photons += n;
+  // A few photons truncated (the ledger's third term).
+  for (int i = 0; i < n / 100; ++i) {
+    const double w[kChannels] = {u(g), u(g), u(g)};
+    t.score_truncated(w);
+    for (int c = 0; c < kChannels; ++c) d.truncated[c] += fixed(w[c]);
+  }
+  t.add_launched(n + n / 100);
+  d.photons += n + n / 100;
 }
 
 void expect_equal(const Tally& t, const DenseSums& d) {
@@ -81,6 +94,56 @@ TEST(TallyPages, ScoredClearedReusedCopiedAndAddedEqualDenseSums) {
   Tally from_exact(kLobes, kTheta, kPhi, kChannels);
   from_exact.add(copy.exact());
   expect_equal(from_exact, doubled);
+}
+
+// `run` writes each direction's tally in place (ResultWriter::write(k,
+// Tally), lobe by lobe into rows of the datasets): the file must hold the
+// dense sums exactly, as exact pairs and as float64 = exact / 2^60, with the
+// ledger derived from them.
+TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
+  Settings s = testing::smooth_circle(30.0, 1);
+  s.fiber.sigma_a = {0.1, 0.2, 0.3};
+  s.source.theta_i = {deg_to_rad(10.0), deg_to_rad(40.0)};
+  const BinGrid grid = BinGrid::make(kTheta, kPhi, s.tally.theta_bins);
+  ASSERT_EQ(s.tally.lobes, kLobes);
+  std::vector<Tally> tallies(2, Tally(kLobes, kTheta, kPhi, kChannels));
+  std::vector<DenseSums> dense(2);
+  score(tallies[0], dense[0], 5000, 3);
+  score(tallies[1], dense[1], 2000, 4);
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_tally_write");
+  const std::string path = (dir / "r.h5").string();
+  ResultWriter w(path, result_header(s, grid));
+  for (std::size_t k = 0; k < 2; ++k) w.write(k, tallies[k]);
+  w.commit();
+
+  const ResultReader reader(path);
+  const ResultFile doubles = read_result(path);
+  for (std::size_t k = 0; k < 2; ++k) {
+    const DenseSums& d = dense[k];
+    const ExactTally e = reader.read(k);
+    EXPECT_EQ(e.photons, d.photons);
+    EXPECT_TRUE(e.count == d.count);
+    EXPECT_TRUE(e.weight_sum == d.s1);
+    EXPECT_TRUE(e.weight_sq_sum == d.s2);
+    EXPECT_TRUE(e.truncated == d.truncated);
+    const std::size_t per_lobe = static_cast<std::size_t>(kTheta) * kPhi;
+    for (int c = 0; c < kChannels; ++c) {
+      ExactTally::Word exited_total = 0;
+      for (int l = 0; l < kLobes; ++l) {
+        ExactTally::Word exited = 0;
+        for (std::size_t b = 0; b < per_lobe; ++b) exited += d.s1[(l * per_lobe + b) * kChannels + c];
+        EXPECT_TRUE(e.exited[l * kChannels + c] == exited) << "lobe " << l << " channel " << c;
+        exited_total += exited;
+      }
+      const ExactTally::Word launched = static_cast<ExactTally::Word>(d.photons) << 60;
+      EXPECT_TRUE(e.absorbed[c] == launched - exited_total - d.truncated[c]) << "channel " << c;
+    }
+    const std::size_t cells = d.s1.size();
+    for (std::size_t i = 0; i < cells; ++i) {
+      ASSERT_EQ(doubles.weight_sum[k * cells + i], static_cast<double>(d.s1[i]) / 0x1.0p60) << i;
+      ASSERT_EQ(doubles.weight_sq_sum[k * cells + i], static_cast<double>(d.s2[i]) / 0x1.0p60) << i;
+    }
+  }
 }
 
 }  // namespace
