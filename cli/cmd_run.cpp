@@ -125,9 +125,10 @@ Job set_up(const RunOptions& o, const sim::ProcessGroup& group) {
 }
 
 // The finished run: OUT.h5 written atomically, the checkpoint removed.
-void write_output(const sim::Simulation& simulation, const Job& job) {
+void write_output(const sim::Simulation& simulation, const Job& job, int threads) {
   const sim::Settings& s = simulation.settings();
   sim::ResultWriter w(s.output, sim::result_header(s, simulation.grid()));
+  w.set_compression_threads(threads);
   for (std::size_t k = 0; k < job.state.tallies.size(); ++k) w.write(k, job.state.tallies[k]);
   if (job.target_error > 0) w.file().set_attr("/", "target_error", job.target_error);
   w.commit();
@@ -216,7 +217,7 @@ void run(const RunOptions& o) {
       return;
     }
     on_all_ranks(group, [&] {
-      if (group.is_root()) write_output(*simulation, job);
+      if (group.is_root()) write_output(*simulation, job, threads);
     });
     if (group.is_root()) report(o, job, *simulation, stats);
   } catch (const sim::FailedElsewhere&) {

@@ -4,7 +4,10 @@
 
 #include <fcntl.h>
 #include <unistd.h>
+#include <zlib.h>
 
+#include <algorithm>
+#include <bit>
 #include <cerrno>
 #include <cstring>
 
@@ -455,6 +458,110 @@ void File::create_dataset(const std::string& name, const Dims& dims, Type type) 
 
 void File::write_slab(const std::string& name, hsize_t i, const std::vector<double>& data) {
   slab_io<double>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_DOUBLE);
+}
+
+namespace {
+
+// Where a slab row's chunks lie, when they can be written directly: chunk
+// dims (1, 1, rows_per_chunk, whole trailing dims) and deflate the only filter.
+struct RowChunks {
+  Handle set;
+  hsize_t rows = 0, rows_per_chunk = 0;  // along the third dimension
+  std::size_t row_bytes = 0;             // one index of the third dimension
+  int level = 0;                         // deflate's
+  bool direct = false;
+};
+
+bool direct_chunks(hid_t file, const std::string& path, const std::string& name, RowChunks& out) {
+  if constexpr (std::endian::native != std::endian::little) return false;  // file types are LE
+  out.set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path);
+  Handle dcpl = checked(H5Dget_create_plist(out.set.id()), H5Pclose, "creation list of " + name, path);
+  if (H5Pget_layout(dcpl.id()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.id()) != 1) return false;
+  unsigned flags = 0, cd[4] = {0, 0, 0, 0};
+  std::size_t n_cd = 4;
+  if (H5Pget_filter2(dcpl.id(), 0, &flags, &n_cd, cd, 0, nullptr, nullptr) != H5Z_FILTER_DEFLATE ||
+      n_cd < 1)
+    return false;
+  Handle space = checked(H5Dget_space(out.set.id()), H5Sclose, "dataspace of " + name, path);
+  const int rank = H5Sget_simple_extent_ndims(space.id());
+  if (rank < 3) return false;
+  Dims dims(rank), chunk(rank);
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  if (H5Pget_chunk(dcpl.id(), rank, chunk.data()) != rank || chunk[0] != 1 || chunk[1] != 1)
+    return false;
+  std::size_t cells = 1;
+  for (int d = 3; d < rank; ++d) {
+    if (chunk[d] != dims[d]) return false;
+    cells *= dims[d];
+  }
+  out.rows = dims[2];
+  out.rows_per_chunk = chunk[2];
+  out.row_bytes = cells * sizeof(double);  // float64 and uint64 alike
+  out.level = static_cast<int>(cd[0]);
+  out.direct = true;
+  return true;
+}
+
+}  // namespace
+
+void File::write_slab_rows(const std::vector<SlabRow>& rows, int threads) {
+  struct Job {
+    std::size_t row;
+    hsize_t first;  // along the third dimension
+    std::vector<unsigned char> bytes;
+    int status = Z_OK;
+  };
+  std::vector<RowChunks> layout(rows.size());
+  std::vector<Job> jobs;
+  for (std::size_t r = 0; r < rows.size(); ++r) {
+    const SlabRow& row = rows[r];
+    if (!direct_chunks(handle_.id(), path_, row.name, layout[r])) {
+      if (row.doubles) write_slab_row(row.name, row.i, row.j, *row.doubles);
+      else write_slab_row(row.name, row.i, row.j, *row.words);
+      continue;
+    }
+    const std::size_t n = row.doubles ? row.doubles->size() : row.words->size();
+    if (n * sizeof(double) != layout[r].rows * layout[r].row_bytes)
+      throw Error(fmt::format("{}: internal error: a row of {} has {} values", path_, row.name, n));
+    for (hsize_t first = 0; first < layout[r].rows; first += layout[r].rows_per_chunk)
+      jobs.push_back({r, first, {}});
+  }
+  // Each chunk is deflated into its own buffer; an edge chunk (past the
+  // dataset's end) is padded with zeros to the whole chunk, as HDF5 stores it.
+#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, threads))
+  for (std::size_t k = 0; k < jobs.size(); ++k) {
+    Job& job = jobs[k];
+    const RowChunks& c = layout[job.row];
+    const SlabRow& row = rows[job.row];
+    const unsigned char* data = row.doubles ? reinterpret_cast<const unsigned char*>(row.doubles->data())
+                                            : reinterpret_cast<const unsigned char*>(row.words->data());
+    const std::size_t chunk_bytes = c.rows_per_chunk * c.row_bytes;
+    const std::size_t valid = std::min(c.rows - job.first, c.rows_per_chunk) * c.row_bytes;
+    std::vector<unsigned char> plain(chunk_bytes, 0);
+    std::memcpy(plain.data(), data + job.first * c.row_bytes, valid);
+    uLongf size = compressBound(chunk_bytes);
+    job.bytes.resize(size);
+    job.status = compress2(job.bytes.data(), &size, plain.data(), chunk_bytes, c.level);
+    job.bytes.resize(size);
+  }
+  for (const Job& job : jobs) {
+    const SlabRow& row = rows[job.row];
+    if (job.status != Z_OK)
+      throw Error(fmt::format("{}: zlib error {} compressing {}", path_, job.status, row.name));
+    Dims offset(3, 0);
+    offset[0] = row.i;
+    offset[1] = row.j;
+    offset[2] = job.first;
+    Handle space = checked(H5Dget_space(layout[job.row].set.id()), H5Sclose, "dataspace of " + row.name, path_);
+    offset.resize(H5Sget_simple_extent_ndims(space.id()), 0);
+    errno = 0;
+    check_write(H5Dwrite_chunk(layout[job.row].set.id(), H5P_DEFAULT, 0, offset.data(),
+                               job.bytes.size(), job.bytes.data()),
+                handle_.id(), "cannot write " + row.name, path_);
+  }
+  for (std::size_t r = 0; r < rows.size(); ++r)
+    if (layout[r].direct)
+      check_write(H5Dflush(layout[r].set.id()), handle_.id(), "cannot write " + rows[r].name, path_);
 }
 
 void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data) {

@@ -77,6 +77,18 @@ class File {
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data);
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
                       const std::vector<std::uint64_t>& data);
+  // Several such rows at once, their chunks deflated on `threads` threads
+  // and stored as they are (H5Dwrite_chunk): the same zlib streams HDF5's
+  // deflate filter would store, so readers see no difference. A dataset
+  // whose chunks are not whole rows deflated alone (or a big-endian machine)
+  // is written through write_slab_row instead.
+  struct SlabRow {
+    std::string name;
+    hsize_t i, j;
+    const std::vector<double>* doubles = nullptr;      // one of the two
+    const std::vector<std::uint64_t>* words = nullptr;
+  };
+  void write_slab_rows(const std::vector<SlabRow>& rows, int threads);
   std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;
   std::vector<std::uint64_t> read_slab_uint64s(const std::string& name, hsize_t i) const;
   Dims dims(const std::string& name) const;  // of a dataset

@@ -88,8 +88,9 @@ void ResultWriter::write(std::size_t k, const Tally& t) {
 }
 
 // One direction, a lobe at a time: a lobe is a whole number of chunks of the
-// bin datasets (h5::File's chunking), so each is compressed once. Counts
-// (whose chunks span lobes) are gathered and written once per direction.
+// bin datasets (h5::File's chunking), each deflated once, the lobe's chunks
+// on the writer's threads. Counts (whose chunks span lobes) are gathered and
+// written once per direction.
 void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
                                    const ExactLedger& ledger, const LobeSource& lobe_of) {
   if (!(shape == shape_) || k >= photons_.size())
@@ -101,8 +102,16 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   for (int l = 0; l < shape_.lobes; ++l) {
     lobe_of(l, lobe_);
     std::copy(lobe_.count.begin(), lobe_.count.end(), counts_.begin() + l * per_lobe);
-    write_lobe("/tally/weight_sum", "/exact/weight_sum", k, l, lobe_.weight_sum);
-    write_lobe("/tally/weight_sq_sum", "/exact/weight_sq_sum", k, l, lobe_.weight_sq_sum);
+    ExactTally::to_double(lobe_.weight_sum, sum_doubles_);
+    ExactTally::to_double(lobe_.weight_sq_sum, sq_doubles_);
+    ExactTally::to_pairs(lobe_.weight_sum, sum_pairs_);
+    ExactTally::to_pairs(lobe_.weight_sq_sum, sq_pairs_);
+    const hsize_t lobe = static_cast<hsize_t>(l);
+    f.write_slab_rows({{"/tally/weight_sum", k, lobe, &sum_doubles_, nullptr},
+                       {"/tally/weight_sq_sum", k, lobe, &sq_doubles_, nullptr},
+                       {"/exact/weight_sum", k, lobe, nullptr, &sum_pairs_},
+                       {"/exact/weight_sq_sum", k, lobe, nullptr, &sq_pairs_}},
+                      threads_);
   }
   f.write_slab("/tally/count", k, counts_);
   f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
@@ -113,14 +122,6 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(ledger.absorbed));
   f.write_slab("/exact/truncated", k, ExactTally::to_pairs(ledger.truncated));
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
-}
-
-void ResultWriter::write_lobe(const char* float_name, const char* exact_name, std::size_t k,
-                              int lobe, const std::vector<ExactTally::Word>& sums) {
-  ExactTally::to_double(sums, doubles_);
-  file_->write_slab_row(float_name, k, static_cast<hsize_t>(lobe), doubles_);
-  ExactTally::to_pairs(sums, pairs_);
-  file_->write_slab_row(exact_name, k, static_cast<hsize_t>(lobe), pairs_);
 }
 
 void ResultWriter::commit() {

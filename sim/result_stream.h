@@ -38,14 +38,14 @@ class ResultWriter {
   void write(std::size_t k, const ExactTally& t);
   void write(std::size_t k, const Tally& t);
   h5::File& file() { return *file_; }              // for extra groups (checkpoints)
+  // Threads that deflate the bin datasets' chunks (1 unless set).
+  void set_compression_threads(int threads) { threads_ = threads; }
   void commit();  // writes /tally/photons, closes, renames into place
 
  private:
   using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
                        const LobeSource& lobe_of);
-  void write_lobe(const char* float_name, const char* exact_name, std::size_t k, int lobe,
-                  const std::vector<ExactTally::Word>& sums);
 
   AtomicOutput out_;
   std::optional<h5::File> file_;
@@ -54,8 +54,9 @@ class ResultWriter {
   // Buffers reused across lobes and directions: fresh memory costs a page
   // fault per 4 KiB, which on these machines cost more than the writing.
   ExactLobe lobe_;
-  std::vector<std::uint64_t> counts_, pairs_;
-  std::vector<double> doubles_;
+  std::vector<std::uint64_t> counts_, sum_pairs_, sq_pairs_;
+  std::vector<double> sum_doubles_, sq_doubles_;
+  int threads_ = 1;
 };
 
 // Writes a whole run (one ExactTally per direction) atomically.
