@@ -34,7 +34,7 @@ struct Pool {
   };
   enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
   // W spare lanes past the end: new photons are written a whole vector at a
-  // time from any lane (Pool::launch_state).
+  // time from any lane (launch_vector in BatchTracer::trace_with).
   static constexpr int kLanes = kPoolLanes + W;
   alignas(64) double col[kColumns][kLanes];
   alignas(64) std::uint64_t bits[kBitColumns][kLanes];
