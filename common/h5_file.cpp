@@ -4,7 +4,7 @@
 
 #include <fcntl.h>
 #include <unistd.h>
-#include <zlib.h>
+#include <libdeflate.h>
 
 #include <algorithm>
 #include <bit>
@@ -509,7 +509,7 @@ void File::write_slab_rows(const std::vector<SlabRow>& rows, int threads) {
     std::size_t row;
     hsize_t first;  // along the third dimension
     std::vector<unsigned char> bytes;
-    int status = Z_OK;
+    bool ok = false;
   };
   std::vector<RowChunks> layout(rows.size());
   std::vector<Job> jobs;
@@ -526,28 +526,42 @@ void File::write_slab_rows(const std::vector<SlabRow>& rows, int threads) {
     for (hsize_t first = 0; first < layout[r].rows; first += layout[r].rows_per_chunk)
       jobs.push_back({r, first, {}});
   }
-  // Each chunk is deflated into its own buffer; an edge chunk (past the
+  // Each chunk is deflated into its own buffer (libdeflate: the zlib stream
+  // format HDF5's filter reads; measured faster than zlib's own compressor,
+  // README "Performance"), one compressor per thread; an edge chunk (past the
   // dataset's end) is padded with zeros to the whole chunk, as HDF5 stores it.
-#pragma omp parallel for schedule(dynamic) num_threads(std::max(1, threads))
-  for (std::size_t k = 0; k < jobs.size(); ++k) {
-    Job& job = jobs[k];
-    const RowChunks& c = layout[job.row];
-    const SlabRow& row = rows[job.row];
-    const unsigned char* data = row.doubles ? reinterpret_cast<const unsigned char*>(row.doubles->data())
-                                            : reinterpret_cast<const unsigned char*>(row.words->data());
-    const std::size_t chunk_bytes = c.rows_per_chunk * c.row_bytes;
-    const std::size_t valid = std::min(c.rows - job.first, c.rows_per_chunk) * c.row_bytes;
-    std::vector<unsigned char> plain(chunk_bytes, 0);
-    std::memcpy(plain.data(), data + job.first * c.row_bytes, valid);
-    uLongf size = compressBound(chunk_bytes);
-    job.bytes.resize(size);
-    job.status = compress2(job.bytes.data(), &size, plain.data(), chunk_bytes, c.level);
-    job.bytes.resize(size);
+#pragma omp parallel num_threads(std::max(1, threads))
+  {
+    libdeflate_compressor* z = nullptr;
+    int z_level = -1;
+#pragma omp for schedule(dynamic)
+    for (std::size_t k = 0; k < jobs.size(); ++k) {
+      Job& job = jobs[k];
+      const RowChunks& c = layout[job.row];
+      const SlabRow& row = rows[job.row];
+      if (c.level != z_level) {
+        if (z) libdeflate_free_compressor(z);
+        z = libdeflate_alloc_compressor(c.level);
+        z_level = c.level;
+      }
+      if (!z) continue;  // job.ok stays false
+      const unsigned char* data = row.doubles ? reinterpret_cast<const unsigned char*>(row.doubles->data())
+                                              : reinterpret_cast<const unsigned char*>(row.words->data());
+      const std::size_t chunk_bytes = c.rows_per_chunk * c.row_bytes;
+      const std::size_t valid = std::min(c.rows - job.first, c.rows_per_chunk) * c.row_bytes;
+      std::vector<unsigned char> plain(chunk_bytes, 0);
+      std::memcpy(plain.data(), data + job.first * c.row_bytes, valid);
+      job.bytes.resize(libdeflate_zlib_compress_bound(z, chunk_bytes));
+      const std::size_t size =
+          libdeflate_zlib_compress(z, plain.data(), chunk_bytes, job.bytes.data(), job.bytes.size());
+      job.bytes.resize(size);
+      job.ok = size > 0;
+    }
+    if (z) libdeflate_free_compressor(z);
   }
   for (const Job& job : jobs) {
     const SlabRow& row = rows[job.row];
-    if (job.status != Z_OK)
-      throw Error(fmt::format("{}: zlib error {} compressing {}", path_, job.status, row.name));
+    if (!job.ok) throw Error(fmt::format("{}: cannot compress {} (libdeflate)", path_, row.name));
     Dims offset(3, 0);
     offset[0] = row.i;
     offset[1] = row.j;

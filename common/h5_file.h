@@ -78,10 +78,10 @@ class File {
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
                       const std::vector<std::uint64_t>& data);
   // Several such rows at once, their chunks deflated on `threads` threads
-  // and stored as they are (H5Dwrite_chunk): the same zlib streams HDF5's
-  // deflate filter would store, so readers see no difference. A dataset
-  // whose chunks are not whole rows deflated alone (or a big-endian machine)
-  // is written through write_slab_row instead.
+  // (libdeflate, at the dataset's deflate level) and stored as they are
+  // (H5Dwrite_chunk): zlib-format streams, which HDF5's deflate filter reads
+  // like its own. A dataset whose chunks are not whole rows deflated alone
+  // (or a big-endian machine) is written through write_slab_row instead.
   struct SlabRow {
     std::string name;
     hsize_t i, j;

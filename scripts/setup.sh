@@ -6,7 +6,7 @@ cd "$(dirname "$0")/.."
 
 packages=(
   build-essential cmake pkg-config ccache
-  libeigen3-dev libhdf5-dev zlib1g-dev libyaml-cpp-dev libcli11-dev libfmt-dev libxsimd-dev
+  libeigen3-dev libhdf5-dev libdeflate-dev libyaml-cpp-dev libcli11-dev libfmt-dev libxsimd-dev
   googletest libgtest-dev libbenchmark-dev libboost-dev libboost-math-dev
   python3 python3-dev python3-h5py python3-numpy python3-matplotlib
   pybind11-dev python3-pybind11 python3-pytest python3-pandas
