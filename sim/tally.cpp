@@ -84,15 +84,10 @@ void Tally::add(const Tally& o) {
 
 ExactTally Tally::exact() const {
   ExactTally e(shape());
-  ExactLobe lobe;
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
-  for (int l = 0; l < lobes_; ++l) {
-    exact_lobe(l, lobe);
-    std::copy(lobe.count.begin(), lobe.count.end(), e.count.begin() + l * per_lobe);
-    std::copy(lobe.weight_sum.begin(), lobe.weight_sum.end(), e.weight_sum.begin() + l * per_lobe * C);
-    std::copy(lobe.weight_sq_sum.begin(), lobe.weight_sq_sum.end(),
-              e.weight_sq_sum.begin() + l * per_lobe * C);
-  }
+  for (int l = 0; l < lobes_; ++l)
+    copy_lobe(l, e.count.data() + l * per_lobe, e.weight_sum.data() + l * per_lobe * C,
+              e.weight_sq_sum.data() + l * per_lobe * C);
   ExactLedger ledger = exact_ledger();
   e.photons = ledger.photons;
   e.exited = std::move(ledger.exited);
@@ -107,14 +102,20 @@ void Tally::exact_lobe(int l, ExactLobe& out) const {
   out.count.assign(per_lobe, 0);
   out.weight_sum.assign(per_lobe * C, 0);
   out.weight_sq_sum.assign(per_lobe * C, 0);
+  copy_lobe(l, out.count.data(), out.weight_sum.data(), out.weight_sq_sum.data());
+}
+
+// Lobe l's touched bins into zeroed arrays ([theta][phi], [theta][phi][channel]).
+void Tally::copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const {
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
   const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
   for (std::size_t i = 0; i < per_lobe; ++i) {
-    if (!touched_[(first + i) / kPageBins]) continue;  // zero, as out starts
+    if (!touched_[(first + i) / kPageBins]) continue;  // zero, as the arrays start
     const Fixed* cell = cells() + (first + i) * block();
-    out.count[i] = static_cast<std::uint64_t>(cell[0]);
+    count[i] = static_cast<std::uint64_t>(cell[0]);
     for (std::size_t c = 0; c < C; ++c) {
-      out.weight_sum[i * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
-      out.weight_sq_sum[i * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
+      s1[i * C + c] = static_cast<ExactTally::Word>(cell[1 + c]);
+      s2[i * C + c] = static_cast<ExactTally::Word>(cell[1 + C + c]);
     }
   }
 }
