@@ -6,36 +6,14 @@
 // the tracers use instead (make_roughness in sim/roughness_models.h).
 //
 // The sampler: one exact rejection sampler for every incidence, with the same
-// work for every candidate (a fixed block of five uniforms, one log, one
-// square root, three sine-cosine pairs, sim/life_trig.h), so that a SIMD vector of photons never waits
-// on a branch only some of its lanes take.
-//
-// The target density of the offsets is G(x) max(0, -d.m) with x = (dl /
-// beta_long, da / beta_azim) standard normal in the plane (density phi(x)).
-// A bound on -d.m: m is n_f moved by an angle delta along the sphere, and
-// the straight path in (inclination, azimuth about u) has length
-// integral sqrt(dl^2 + cos^2(t) da^2) <= sqrt(dl^2 + da^2) <= b rho, with
-// rho = |x| and b = max(beta_long, beta_azim). With c0 = -d.n_f = cos(gamma),
-// gamma the angle between -d and n_f, -d.m <= cos(max(0, gamma - delta)), so
-//   -d.m <= c + delta <= c + b rho,
-// where c = c0 when c0 >= 0 (the cosine is 1-Lipschitz) and c = -eps =
-// asin(c0) when n_f faces away by eps (gamma = pi/2 + eps: -d.m <=
-// sin(delta - eps) <= delta - eps; the tighter bound matters in the tail).
-// With w = rho^2 / 2 (d^2x = dw dpsi, psi the direction of x, uniform) and
-// sqrt(2w) <= k/2 + w/k (any k > 0; equality at rho = k):
-//   -d.m <= A + B w,   A = c + b k / 2,   B = b / k.
-// So propose x with density ~ phi(x) (A + B w)+ and accept with probability
-// max(0, -d.m) / (A + B w): exact, the tail included. In w the proposal is
-// e^-w (A + B w) on w >= w0 = max(0, -A / B): w = w0 + E, where E has
-// density ~ e^-E (A0 + B E), A0 = A + B w0 >= 0, a mixture of Exp(1)
-// (weight A0) and Gamma(2, 1) (weight B): E = -log(u1) or -log(u1 u2).
-// k: the envelope's mass is e^-w0 (A0 + B); k = sqrt 2 minimises it when
-// w0 = 0, k = (rho0 + sqrt(rho0^2 + 4)) / 2 when n_f faces away from the
-// photon by rho0 = -c / b > 1/sqrt 2 (then every visible normal is in the
-// tail). When the envelope's mass is >= 1 the plain proposal (A, B) = (1, 0)
-// (x from phi, accept with probability -d.m) is used instead.
+// work for every candidate (a fixed block of five uniforms, one log, two
+// square roots, three sine-cosine pairs, sim/life_trig.h), so that a SIMD
+// vector of photons never waits on a branch only some of its lanes take. Its
+// proposal, and the proof that it bounds the target, is in
+// sim/gaussian_envelope.h.
 #include <optional>
 
+#include "sim/gaussian_envelope.h"
 #include "sim/life_trig.h"
 #include "sim/roughness_model.h"
 #include "sim/settings.h"
@@ -45,7 +23,7 @@ namespace fiberlab::sim::life {
 class GaussianRoughness {
  public:
   GaussianRoughness(double beta_long, double beta_azim)
-      : beta_long_(beta_long), beta_azim_(beta_azim), b_(std::max(beta_long, beta_azim)) {}
+      : beta_long_(beta_long), beta_azim_(beta_azim) {}
   explicit GaussianRoughness(const Settings& s)
       : GaussianRoughness(s.roughness.beta_long.front(), s.roughness.beta_azim.front()) {}
 
@@ -56,7 +34,8 @@ class GaussianRoughness {
     // n_f = sin(theta_n) u + cos(theta_n) (0, pv, pw).
     const T sin_n = frame.sin_n, cos_n = frame.cos_n;
     const T pv = frame.untilted_facing.y, pw = frame.untilted_facing.z;
-    const Envelope<T> env = envelope(-d.dot(frame.facing));
+    const GaussianEnvelope<T> env = gaussian_envelope(-d, frame, beta_long_, beta_azim_);
+    const T a_end = env.a_end(), lobe_end = env.lobe_end(), mass = env.mass();
     FacetDraw<T> out{Vec3Of<T>(T(0.0), T(0.0), T(0.0)), MaskOf<T>(false), MaskOf<T>(false)};
     MaskOf<T> pending = live;
     for (int k = 0; k < rounds && any(pending); ++k) {
@@ -64,15 +43,18 @@ class GaussianRoughness {
       tries = tries + ones<T>(pending);
       const auto [u_pick, u1_closed, u2_closed, u_psi, u_accept] = rng.template uniforms<5>(pending);
       const T u1 = LaneRandom<T>::open0(u1_closed), u2 = LaneRandom<T>::open0(u2_closed);
-      const MaskOf<T> gamma2 = u_pick * (env.a0 + env.b) < env.b;
+      // The part: a flat, a lobe, b lobe, b flat (sim/gaussian_envelope.h).
+      const T pick = u_pick * mass;
+      const MaskOf<T> gamma2 = pick >= a_end;
+      const MaskOf<T> lobe = (pick >= env.a_flat) & (pick < lobe_end);
       const T e = -log(u1 * select(gamma2, u2, T(1.0)));
       const T rho = sqrt(T(2.0) * (env.w0 + e));
-      const auto [sp, cp] = sincos_turn(u_psi);
-      const Vec3Of<T> m =
-          rotated_normal(sin_n, cos_n, pv, pw, T(beta_long_) * rho * cp, T(beta_azim_) * rho * sp);
+      const Direction<T> dir = direction(env, lobe, u_psi);
+      const Vec3Of<T> m = rotated_normal(sin_n, cos_n, pv, pw, T(beta_long_) * rho * dir.cos,
+                                         T(beta_azim_) * rho * dir.sin);
       const T visible = -d.dot(m);
       const MaskOf<T> accepted =
-          pending & (visible > T(0.0)) & (u_accept * (env.a0 + env.b * e) < visible);
+          pending & (visible > T(0.0)) & (u_accept * env.at(e, dir.c_plus) < visible);
       out.m = select(accepted, m, out.m);
       out.ready = out.ready | accepted;
       pending = pending & !accepted;
@@ -85,25 +67,24 @@ class GaussianRoughness {
   }
 
  private:
-  // The proposal e^-E (a0 + b E) on w = w0 + E of the comment above.
+  // The offsets' direction psi, and c+ = max(0, cos(psi - psi_h)).
   template <class T>
-  struct Envelope {
-    T a0, b, w0;
+  struct Direction {
+    T cos, sin, c_plus;
   };
+  // Uniform from u (the flat parts), or with density cos(psi - psi_h) / 2
+  // on the half plane around psi_h (the lobe parts): sin(psi - psi_h) = 2 u - 1.
   template <class T>
-  Envelope<T> envelope(const T& c0) const {
-    constexpr double kSqrt2 = 1.4142135623730951;
-    const MaskOf<T> away = c0 < T(0.0);
-    const T c = any(away) ? select(away, asin(max(T(-1.0), c0)), c0) : c0;
-    const T rho0 = max(T(0.0), -c) * T(1.0 / b_);
-    const MaskOf<T> tail = rho0 > T(1.0 / kSqrt2);
-    const T k = select(tail, T(0.5) * (rho0 + sqrt(rho0 * rho0 + T(4.0))), T(kSqrt2));
-    const T inv_k = select(tail, k - rho0, T(1.0 / kSqrt2));  // k^2 - rho0 k - 1 = 0
-    const T a = c + T(0.5 * b_) * k, b = T(b_) * inv_k;
-    const T w0 = max(T(0.0), -a * k * T(1.0 / b_));
-    const T a0 = max(T(0.0), a);
-    const MaskOf<T> plain = (w0 == T(0.0)) & (a0 + b >= T(1.0));
-    return {select(plain, T(1.0), a0), select(plain, T(0.0), b), w0};
+  static Direction<T> direction(const GaussianEnvelope<T>& env, const MaskOf<T>& lobe,
+                                const T& u) {
+    const auto [s_flat, c_flat] = sincos_turn(u);
+    const T s_rel = T(2.0) * u - T(1.0);
+    const T c_rel = sqrt((T(1.0) - s_rel) * (T(1.0) + s_rel));
+    const T c_lobe = env.h_cos * c_rel - env.h_sin * s_rel;
+    const T s_lobe = env.h_sin * c_rel + env.h_cos * s_rel;
+    const T c_plus_flat = max(T(0.0), env.h_cos * c_flat + env.h_sin * s_flat);
+    return {select(lobe, c_lobe, c_flat), select(lobe, s_lobe, s_flat),
+            select(lobe, c_rel, c_plus_flat)};
   }
 
   // m for a longitudinal offset dl and an azimuthal offset da (SPEC section
@@ -118,7 +99,7 @@ class GaussianRoughness {
     return {st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
   }
 
-  double beta_long_, beta_azim_, b_;
+  double beta_long_, beta_azim_;
 };
 
 }  // namespace fiberlab::sim::life
