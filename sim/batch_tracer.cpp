@@ -22,7 +22,7 @@ constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many candidate normals per step; lanes
 // still without a normal go on at the next step (see sim/roughness_model.h).
-constexpr int kRoundsPerStep = 2;
+constexpr int kRoundsPerStep = 1;
 
 // The photons in flight, structure of arrays: one column per number of
 // PhotonState (the Stokes columns used by polarised light only).
