@@ -47,7 +47,8 @@
 // for every x, psi_h the direction of h. With rho <= k/2 + w/k (k = sqrt 2,
 // the k that minimises the mass):
 //   a_flat = c0+, a_lobe = |h| k/2, b_lobe = |h| / k,
-//   b_flat = (2 s0 K + c0-) b^2, w0 = 0.
+//   b_flat = (2 s K + c0-) b^2, w0 = 0,
+// with s = 1 - c0^2 / 2 >= s0 = sqrt(1 - c0^2) (|v| = 1; saves a root).
 // It follows the first-order change of v.m, which only h's direction
 // raises: at grazing incidence (c0 -> 0) with beta 5 deg about 0.7 of its
 // candidates are accepted, against 0.3 for the radial envelope.
@@ -100,49 +101,72 @@ struct GaussianEnvelope {
 // with frame `frame` (the comment above), for roughness widths beta_long and
 // beta_azim (radians).
 template <class T>
-GaussianEnvelope<T> gaussian_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame,
-                                      double beta_long, double beta_azim) {
-  constexpr double kSqrt2 = 1.4142135623730951;
-  const double b = std::max(beta_long, beta_azim);
-  const T zero(0.0), one(1.0);
-  const T c0 = v.dot(frame.facing);
+struct RadialEnvelope {
+  T a, slope, w0;  // env = a + slope E on w = w0 + E
+};
 
-  // The radial envelope.
+// The radial envelope (the comment above).
+template <class T>
+RadialEnvelope<T> radial_envelope(const T& c0, double b) {
+  constexpr double kSqrt2 = 1.4142135623730951;
+  const T zero(0.0);
   const MaskOf<T> away = c0 < zero;
-  const T c = any(away) ? select(away, asin(max(T(-1.0), c0)), c0) : c0;
+  // No lane facing away: k = sqrt 2 and w0 = 0 (the same operations as below).
+  if (!any(away)) return {c0 + T(0.5 * b) * T(kSqrt2), T(b) * T(1.0 / kSqrt2), zero};
+  const T c = select(away, asin(max(T(-1.0), c0)), c0);
   const T rho0 = max(zero, -c) * T(1.0 / b);
   const MaskOf<T> tail = rho0 > T(1.0 / kSqrt2);
   const T k = select(tail, T(0.5) * (rho0 + sqrt(rho0 * rho0 + T(4.0))), T(kSqrt2));
   const T inv_k = select(tail, k - rho0, T(1.0 / kSqrt2));  // k^2 - rho0 k - 1 = 0
-  const T a = c + T(0.5 * b) * k, slope = T(b) * inv_k;
+  const T a = c + T(0.5 * b) * k;
   const T w0 = max(zero, -a * k * T(1.0 / b));
-  const T radial_a = max(zero, a);
+  return {max(zero, a), T(b) * inv_k, w0};
+}
 
-  // The lobe envelope: v's parts along e_l and q, and h.
+// The lobe envelope (the comment above).
+template <class T>
+GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame, const T& c0,
+                                  double beta_long, double beta_azim) {
+  constexpr double kSqrt2 = 1.4142135623730951;
+  const double b = std::max(beta_long, beta_azim);
+  const T zero(0.0), one(1.0);
+  // v's parts along e_l and q, and h.
   const Vec3Of<T>& p = frame.untilted_facing;  // (0, p.y, p.z)
   const T v_p = v.y * p.y + v.z * p.z;
   const T g_l = frame.cos_n * v.x - frame.sin_n * v_p;
   const T g_a = v.z * p.y - v.y * p.z;  // v.q, q = u x p = (0, -p.z, p.y)
   const T h1 = g_l * T(beta_long), h2 = g_a * frame.cos_n * T(beta_azim);
   const T h = sqrt(h1 * h1 + h2 * h2);
-  const T s0 = sqrt(g_l * g_l + g_a * g_a);
+  const T s = one - T(0.5) * c0 * c0;
   const T quad = T(0.51) + T(0.81) * abs(frame.sin_n);  // K
-  GaussianEnvelope<T> lobe{max(zero, c0), h * T(0.5 * kSqrt2), h * T(1.0 / kSqrt2),
-                           T(b * b) * (T(2.0) * s0 * quad + max(zero, -c0)), zero, one, zero};
   const MaskOf<T> has_h = h > zero;
   const T inv_h = one / select(has_h, h, one);
-  lobe.h_cos = select(has_h, h1 * inv_h, one);
-  lobe.h_sin = select(has_h, h2 * inv_h, zero);
+  return {max(zero, c0),
+          h * T(0.5 * kSqrt2),
+          h * T(1.0 / kSqrt2),
+          T(b * b) * (T(2.0) * s * quad + max(zero, -c0)),
+          zero,
+          select(has_h, h1 * inv_h, one),
+          select(has_h, h2 * inv_h, zero)};
+}
 
+// The envelope for a photon with reversed direction v at a boundary point
+// with frame `frame` (the comment above), for roughness widths beta_long and
+// beta_azim (radians).
+template <class T>
+GaussianEnvelope<T> gaussian_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame,
+                                      double beta_long, double beta_azim) {
+  const T zero(0.0), one(1.0);
+  const T c0 = v.dot(frame.facing);
+  const RadialEnvelope<T> radial = radial_envelope(c0, std::max(beta_long, beta_azim));
+  GaussianEnvelope<T> env = lobe_envelope(v, frame, c0, beta_long, beta_azim);
   // Where the radial envelope starts at w0 = 0 the masses compare directly.
-  const MaskOf<T> use_lobe = (w0 == zero) & (lobe.mass() < radial_a + slope);
-  GaussianEnvelope<T> env{select(use_lobe, lobe.a_flat, radial_a),
-                          select(use_lobe, lobe.a_lobe, zero),
-                          select(use_lobe, lobe.b_lobe, zero),
-                          select(use_lobe, lobe.b_flat, slope),
-                          select(use_lobe, zero, w0),
-                          lobe.h_cos,
-                          lobe.h_sin};
+  const MaskOf<T> use_radial = (radial.w0 > zero) | (radial.a + radial.slope <= env.mass());
+  env.a_flat = select(use_radial, radial.a, env.a_flat);
+  env.a_lobe = select(use_radial, zero, env.a_lobe);
+  env.b_lobe = select(use_radial, zero, env.b_lobe);
+  env.b_flat = select(use_radial, radial.slope, env.b_flat);
+  env.w0 = select(use_radial, radial.w0, zero);
   // The plain proposal when the envelope's mass is 1 or more.
   const MaskOf<T> plain = (env.w0 == zero) & (env.mass() >= one);
   env.a_flat = select(plain, one, env.a_flat);
