@@ -62,7 +62,10 @@
 //   v.m <= c + delta <= c + b rho,
 // where c = c0 when c0 >= 0 (the cosine is 1-Lipschitz) and c = -eps =
 // asin(c0) when n_f faces away by eps (gamma = pi/2 + eps: v.m <=
-// sin(delta - eps) <= delta - eps; the tighter bound matters in the tail).
+// sin(delta - eps) <= delta - eps). asin(c0) <= c0 there, so c = c0 is a
+// valid, looser choice: it is taken while eps <= b / sqrt 2 (asin's cost
+// buys nothing there: the envelope starts at w0 = 0 either way, and the
+// lobe envelope is usually chosen), asin(c0) beyond, in the tail.
 // With sqrt(2w) <= k/2 + w/k (any k > 0; equality at rho = k):
 //   v.m <= A + B w,   A = c + b k / 2,   B = b / k,
 // positive from w0 = max(0, -A / B) on: a_flat = A0 = A + B w0, b_flat = B,
@@ -110,10 +113,11 @@ template <class T>
 RadialEnvelope<T> radial_envelope(const T& c0, double b) {
   constexpr double kSqrt2 = 1.4142135623730951;
   const T zero(0.0);
-  const MaskOf<T> away = c0 < zero;
-  // No lane facing away: k = sqrt 2 and w0 = 0 (the same operations as below).
-  if (!any(away)) return {c0 + T(0.5 * b) * T(kSqrt2), T(b) * T(1.0 / kSqrt2), zero};
-  const T c = select(away, asin(max(T(-1.0), c0)), c0);
+  // In the tail: eps > b / sqrt 2, where rho0 below exceeds 1 / sqrt 2.
+  const MaskOf<T> deep = c0 < T(-std::sin(b / kSqrt2));
+  // No lane in the tail: k = sqrt 2 and w0 = 0 (the same operations as below).
+  if (!any(deep)) return {c0 + T(0.5 * b) * T(kSqrt2), T(b) * T(1.0 / kSqrt2), zero};
+  const T c = select(deep, asin(max(T(-1.0), c0)), c0);
   const T rho0 = max(zero, -c) * T(1.0 / b);
   const MaskOf<T> tail = rho0 > T(1.0 / kSqrt2);
   const T k = select(tail, T(0.5) * (rho0 + sqrt(rho0 * rho0 + T(4.0))), T(kSqrt2));
