@@ -77,6 +77,9 @@
 // tests/sim/test_gaussian_envelope.cpp checks env >= v.m over random
 // frames, betas and offsets; tests/sim/test_gaussian_normal.cpp checks the
 // sampled normals against the definition.
+#include <algorithm>
+#include <cmath>
+
 #include "sim/lanes.h"
 #include "sim/roughness_model.h"
 
@@ -103,6 +106,19 @@ struct GaussianEnvelope {
 // The envelope for a photon with reversed direction v at a boundary point
 // with frame `frame` (the comment above), for roughness widths beta_long and
 // beta_azim (radians).
+// The roughness widths (radians) and what the envelopes derive from them,
+// computed once per model.
+struct EnvelopeWidths {
+  EnvelopeWidths(double beta_long_, double beta_azim_)
+      : beta_long(beta_long_),
+        beta_azim(beta_azim_),
+        b(std::max(beta_long_, beta_azim_)),
+        tail_c0(-std::sin(b / 1.4142135623730951)) {}
+  double beta_long, beta_azim;
+  double b;        // the larger beta
+  double tail_c0;  // c0 below which n_f faces away by more than b / sqrt 2
+};
+
 template <class T>
 struct RadialEnvelope {
   T a, slope, w0;  // env = a + slope E on w = w0 + E
@@ -110,11 +126,12 @@ struct RadialEnvelope {
 
 // The radial envelope (the comment above).
 template <class T>
-RadialEnvelope<T> radial_envelope(const T& c0, double b) {
+RadialEnvelope<T> radial_envelope(const T& c0, const EnvelopeWidths& widths) {
   constexpr double kSqrt2 = 1.4142135623730951;
+  const double b = widths.b;
   const T zero(0.0);
   // In the tail: eps > b / sqrt 2, where rho0 below exceeds 1 / sqrt 2.
-  const MaskOf<T> deep = c0 < T(-std::sin(b / kSqrt2));
+  const MaskOf<T> deep = c0 < T(widths.tail_c0);
   // No lane in the tail: k = sqrt 2 and w0 = 0 (the same operations as below).
   if (!any(deep)) return {c0 + T(0.5 * b) * T(kSqrt2), T(b) * T(1.0 / kSqrt2), zero};
   const T c = select(deep, asin(max(T(-1.0), c0)), c0);
@@ -130,9 +147,9 @@ RadialEnvelope<T> radial_envelope(const T& c0, double b) {
 // The lobe envelope (the comment above).
 template <class T>
 GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame, const T& c0,
-                                  double beta_long, double beta_azim) {
+                                  const EnvelopeWidths& widths) {
   constexpr double kSqrt2 = 1.4142135623730951;
-  const double b = std::max(beta_long, beta_azim);
+  const double beta_long = widths.beta_long, beta_azim = widths.beta_azim, b = widths.b;
   const T zero(0.0), one(1.0);
   // v's parts along e_l and q, and h.
   const Vec3Of<T>& p = frame.untilted_facing;  // (0, p.y, p.z)
@@ -155,15 +172,14 @@ GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& fr
 }
 
 // The envelope for a photon with reversed direction v at a boundary point
-// with frame `frame` (the comment above), for roughness widths beta_long and
-// beta_azim (radians).
+// with frame `frame` (the comment above), for the roughness widths `widths`.
 template <class T>
 GaussianEnvelope<T> gaussian_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame,
-                                      double beta_long, double beta_azim) {
+                                      const EnvelopeWidths& widths) {
   const T zero(0.0), one(1.0);
   const T c0 = v.dot(frame.facing);
-  const RadialEnvelope<T> radial = radial_envelope(c0, std::max(beta_long, beta_azim));
-  GaussianEnvelope<T> env = lobe_envelope(v, frame, c0, beta_long, beta_azim);
+  const RadialEnvelope<T> radial = radial_envelope(c0, widths);
+  GaussianEnvelope<T> env = lobe_envelope(v, frame, c0, widths);
   // Where the radial envelope starts at w0 = 0 the masses compare directly.
   const MaskOf<T> use_radial = (radial.w0 > zero) | (radial.a + radial.slope <= env.mass());
   env.a_flat = select(use_radial, radial.a, env.a_flat);

@@ -23,7 +23,7 @@ namespace fiberlab::sim::life {
 class GaussianRoughness {
  public:
   GaussianRoughness(double beta_long, double beta_azim)
-      : beta_long_(beta_long), beta_azim_(beta_azim) {}
+      : beta_long_(beta_long), beta_azim_(beta_azim), widths_(beta_long, beta_azim) {}
   explicit GaussianRoughness(const Settings& s)
       : GaussianRoughness(s.roughness.beta_long.front(), s.roughness.beta_azim.front()) {}
 
@@ -34,7 +34,7 @@ class GaussianRoughness {
     // n_f = sin(theta_n) u + cos(theta_n) (0, pv, pw).
     const T sin_n = frame.sin_n, cos_n = frame.cos_n;
     const T pv = frame.untilted_facing.y, pw = frame.untilted_facing.z;
-    const GaussianEnvelope<T> env = gaussian_envelope(-d, frame, beta_long_, beta_azim_);
+    const GaussianEnvelope<T> env = gaussian_envelope(-d, frame, widths_);
     const T a_end = env.a_end(), lobe_end = env.lobe_end(), mass = env.mass();
     FacetDraw<T> out{Vec3Of<T>(T(0.0), T(0.0), T(0.0)), MaskOf<T>(false), MaskOf<T>(false)};
     MaskOf<T> pending = live;
@@ -100,6 +100,7 @@ class GaussianRoughness {
   }
 
   double beta_long_, beta_azim_;
+  EnvelopeWidths widths_;
 };
 
 }  // namespace fiberlab::sim::life

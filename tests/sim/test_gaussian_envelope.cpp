@@ -76,7 +76,8 @@ TEST(GaussianEnvelope, BoundsTheVisibilityEverywhere) {
   for (int k = 0; k < 20000; ++k) {
     const Case c = random_case(gen);
     const GaussianEnvelope<double> env =
-        life::gaussian_envelope(Vec3Of<double>(c.v), c.frame, c.beta_long, c.beta_azim);
+        life::gaussian_envelope(Vec3Of<double>(c.v), c.frame,
+                                 life::EnvelopeWidths(c.beta_long, c.beta_azim));
     if (env.a_lobe > 0.0) ++lobe_cases;
     const double b = std::max(c.beta_long, c.beta_azim);
     for (int j = 0; j < 100; ++j) {
@@ -114,7 +115,7 @@ TEST(GaussianEnvelope, TightAtGrazingIncidence) {
     const Case c{{Vec3Of<double>(nf), Vec3Of<double>(p), std::sin(t_n), std::cos(t_n)},
                  c0 * nf + std::sqrt(1.0 - c0 * c0) * el, beta, beta};
     const GaussianEnvelope<double> env =
-        life::gaussian_envelope(Vec3Of<double>(c.v), c.frame, beta, beta);
+        life::gaussian_envelope(Vec3Of<double>(c.v), c.frame, life::EnvelopeWidths(beta, beta));
     ASSERT_GT(env.a_lobe, 0.0);
     double target = 0.0;
     const int n = 400000;
