@@ -20,9 +20,11 @@ constexpr int W = kBatchWidth;
 static_assert(W <= 8, "the hand-over reads a vector's finished flags into one 64-bit word");
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
-// A vector of lanes draws at most this many candidate normals per step; lanes
-// still without a normal go on at the next step (see sim/roughness_model.h).
-constexpr int kRoundsPerStep = 1;
+// A vector of lanes draws at most this many rounds of candidate normals per
+// step, a round after the first only while half of its lanes still wait
+// (life::another_round); lanes still without a normal go on at the next step
+// (see sim/roughness_model.h).
+constexpr int kRoundsPerStep = 8;
 
 // The photons in flight, structure of arrays: one column per number of
 // PhotonState (the Stokes columns used by polarised light only).

@@ -27,7 +27,8 @@
 // streams untouched: draw with rng.uniform(mask) masks within `live`):
 // - return m with d.m < 0 in the lanes of `ready`; lanes whose sampler gave
 //   up go in `failed` (the photon is truncated: SPEC section 3 wants none);
-// - a rejection sampler draws at most `rounds` candidates per call: lanes
+// - a rejection sampler draws at most `rounds` candidates per call, and a
+//   round after the first only while another_round(pending, slow): lanes
 //   neither ready nor failed are called again with the same inputs and
 //   continue from their own stream (count candidates in `tries`, reset it
 //   to 0 in ready or failed lanes). The scalar tracer passes rounds =
@@ -60,6 +61,16 @@ namespace fiberlab::sim::life {
 
 // Cap on candidate normals per event (SPEC section 3: at least 10,000).
 inline constexpr int kMaxNormalTries = 100000;
+
+// Whether a rejection sampler draws another round of candidates in this
+// call: one photon until it has its normal; a vector while a lane whose
+// candidates are seldom accepted (`slow`, the model's judgement) still
+// waits. A lane that is usually accepted at the next candidate is cheaper
+// to carry to the next step, whose other lanes move on, than a round for all.
+inline bool another_round(bool pending, bool /*slow*/) { return pending; }
+inline bool another_round(const MaskOf<Batch>& pending, const MaskOf<Batch>& slow) {
+  return xsimd::any(pending & slow);
+}
 
 // The macro normals of the boundary point as the photon sees them.
 template <class T>
