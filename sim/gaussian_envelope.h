@@ -126,7 +126,8 @@ struct RadialEnvelope {
 
 // The radial envelope (the comment above).
 template <class T>
-RadialEnvelope<T> radial_envelope(const T& c0, const EnvelopeWidths& widths) {
+[[gnu::always_inline]] inline RadialEnvelope<T> radial_envelope(const T& c0,
+                                                                const EnvelopeWidths& widths) {
   constexpr double kSqrt2 = 1.4142135623730951;
   const double b = widths.b;
   const T zero(0.0);
@@ -146,8 +147,10 @@ RadialEnvelope<T> radial_envelope(const T& c0, const EnvelopeWidths& widths) {
 
 // The lobe envelope (the comment above).
 template <class T>
-GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame, const T& c0,
-                                  const EnvelopeWidths& widths) {
+[[gnu::always_inline]] inline GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v,
+                                                                const BoundaryFrame<T>& frame,
+                                                                const T& c0,
+                                                                const EnvelopeWidths& widths) {
   constexpr double kSqrt2 = 1.4142135623730951;
   const double beta_long = widths.beta_long, beta_azim = widths.beta_azim, b = widths.b;
   const T zero(0.0), one(1.0);
@@ -174,8 +177,9 @@ GaussianEnvelope<T> lobe_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& fr
 // The envelope for a photon with reversed direction v at a boundary point
 // with frame `frame` (the comment above), for the roughness widths `widths`.
 template <class T>
-GaussianEnvelope<T> gaussian_envelope(const Vec3Of<T>& v, const BoundaryFrame<T>& frame,
-                                      const EnvelopeWidths& widths) {
+[[gnu::always_inline]] inline GaussianEnvelope<T> gaussian_envelope(const Vec3Of<T>& v,
+                                                                    const BoundaryFrame<T>& frame,
+                                                                    const EnvelopeWidths& widths) {
   const T zero(0.0), one(1.0);
   const T c0 = v.dot(frame.facing);
   const RadialEnvelope<T> radial = radial_envelope(c0, widths);
