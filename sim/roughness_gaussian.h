@@ -77,6 +77,7 @@ class GaussianRoughness {
   // Uniform from u (the flat parts), or with density cos(psi - psi_h) / 2
   // on the half plane around psi_h (the lobe parts): sin(psi - psi_h) = 2 u - 1.
   template <class T>
+  [[gnu::always_inline]]
   static Direction<T> direction(const GaussianEnvelope<T>& env, const MaskOf<T>& lobe,
                                 const T& u) {
     const auto [s_flat, c_flat] = sincos_turn(u);
@@ -93,6 +94,7 @@ class GaussianRoughness {
   // 3): n_f tilted to inclination theta_n + dl in its plane with u (sin and
   // cos by the angle-sum rule), then turned by da about u.
   template <class T>
+  [[gnu::always_inline]]
   static Vec3Of<T> rotated_normal(const T& sin_n, const T& cos_n, const T& pv, const T& pw,
                                   const T& dl, const T& da) {
     const auto [sl, cl] = sincos_small(dl);
