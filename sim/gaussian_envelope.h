@@ -76,7 +76,8 @@
 //
 // tests/sim/test_gaussian_envelope.cpp checks env >= v.m over random
 // frames, betas and offsets; tests/sim/test_gaussian_normal.cpp checks the
-// sampled normals against the definition.
+// sampled normals against the definition. Any choice between valid
+// envelopes is exact; the choices only change the candidates' count.
 #include <algorithm>
 #include <cmath>
 
@@ -103,9 +104,6 @@ struct GaussianEnvelope {
   }
 };
 
-// The envelope for a photon with reversed direction v at a boundary point
-// with frame `frame` (the comment above), for roughness widths beta_long and
-// beta_azim (radians).
 // The roughness widths (radians) and what the envelopes derive from them,
 // computed once per model.
 struct EnvelopeWidths {
