@@ -21,9 +21,9 @@ static_assert(W <= 8, "the hand-over reads a vector's finished flags into one 64
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many rounds of candidate normals per
-// step, a round after the first only while half of its lanes still wait
-// (life::another_round); lanes still without a normal go on at the next step
-// (see sim/roughness_model.h).
+// step, a round after the first only while a lane whose candidates are
+// seldom accepted still waits (life::another_round); lanes still without a
+// normal go on at the next step (see sim/roughness_model.h).
 constexpr int kRoundsPerStep = 8;
 
 // The photons in flight, structure of arrays: one column per number of

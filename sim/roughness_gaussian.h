@@ -23,7 +23,7 @@ namespace fiberlab::sim::life {
 class GaussianRoughness {
  public:
   GaussianRoughness(double beta_long, double beta_azim)
-      : beta_long_(beta_long), beta_azim_(beta_azim), widths_(beta_long, beta_azim) {}
+      : widths_(beta_long, beta_azim) {}
   explicit GaussianRoughness(const Settings& s)
       : GaussianRoughness(s.roughness.beta_long.front(), s.roughness.beta_azim.front()) {}
 
@@ -52,8 +52,8 @@ class GaussianRoughness {
       const T e = -log(u1 * select(gamma2, u2, T(1.0)));
       const T rho = sqrt(T(2.0) * (env.w0 + e));
       const Direction<T> dir = direction(env, lobe, u_psi);
-      const Vec3Of<T> m = rotated_normal(sin_n, cos_n, pv, pw, T(beta_long_) * rho * dir.cos,
-                                         T(beta_azim_) * rho * dir.sin);
+      const Vec3Of<T> m = rotated_normal(sin_n, cos_n, pv, pw, T(widths_.beta_long) * rho * dir.cos,
+                                         T(widths_.beta_azim) * rho * dir.sin);
       const T visible = -d.dot(m);
       const MaskOf<T> accepted =
           pending & (visible > T(0.0)) & (u_accept * env.at(e, dir.c_plus) < visible);
@@ -103,7 +103,6 @@ class GaussianRoughness {
     return {st, ct * (pv * ca - pw * sa), ct * (pv * sa + pw * ca)};
   }
 
-  double beta_long_, beta_azim_;
   EnvelopeWidths widths_;
 };
 
