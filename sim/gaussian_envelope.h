@@ -86,6 +86,8 @@
 
 namespace fiberlab::sim::life {
 
+inline constexpr double kSqrt2 = 1.4142135623730951;
+
 template <class T>
 struct GaussianEnvelope {
   T a_flat, a_lobe, b_lobe, b_flat;  // env = a_flat + a_lobe c+ + (b_lobe c+ + b_flat) E
@@ -111,7 +113,8 @@ struct EnvelopeWidths {
       : beta_long(beta_long_),
         beta_azim(beta_azim_),
         b(std::max(beta_long_, beta_azim_)),
-        tail_c0(-std::sin(b / 1.4142135623730951)) {}
+        // No c0 >= -1 faces away by more than pi/2: no tail for b / sqrt 2 >= pi/2.
+        tail_c0(b / kSqrt2 >= 1.5707963267948966 ? -1.0 : -std::sin(b / kSqrt2)) {}
   double beta_long, beta_azim;
   double b;        // the larger beta
   double tail_c0;  // c0 below which n_f faces away by more than b / sqrt 2
@@ -126,7 +129,6 @@ struct RadialEnvelope {
 template <class T>
 [[gnu::always_inline]] inline RadialEnvelope<T> radial_envelope(const T& c0,
                                                                 const EnvelopeWidths& widths) {
-  constexpr double kSqrt2 = 1.4142135623730951;
   const double b = widths.b;
   const T zero(0.0);
   // In the tail: eps > b / sqrt 2, where rho0 below exceeds 1 / sqrt 2.
@@ -149,7 +151,6 @@ template <class T>
                                                                 const BoundaryFrame<T>& frame,
                                                                 const T& c0,
                                                                 const EnvelopeWidths& widths) {
-  constexpr double kSqrt2 = 1.4142135623730951;
   const double beta_long = widths.beta_long, beta_azim = widths.beta_azim, b = widths.b;
   const T zero(0.0), one(1.0);
   // v's parts along e_l and q, and h.
