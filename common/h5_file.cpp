@@ -4,7 +4,6 @@
 
 #include <fcntl.h>
 #include <unistd.h>
-#include <libdeflate.h>
 
 #include <algorithm>
 #include <bit>
@@ -460,122 +459,110 @@ void File::write_slab(const std::string& name, hsize_t i, const std::vector<doub
   slab_io<double>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_DOUBLE);
 }
 
-namespace {
-
-// Where a slab row's chunks lie, when they can be written directly: chunk
-// dims (1, 1, rows_per_chunk, whole trailing dims) and deflate the only filter.
-struct RowChunks {
-  Handle set;
-  hsize_t rows = 0, rows_per_chunk = 0;  // along the third dimension
-  std::size_t row_bytes = 0;             // one index of the third dimension
-  int level = 0;                         // deflate's
-  bool direct = false;
-};
-
-bool direct_chunks(hid_t file, const std::string& path, const std::string& name, RowChunks& out) {
-  if constexpr (std::endian::native != std::endian::little) return false;  // file types are LE
-  out.set = checked(H5Dopen2(file, name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path);
-  Handle dcpl = checked(H5Dget_create_plist(out.set.id()), H5Pclose, "creation list of " + name, path);
-  if (H5Pget_layout(dcpl.id()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.id()) != 1) return false;
+File::RowPlan File::plan_rows(const std::string& name) {
+  RowPlan plan;
+  plan.name = name;
+  plan.set = checked(H5Dopen2(handle_.id(), name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path_);
+  Handle type = checked(H5Dget_type(plan.set.id()), H5Tclose, "type of " + name, path_);
+  plan.type = H5Tget_class(type.id()) == H5T_FLOAT ? Type::Float64 : Type::UInt64;
+  if constexpr (std::endian::native != std::endian::little) return plan;  // file types are LE
+  // Direct: chunk dims (1, 1, rows_per_chunk, whole trailing dims), deflate the only filter.
+  Handle dcpl = checked(H5Dget_create_plist(plan.set.id()), H5Pclose, "creation list of " + name, path_);
+  if (H5Pget_layout(dcpl.id()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.id()) != 1) return plan;
   unsigned flags = 0, cd[4] = {0, 0, 0, 0};
   std::size_t n_cd = 4;
   if (H5Pget_filter2(dcpl.id(), 0, &flags, &n_cd, cd, 0, nullptr, nullptr) != H5Z_FILTER_DEFLATE ||
       n_cd < 1)
-    return false;
-  Handle space = checked(H5Dget_space(out.set.id()), H5Sclose, "dataspace of " + name, path);
+    return plan;
+  Handle space = checked(H5Dget_space(plan.set.id()), H5Sclose, "dataspace of " + name, path_);
   const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 3) return false;
+  if (rank < 3) return plan;
   Dims dims(rank), chunk(rank);
   H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
   if (H5Pget_chunk(dcpl.id(), rank, chunk.data()) != rank || chunk[0] != 1 || chunk[1] != 1)
-    return false;
+    return plan;
   std::size_t cells = 1;
   for (int d = 3; d < rank; ++d) {
-    if (chunk[d] != dims[d]) return false;
+    if (chunk[d] != dims[d]) return plan;
     cells *= dims[d];
   }
-  out.rows = dims[2];
-  out.rows_per_chunk = chunk[2];
-  out.row_bytes = cells * sizeof(double);  // float64 and uint64 alike
-  out.level = static_cast<int>(cd[0]);
-  out.direct = true;
-  return true;
+  plan.rows = dims[2];
+  plan.rows_per_chunk = chunk[2];
+  plan.row_bytes = cells * sizeof(double);  // float64 and uint64 alike
+  plan.level = static_cast<int>(cd[0]);
+  plan.direct = true;
+  return plan;
+}
+
+namespace {
+
+// Each chunk of a row deflated alone; an edge chunk (past the dataset's end)
+// padded with zeros to the whole chunk, as HDF5 stores it.
+void deflate_chunks(const File::RowPlan& plan, const unsigned char* data, std::size_t bytes,
+                    Deflater& z, File::PreparedRow& out) {
+  if (bytes != plan.rows * plan.row_bytes)
+    throw Error(fmt::format("internal error: a row of {} has {} bytes, not {}", plan.name, bytes,
+                            plan.rows * plan.row_bytes));
+  if (z.level() != plan.level)
+    throw Error(fmt::format("internal error: {} is deflated at level {}, not {}", plan.name,
+                            plan.level, z.level()));
+  const std::size_t chunks = (plan.rows + plan.rows_per_chunk - 1) / plan.rows_per_chunk;
+  out.chunks.resize(chunks);
+  const std::size_t chunk_bytes = plan.rows_per_chunk * plan.row_bytes;
+  for (std::size_t c = 0; c < chunks; ++c) {
+    const std::size_t first = c * chunk_bytes;
+    z.deflate(data + first, std::min(chunk_bytes, bytes - first), chunk_bytes, out.chunks[c]);
+  }
+}
+
+template <typename T>
+void prepare(const File::RowPlan& plan, File::Type type, const std::vector<T>& values, Deflater& z,
+             File::PreparedRow& out, std::vector<T>& kept) {
+  if (plan.type != type)
+    throw Error(fmt::format("internal error: {} is not a dataset of this type", plan.name));
+  if (!plan.direct) {
+    kept = values;
+    return;
+  }
+  deflate_chunks(plan, reinterpret_cast<const unsigned char*>(values.data()),
+                 values.size() * sizeof(T), z, out);
 }
 
 }  // namespace
 
-void File::write_slab_rows(const std::vector<SlabRow>& rows, int threads) {
-  struct Job {
-    std::size_t row;
-    hsize_t first;  // along the third dimension
-    std::vector<unsigned char> bytes;
-    bool ok = false;
-  };
-  std::vector<RowChunks> layout(rows.size());
-  std::vector<Job> jobs;
-  for (std::size_t r = 0; r < rows.size(); ++r) {
-    const SlabRow& row = rows[r];
-    if (!direct_chunks(handle_.id(), path_, row.name, layout[r])) {
-      if (row.doubles) write_slab_row(row.name, row.i, row.j, *row.doubles);
-      else write_slab_row(row.name, row.i, row.j, *row.words);
-      continue;
-    }
-    const std::size_t n = row.doubles ? row.doubles->size() : row.words->size();
-    if (n * sizeof(double) != layout[r].rows * layout[r].row_bytes)
-      throw Error(fmt::format("{}: internal error: a row of {} has {} values", path_, row.name, n));
-    for (hsize_t first = 0; first < layout[r].rows; first += layout[r].rows_per_chunk)
-      jobs.push_back({r, first, {}});
+void File::prepare_row(const RowPlan& plan, const std::vector<double>& values, Deflater& z,
+                       PreparedRow& out) {
+  prepare(plan, Type::Float64, values, z, out, out.doubles);
+}
+
+void File::prepare_row(const RowPlan& plan, const std::vector<std::uint64_t>& values,
+                       Deflater& z, PreparedRow& out) {
+  prepare(plan, Type::UInt64, values, z, out, out.words);
+}
+
+void File::write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRow& row) {
+  if (!plan.direct) {
+    if (plan.type == Type::Float64) write_slab_row(plan.name, i, j, row.doubles);
+    else write_slab_row(plan.name, i, j, row.words);
+    return;
   }
-  // Each chunk is deflated into its own buffer (libdeflate: the zlib stream
-  // format HDF5's filter reads; measured faster than zlib's own compressor,
-  // README "Performance"), one compressor per thread; an edge chunk (past the
-  // dataset's end) is padded with zeros to the whole chunk, as HDF5 stores it.
-#pragma omp parallel num_threads(std::max(1, threads))
-  {
-    libdeflate_compressor* z = nullptr;
-    int z_level = -1;
-#pragma omp for schedule(dynamic)
-    for (std::size_t k = 0; k < jobs.size(); ++k) {
-      Job& job = jobs[k];
-      const RowChunks& c = layout[job.row];
-      const SlabRow& row = rows[job.row];
-      if (c.level != z_level) {
-        if (z) libdeflate_free_compressor(z);
-        z = libdeflate_alloc_compressor(c.level);
-        z_level = c.level;
-      }
-      if (!z) continue;  // job.ok stays false
-      const unsigned char* data = row.doubles ? reinterpret_cast<const unsigned char*>(row.doubles->data())
-                                              : reinterpret_cast<const unsigned char*>(row.words->data());
-      const std::size_t chunk_bytes = c.rows_per_chunk * c.row_bytes;
-      const std::size_t valid = std::min(c.rows - job.first, c.rows_per_chunk) * c.row_bytes;
-      std::vector<unsigned char> plain(chunk_bytes, 0);
-      std::memcpy(plain.data(), data + job.first * c.row_bytes, valid);
-      job.bytes.resize(libdeflate_zlib_compress_bound(z, chunk_bytes));
-      const std::size_t size =
-          libdeflate_zlib_compress(z, plain.data(), chunk_bytes, job.bytes.data(), job.bytes.size());
-      job.bytes.resize(size);
-      job.ok = size > 0;
-    }
-    if (z) libdeflate_free_compressor(z);
-  }
-  for (const Job& job : jobs) {
-    const SlabRow& row = rows[job.row];
-    if (!job.ok) throw Error(fmt::format("{}: cannot compress {} (libdeflate)", path_, row.name));
-    Dims offset(3, 0);
-    offset[0] = row.i;
-    offset[1] = row.j;
-    offset[2] = job.first;
-    Handle space = checked(H5Dget_space(layout[job.row].set.id()), H5Sclose, "dataspace of " + row.name, path_);
-    offset.resize(H5Sget_simple_extent_ndims(space.id()), 0);
+  Handle space = checked(H5Dget_space(plan.set.id()), H5Sclose, "dataspace of " + plan.name, path_);
+  Dims offset(H5Sget_simple_extent_ndims(space.id()), 0);
+  offset[0] = i;
+  offset[1] = j;
+  for (std::size_t c = 0; c < row.chunks.size(); ++c) {
+    offset[2] = c * plan.rows_per_chunk;
     errno = 0;
-    check_write(H5Dwrite_chunk(layout[job.row].set.id(), H5P_DEFAULT, 0, offset.data(),
-                               job.bytes.size(), job.bytes.data()),
-                handle_.id(), "cannot write " + row.name, path_);
+    check_write(H5Dwrite_chunk(plan.set.id(), H5P_DEFAULT, 0, offset.data(), row.chunks[c].size(),
+                               row.chunks[c].data()),
+                handle_.id(), "cannot write " + plan.name, path_);
   }
-  for (std::size_t r = 0; r < rows.size(); ++r)
-    if (layout[r].direct)
-      check_write(H5Dflush(layout[r].set.id()), handle_.id(), "cannot write " + rows[r].name, path_);
+}
+
+void File::end_rows(const RowPlan& plan) {
+  if (!plan.direct) return;  // write_slab_row flushed
+  errno = 0;
+  check_write(H5Dflush(plan.set.id()), handle_.id(), "cannot write " + plan.name, path_);
 }
 
 void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data) {

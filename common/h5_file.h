@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "common/deflater.h"
+
 namespace fiberlab::h5 {
 
 // Owns one hid_t and closes it with the matching H5*close.
@@ -77,18 +79,39 @@ class File {
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data);
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
                       const std::vector<std::uint64_t>& data);
-  // Several such rows at once, their chunks deflated on `threads` threads
-  // (libdeflate, at the dataset's deflate level) and stored as they are
-  // (H5Dwrite_chunk): zlib-format streams, which HDF5's deflate filter reads
-  // like its own. A dataset whose chunks are not whole rows deflated alone
-  // (or a big-endian machine) is written through write_slab_row instead.
-  struct SlabRow {
+  // Rows stored as chunks deflated ahead of HDF5 (H5Dwrite_chunk), so that
+  // the deflating, which needs no HDF5 call, can run on threads:
+  //   RowPlan plan = f.plan_rows(name);                 // serial: HDF5's layout
+  //   File::prepare_row(plan, values, deflater, row);   // any thread, own Deflater
+  //   f.write_row(plan, i, j, row); ... f.end_rows(plan);  // serial
+  // The chunks are zlib-format streams at the dataset's deflate level, which
+  // HDF5's deflate filter reads like its own. A dataset whose chunks are not
+  // whole rows deflated alone (or a big-endian machine) keeps the row's
+  // values as they are, written through write_slab_row.
+  struct RowPlan {
     std::string name;
-    hsize_t i, j;
-    const std::vector<double>* doubles = nullptr;      // one of the two
-    const std::vector<std::uint64_t>* words = nullptr;
+    Handle set;
+    Type type = Type::Float64;
+    bool direct = false;                   // the fields below are set when true
+    hsize_t rows = 0, rows_per_chunk = 0;  // along the third dimension
+    std::size_t row_bytes = 0;             // one index of the third dimension
+    int level = 0;                         // deflate's
   };
-  void write_slab_rows(const std::vector<SlabRow>& rows, int threads);
+  struct PreparedRow {
+    std::vector<std::vector<unsigned char>> chunks;  // direct: one stream per chunk
+    std::vector<double> doubles;                     // otherwise: the values
+    std::vector<std::uint64_t> words;
+  };
+  RowPlan plan_rows(const std::string& name);
+  // Throws fiberlab::Error if the values do not fill a row of the plan's
+  // type, or if z's level is not the dataset's.
+  static void prepare_row(const RowPlan& plan, const std::vector<double>& values, Deflater& z,
+                          PreparedRow& out);
+  static void prepare_row(const RowPlan& plan, const std::vector<std::uint64_t>& values,
+                          Deflater& z, PreparedRow& out);
+  void write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRow& row);
+  // After a plan's last row: flushes, so that a failed write is reported here.
+  void end_rows(const RowPlan& plan);
   std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;
   std::vector<std::uint64_t> read_slab_uint64s(const std::string& name, hsize_t i) const;
   Dims dims(const std::string& name) const;  // of a dataset

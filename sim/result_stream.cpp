@@ -2,7 +2,11 @@
 
 #include <fmt/core.h>
 
+#include <omp.h>
+
 #include <algorithm>
+#include <atomic>
+#include <exception>
 
 #include "common/error.h"
 #include "common/result_layout.h"
@@ -87,32 +91,41 @@ void ResultWriter::write(std::size_t k, const Tally& t) {
                   [&](int l, ExactLobe& lobe) { t.exact_lobe(l, lobe); });
 }
 
-// One direction, a lobe at a time: a lobe is a whole number of chunks of the
-// bin datasets (h5::File's chunking), each deflated once, the lobe's chunks
-// on the writer's threads. Counts (whose chunks span lobes) are gathered and
-// written once per direction.
+// One direction: each lobe's sums converted and its chunks deflated on the
+// writer's threads (a lobe is a whole number of chunks of the bin datasets,
+// h5::File's chunking), then every chunk handed to HDF5 on this thread (HDF5
+// is serial, and its error settings are per thread). Counts (whose chunks
+// span lobes) are gathered and written once.
 void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
                                    const ExactLedger& ledger, const LobeSource& lobe_of) {
   if (!(shape == shape_) || k >= photons_.size())
     throw Error("internal error: writing a tally of the wrong shape or direction");
   h5::File& f = *file_;
   photons_[k] = ledger.photons;
-  const std::size_t per_lobe = static_cast<std::size_t>(shape_.n_theta) * shape_.n_phi;
   counts_.resize(shape_.bins());
+  const LobePlans plans{f.plan_rows("/tally/weight_sum"), f.plan_rows("/tally/weight_sq_sum"),
+                        f.plan_rows("/exact/weight_sum"), f.plan_rows("/exact/weight_sq_sum")};
+  prepared_.resize(static_cast<std::size_t>(shape_.lobes));
+  const int threads = std::clamp(threads_, 1, shape_.lobes);
+  if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
+  std::exception_ptr failure;  // the first; the lobes after it are skipped
+  std::atomic<bool> failed{false};
+#pragma omp parallel for num_threads(threads) schedule(dynamic)
   for (int l = 0; l < shape_.lobes; ++l) {
-    lobe_of(l, lobe_);
-    std::copy(lobe_.count.begin(), lobe_.count.end(), counts_.begin() + l * per_lobe);
-    ExactTally::to_double(lobe_.weight_sum, sum_doubles_);
-    ExactTally::to_double(lobe_.weight_sq_sum, sq_doubles_);
-    ExactTally::to_pairs(lobe_.weight_sum, sum_pairs_);
-    ExactTally::to_pairs(lobe_.weight_sq_sum, sq_pairs_);
-    const hsize_t lobe = static_cast<hsize_t>(l);
-    f.write_slab_rows({{"/tally/weight_sum", k, lobe, &sum_doubles_, nullptr},
-                       {"/tally/weight_sq_sum", k, lobe, &sq_doubles_, nullptr},
-                       {"/exact/weight_sum", k, lobe, nullptr, &sum_pairs_},
-                       {"/exact/weight_sq_sum", k, lobe, nullptr, &sq_pairs_}},
-                      threads_);
+    if (failed) continue;
+    try {
+      prepare_lobe(l, plans, lobe_of, scratch_[omp_get_thread_num()], prepared_[l]);
+    } catch (...) {
+#pragma omp critical(result_writer_failure)
+      if (!failure) failure = std::current_exception();
+      failed = true;
+    }
   }
+  if (failure) std::rethrow_exception(failure);
+  for (int l = 0; l < shape_.lobes; ++l)
+    for (std::size_t r = 0; r < plans.size(); ++r)
+      f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
+  for (const h5::File::RowPlan& plan : plans) f.end_rows(plan);
   f.write_slab("/tally/count", k, counts_);
   f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
   f.write_slab("/ledger/absorbed", k, ExactTally::to_double(ledger.absorbed));
@@ -122,6 +135,28 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(ledger.absorbed));
   f.write_slab("/exact/truncated", k, ExactTally::to_pairs(ledger.truncated));
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
+}
+
+// Lobe l's four rows (float64 and exact sums and squared sums), on one
+// thread with its scratch; its counts into counts_ (each lobe its own range).
+void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of,
+                                LobeScratch& s, std::array<h5::File::PreparedRow, 4>& out) {
+  lobe_of(l, s.lobe);
+  std::copy(s.lobe.count.begin(), s.lobe.count.end(),
+            counts_.begin() + static_cast<std::ptrdiff_t>(l * s.lobe.count.size()));
+  const auto deflater = [&](const h5::File::RowPlan& plan) -> Deflater& {
+    const int level = plan.direct ? plan.level : 1;  // (unused when not direct)
+    if (!s.deflater || s.deflater->level() != level) s.deflater.emplace(level);
+    return *s.deflater;
+  };
+  ExactTally::to_double(s.lobe.weight_sum, s.doubles);
+  h5::File::prepare_row(plans[0], s.doubles, deflater(plans[0]), out[0]);
+  ExactTally::to_double(s.lobe.weight_sq_sum, s.doubles);
+  h5::File::prepare_row(plans[1], s.doubles, deflater(plans[1]), out[1]);
+  ExactTally::to_pairs(s.lobe.weight_sum, s.pairs);
+  h5::File::prepare_row(plans[2], s.pairs, deflater(plans[2]), out[2]);
+  ExactTally::to_pairs(s.lobe.weight_sq_sum, s.pairs);
+  h5::File::prepare_row(plans[3], s.pairs, deflater(plans[3]), out[3]);
 }
 
 void ResultWriter::commit() {

@@ -9,6 +9,7 @@
 //   /exact/exited  K x L x C x 2,  /exact/absorbed, /exact/truncated, /exact/lost  K x C x 2
 // uint64 pairs (high, low) of an unsigned 128-bit integer; the value is
 // integer / 2^60. The float64 datasets are these integers / 2^60 rounded once.
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -38,24 +39,36 @@ class ResultWriter {
   void write(std::size_t k, const ExactTally& t);
   void write(std::size_t k, const Tally& t);
   h5::File& file() { return *file_; }              // for extra groups (checkpoints)
-  // Threads that deflate the bin datasets' chunks (1 unless set).
+  // Threads that convert and deflate the bin datasets' lobes (1 unless set).
   void set_compression_threads(int threads) { threads_ = threads; }
   void commit();  // writes /tally/photons, closes, renames into place
 
  private:
   using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
+  // The bin datasets written a lobe (a row) at a time: S1 and S2 as float64,
+  // then as exact pairs.
+  using LobePlans = std::array<h5::File::RowPlan, 4>;
+  // One writing thread's buffers, kept across lobes and directions: fresh
+  // memory costs a page fault per 4 KiB, which on these machines costs more
+  // than the conversions.
+  struct LobeScratch {
+    ExactLobe lobe;
+    std::vector<double> doubles;
+    std::vector<std::uint64_t> pairs;
+    std::optional<Deflater> deflater;
+  };
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
                        const LobeSource& lobe_of);
+  void prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of, LobeScratch& s,
+                    std::array<h5::File::PreparedRow, 4>& out);
 
   AtomicOutput out_;
   std::optional<h5::File> file_;
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
-  // Buffers reused across lobes and directions: fresh memory costs a page
-  // fault per 4 KiB, which on these machines cost more than the writing.
-  ExactLobe lobe_;
-  std::vector<std::uint64_t> counts_, sum_pairs_, sq_pairs_;
-  std::vector<double> sum_doubles_, sq_doubles_;
+  std::vector<std::uint64_t> counts_;  // a direction's [lobe][theta][phi]
+  std::vector<LobeScratch> scratch_;   // [thread]
+  std::vector<std::array<h5::File::PreparedRow, 4>> prepared_;  // [lobe][dataset], until written
   int threads_ = 1;
 };
 

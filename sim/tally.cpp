@@ -87,7 +87,7 @@ ExactTally Tally::exact() const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
   for (int l = 0; l < lobes_; ++l)
     copy_lobe(l, e.count.data() + l * per_lobe, e.weight_sum.data() + l * per_lobe * C,
-              e.weight_sq_sum.data() + l * per_lobe * C);
+              e.weight_sq_sum.data() + l * per_lobe * C, false);
   ExactLedger ledger = exact_ledger();
   e.photons = ledger.photons;
   e.exited = std::move(ledger.exited);
@@ -99,18 +99,28 @@ ExactTally Tally::exact() const {
 
 void Tally::exact_lobe(int l, ExactLobe& out) const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
-  out.count.assign(per_lobe, 0);
-  out.weight_sum.assign(per_lobe * C, 0);
-  out.weight_sq_sum.assign(per_lobe * C, 0);
-  copy_lobe(l, out.count.data(), out.weight_sum.data(), out.weight_sq_sum.data());
+  // Every element is written (untouched bins as zeros): a reused buffer is not cleared first.
+  out.count.resize(per_lobe);
+  out.weight_sum.resize(per_lobe * C);
+  out.weight_sq_sum.resize(per_lobe * C);
+  copy_lobe(l, out.count.data(), out.weight_sum.data(), out.weight_sq_sum.data(), true);
 }
 
-// Lobe l's touched bins into zeroed arrays ([theta][phi], [theta][phi][channel]).
-void Tally::copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const {
+// Lobe l's touched bins into the arrays ([theta][phi], [theta][phi][channel]);
+// the untouched ones are zero: left as they are (zeroed arrays), or written.
+void Tally::copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2,
+                      bool write_untouched) const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
   const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
   for (std::size_t i = 0; i < per_lobe; ++i) {
-    if (!touched_[(first + i) / kPageBins]) continue;  // zero, as the arrays start
+    if (!touched_[(first + i) / kPageBins]) {
+      if (write_untouched) {
+        count[i] = 0;
+        std::fill(s1 + i * C, s1 + (i + 1) * C, ExactTally::Word{0});
+        std::fill(s2 + i * C, s2 + (i + 1) * C, ExactTally::Word{0});
+      }
+      continue;
+    }
     const Fixed* cell = cells() + (first + i) * block();
     count[i] = static_cast<std::uint64_t>(cell[0]);
     for (std::size_t c = 0; c < C; ++c) {

@@ -106,7 +106,8 @@ class Tally {
   // that scoring a photon touches one or two cache lines, not three arrays.
   std::size_t block() const { return 2 * static_cast<std::size_t>(channels_) + 1; }
   std::vector<double> column(int offset) const;  // S1 (offset 1) or S2 (1 + C)
-  void copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const;
+  void copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2,
+                 bool write_untouched) const;
 
   int lobes_, n_theta_, n_phi_, channels_;
   std::uint64_t photons_ = 0;

@@ -1,5 +1,6 @@
-// h5::File::write_slab_rows (common/h5_file.h) deflates a slab row's chunks
-// itself, on several threads, and hands HDF5 the stored bytes. Oracle: what
+// h5::File's row plans (common/h5_file.h): a slab row's chunks deflated
+// ahead (prepare_row, here on two threads with a Deflater each) and handed to
+// HDF5 as stored bytes (write_row). Oracle: what
 // HDF5 reads back through its own deflate filter must be the values written,
 // for the result file's chunkings (whole rows; rows split with an edge chunk
 // past the dataset's end) and for one it cannot write directly (fallback).
@@ -7,8 +8,10 @@
 
 #include <cstdint>
 #include <random>
+#include <thread>
 #include <vector>
 
+#include "common/error.h"
 #include "common/h5_file.h"
 #include "tests/unique_temp_dir.h"
 
@@ -30,7 +33,7 @@ std::vector<std::uint64_t> random_words(std::size_t n, std::uint32_t seed) {
   return v;
 }
 
-TEST(H5SlabRows, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
+TEST(H5RowPlan, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
   const auto dir = test_support::unique_temp_dir("fiberlab_test_slab_rows");
   const std::string path = (dir / "rows.h5").string();
   // As in a result file: K x L x 90 x 180 x 3 float64 (a chunk is a whole
@@ -45,20 +48,37 @@ TEST(H5SlabRows, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
     f.create_dataset("/d", doubles_dims, File::Type::Float64);
     f.create_dataset("/w", words_dims, File::Type::UInt64);
     f.create_dataset("/o", odd_dims, File::Type::Float64);
+    File::RowPlan plans[3] = {f.plan_rows("/d"), f.plan_rows("/w"), f.plan_rows("/o")};
+    EXPECT_TRUE(plans[0].direct);
+    EXPECT_TRUE(plans[1].direct);
+    EXPECT_FALSE(plans[2].direct);  // chunks split the last dimension: HDF5 filters it
     for (hsize_t i = 0; i < 2; ++i) {
-      std::vector<File::SlabRow> rows;
       for (hsize_t j = 0; j < 3; ++j) {
         doubles.push_back(random_doubles(row_doubles, static_cast<std::uint32_t>(10 * i + j)));
         words.push_back(random_words(row_words, static_cast<std::uint32_t>(20 + 10 * i + j)));
       }
       for (hsize_t j = 0; j < 2; ++j) odd.push_back(random_doubles(row_odd, static_cast<std::uint32_t>(40 + 10 * i + j)));
+      // Rows 0..7 of this slab: /d j, /w j (j < 3), /o j (j < 2), prepared
+      // on two threads (even and odd rows), each with its own Deflater.
+      std::vector<File::PreparedRow> prepared(8);
+      auto prepare = [&](int parity) {
+        Deflater z(1);
+        for (int r = parity; r < 8; r += 2) {
+          if (r < 6 && r % 2 == 0) File::prepare_row(plans[0], doubles[3 * i + r / 2], z, prepared[r]);
+          else if (r < 6) File::prepare_row(plans[1], words[3 * i + r / 2], z, prepared[r]);
+          else File::prepare_row(plans[2], odd[2 * i + (r - 6)], z, prepared[r]);
+        }
+      };
+      std::thread even(prepare, 0), odd_rows(prepare, 1);
+      even.join();
+      odd_rows.join();
       for (hsize_t j = 0; j < 3; ++j) {
-        rows.push_back({"/d", i, j, &doubles[3 * i + j], nullptr});
-        rows.push_back({"/w", i, j, nullptr, &words[3 * i + j]});
+        f.write_row(plans[0], i, j, prepared[2 * j]);
+        f.write_row(plans[1], i, j, prepared[2 * j + 1]);
       }
-      for (hsize_t j = 0; j < 2; ++j) rows.push_back({"/o", i, j, &odd[2 * i + j], nullptr});
-      f.write_slab_rows(rows, 2);
+      for (hsize_t j = 0; j < 2; ++j) f.write_row(plans[2], i, j, prepared[6 + j]);
     }
+    for (const File::RowPlan& plan : plans) f.end_rows(plan);
     f.close();
   }
   const File f = File::open_read(path);
@@ -76,6 +96,23 @@ TEST(H5SlabRows, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
       EXPECT_TRUE(std::equal(odd[2 * i + j].begin(), odd[2 * i + j].end(), o.begin() + j * row_odd))
           << "/o slab " << i << " row " << j;
   }
+}
+
+// A row of the wrong length or type, or a Deflater at another level, is an
+// internal error named for the dataset, never a corrupt chunk.
+TEST(H5RowPlan, RefusesRowsThatDoNotFitThePlan) {
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_row_plan");
+  File f = File::create((dir / "plan.h5").string());
+  f.create_dataset("/d", {1, 2, 90, 180, 3}, File::Type::Float64);
+  const File::RowPlan plan = f.plan_rows("/d");
+  ASSERT_TRUE(plan.direct);
+  File::PreparedRow row;
+  Deflater z1(1), z6(6);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3 - 1), z1, row), Error);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<std::uint64_t>(90 * 180 * 3), z1, row), Error);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), z6, row), Error);
+  EXPECT_NO_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), z1, row));
+  f.close();
 }
 
 }  // namespace
