@@ -20,7 +20,8 @@ Deflater::~Deflater() {
 }
 
 Deflater::Deflater(Deflater&& o) noexcept
-    : z_(std::exchange(o.z_, nullptr)), level_(o.level_), plain_(std::move(o.plain_)) {}
+    : z_(std::exchange(o.z_, nullptr)), level_(o.level_), plain_(std::move(o.plain_)),
+      compressed_(std::move(o.compressed_)) {}
 
 Deflater& Deflater::operator=(Deflater&& o) noexcept {
   if (this != &o) {
@@ -28,6 +29,7 @@ Deflater& Deflater::operator=(Deflater&& o) noexcept {
     z_ = std::exchange(o.z_, nullptr);
     level_ = o.level_;
     plain_ = std::move(o.plain_);
+    compressed_ = std::move(o.compressed_);
   }
   return *this;
 }
@@ -42,11 +44,15 @@ void Deflater::deflate(const unsigned char* data, std::size_t bytes, std::size_t
               plain_.begin() + static_cast<std::ptrdiff_t>(padded), 0);
     in = plain_.data();
   }
-  // Straight into `out`: a caller reusing its vectors touches no new memory.
-  out.resize(libdeflate_zlib_compress_bound(z_, padded));
-  const std::size_t size = libdeflate_zlib_compress(z_, in, padded, out.data(), out.size());
+  // Into a buffer of the bound's size kept across calls (growing `out` to
+  // the bound for every chunk would zero-fill what it does not use), then
+  // the stream's bytes into `out`, whose capacity a caller can reuse.
+  const std::size_t bound = libdeflate_zlib_compress_bound(z_, padded);
+  if (compressed_.size() < bound) compressed_.resize(bound);
+  const std::size_t size =
+      libdeflate_zlib_compress(z_, in, padded, compressed_.data(), compressed_.size());
   if (size == 0) throw Error("internal error: libdeflate could not compress a chunk");
-  out.resize(size);
+  out.assign(compressed_.begin(), compressed_.begin() + static_cast<std::ptrdiff_t>(size));
 }
 
 }  // namespace fiberlab

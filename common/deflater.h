@@ -23,8 +23,7 @@ class Deflater {
 
   int level() const { return level_; }
   // The stream of bytes [data, data + bytes) followed by zeros up to
-  // `padded` bytes (padded >= bytes), into `out` (resized to fit; its
-  // capacity is kept, so reusing `out` touches no new memory). Throws
+  // `padded` bytes (padded >= bytes), into `out` (resized to fit). Throws
   // fiberlab::Error if libdeflate fails (it cannot for a large enough buffer).
   void deflate(const unsigned char* data, std::size_t bytes, std::size_t padded,
                std::vector<unsigned char>& out);
@@ -32,7 +31,8 @@ class Deflater {
  private:
   libdeflate_compressor* z_ = nullptr;
   int level_ = 0;
-  std::vector<unsigned char> plain_;  // a padded input
+  std::vector<unsigned char> plain_;       // a padded input
+  std::vector<unsigned char> compressed_;  // the output, at the bound's size
 };
 
 }  // namespace fiberlab
