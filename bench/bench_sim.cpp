@@ -10,9 +10,18 @@
 // and candidate normals per photon. `trace` is the batched SIMD tracer that
 // `fiberlab run` uses for unpolarised light (binning and tally included);
 // `trace_reference` the scalar reference tracer (tracing only).
+//
+// `write`: one direction's result file (`fiberlab run`'s last step: the
+// tally converted to float64 and exact pairs, deflated, written, renamed
+// into place) from case c's tally after 1 M photons, on 1 and 2 threads.
 #include <benchmark/benchmark.h>
 
+#include <filesystem>
+#include <unistd.h>
+
 #include "common/units.h"
+#include "sim/checkpoint.h"
+#include "sim/result_stream.h"
 #include "sim/simulation.h"
 #include "sim/source.h"
 
@@ -96,6 +105,28 @@ BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisec
 BENCHMARK_CAPTURE(trace, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_per_chunk, 'b', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_per_chunk, 'c', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
+
+void write(benchmark::State& state) {
+  Settings s = bench_case('c');
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("fiberlab_bench_write_" + std::to_string(getpid()) + ".h5"))
+                               .string();
+  s.output = path;
+  const Simulation sim(s);
+  Tally tally(8, 90, 180, 3);
+  TracerCounters counters;
+  sim.trace_photons(0, 0, 1 << 20, tally, counters);
+  const ResultFile header = result_header(sim.settings(), sim.grid());
+  for (auto _ : state) {
+    ResultWriter w(path, header);
+    w.set_compression_threads(static_cast<int>(state.range(0)));
+    w.write(0, tally);
+    w.commit();
+  }
+  std::filesystem::remove(path);
+}
+
+BENCHMARK(write)->Arg(1)->Arg(2)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 
 BENCHMARK_CAPTURE(trace_reference, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(1.0);
