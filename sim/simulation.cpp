@@ -10,6 +10,7 @@
 #include <exception>
 #include <memory>
 #include <mutex>
+#include <utility>
 #include <optional>
 #include <thread>
 
@@ -166,13 +167,21 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
 
 // Adds every rank's unflushed sums of direction k into rank 0's state. The
 // threads' tallies are cleared, not freed: they serve the next round and
-// direction without being allocated and faulted in again.
+// direction without being allocated and faulted in again. Into a state that
+// holds nothing yet, a thread's tally is swapped instead (exact: the sum of
+// it and zero): the state's pages were never touched, and touching fresh
+// memory costs about 1 ms per 2 MiB here, whereas the zero tally the thread
+// gets back costs nothing until that thread writes to it.
 void Simulation::Runner::flush(std::size_t k) {
   if (group_.size() == 1) {
     for (std::unique_ptr<Tally>& t : thread_tallies_)
       if (t) {
-        state_.tallies[k].add(*t);
-        t->clear();
+        if (state_.tallies[k].is_zero()) {
+          std::swap(state_.tallies[k], *t);
+        } else {
+          state_.tallies[k].add(*t);
+          t->clear();
+        }
       }
     return;
   }

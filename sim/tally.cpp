@@ -82,6 +82,13 @@ void Tally::add(const Tally& o) {
   }
 }
 
+bool Tally::is_zero() const {
+  const auto zero = [](auto x) { return x == 0; };
+  return photons_ == 0 && std::all_of(touched_.begin(), touched_.end(), zero) &&
+         std::all_of(truncated_.begin(), truncated_.end(), zero) &&
+         std::all_of(lost_.begin(), lost_.end(), zero);
+}
+
 ExactTally Tally::exact() const {
   ExactTally e(shape());
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;

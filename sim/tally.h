@@ -71,6 +71,8 @@ class Tally {
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
   void add(const Tally& other);  // exact: integer sums
+  // Nothing scored: no photon launched, no cell touched, no ledger entry.
+  bool is_zero() const;
   // The same sums as exact integers in file order (checkpoints, MPI, merge),
   // and back (a checkpoint's partial sums before resuming).
   TallyShape shape() const { return {lobes_, n_theta_, n_phi_, channels_}; }
