@@ -23,9 +23,16 @@ void keep_freed_memory_for_reuse() {
   mallopt(M_ARENA_MAX, 1);
   mallopt(M_TOP_PAD, static_cast<int>(kHeapStep));
   void* probe = std::malloc(kHugePage);  // more than the heap holds yet: it grows
-  const auto start = (reinterpret_cast<std::uintptr_t>(probe) + kHugePage - 1) & ~(kHugePage - 1);
-  const auto end = reinterpret_cast<std::uintptr_t>(sbrk(0)) & ~(kHugePage - 1);
-  if (end > start) madvise(reinterpret_cast<void*>(start), end - start, MADV_HUGEPAGE);
+  const auto at = reinterpret_cast<std::uintptr_t>(probe);
+  const auto brk = reinterpret_cast<std::uintptr_t>(sbrk(0));
+  // Only when the probe came from the heap's top (glibc falls back to a
+  // mapping of its own when the heap cannot grow): [probe, break) is then
+  // the heap's free top.
+  if (probe && at < brk && brk - at <= kHeapStep + 2 * kHugePage) {
+    const auto start = (at + kHugePage - 1) & ~(kHugePage - 1);
+    const auto end = brk & ~(kHugePage - 1);
+    if (end > start) madvise(reinterpret_cast<void*>(start), end - start, MADV_HUGEPAGE);
+  }
   std::free(probe);
 }
 
