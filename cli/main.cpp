@@ -13,7 +13,7 @@
 #include "common/h5_file.h"
 
 int main(int argc, char** argv) {
-  fiberlab::keep_freed_memory_for_reuse();
+  fiberlab::tune_allocator();
   fiberlab::h5::prepare_hdf5();
   CLI::App app{"fiberlab " FIBERLAB_VERSION
                ": Monte Carlo ground truth for light scattering by single fibers"};

@@ -14,7 +14,7 @@ constexpr std::size_t kHugePage = std::size_t{2} << 20;
 constexpr std::size_t kHeapStep = std::size_t{64} << 20;
 }  // namespace
 
-void keep_freed_memory_for_reuse() {
+void tune_allocator() {
   // Failure leaves glibc's defaults: slower, never wrong.
   mallopt(M_MMAP_THRESHOLD, 32 << 20);
   mallopt(M_TRIM_THRESHOLD, 256 << 20);

@@ -23,6 +23,6 @@
 namespace fiberlab {
 
 // Call once, at the start of main (a program's choice, not a library's).
-void keep_freed_memory_for_reuse();
+void tune_allocator();
 
 }  // namespace fiberlab

@@ -5,7 +5,6 @@
 // across calls, since fresh memory costs a page fault per 4 KiB on these
 // machines. Not thread-safe: one Deflater per thread.
 #include <cstddef>
-#include <memory>
 #include <vector>
 
 struct libdeflate_compressor;
