@@ -111,8 +111,12 @@ TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
   score(tallies[0], dense[0], 5000, 3);
   score(tallies[1], dense[1], 2000, 4);
   const auto dir = test_support::unique_temp_dir("fiberlab_test_tally_write");
-  const std::string path = (dir / "r.h5").string();
+  // One writing thread, and more threads than lobes divide evenly among.
+  for (int threads : {1, 3}) {
+  SCOPED_TRACE(::testing::Message() << threads << " writing threads");
+  const std::string path = (dir / ("r" + std::to_string(threads) + ".h5")).string();
   ResultWriter w(path, result_header(s, grid));
+  w.set_compression_threads(threads);
   for (std::size_t k = 0; k < 2; ++k) w.write(k, tallies[k]);
   w.commit();
 
@@ -144,6 +148,22 @@ TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
       ASSERT_EQ(doubles.weight_sq_sum[k * cells + i], static_cast<double>(d.s2[i]) / 0x1.0p60) << i;
     }
   }
+  }
+}
+
+// The float64 datasets are the exact sums / 2^60 rounded once, below and
+// above 2^64 (where the high word is used): values whose doubles are known.
+TEST(ExactTallyToDouble, RoundsOnceBelowAndAbove2To64) {
+  using Word = ExactTally::Word;
+  const Word two64 = Word{1} << 64;
+  const std::vector<Word> v{0,
+                            Word{3} << 59,            // 1.5
+                            two64 - 1,                // rounds up to 2^64: 16
+                            two64 + (Word{1} << 12),  // 2^64 + one ulp: 16 + 2^-48
+                            two64 + (Word{1} << 11),  // half an ulp, ties to even: 16
+                            (Word{5} << 100) + 7};    // 5 * 2^40
+  const std::vector<double> expected{0.0, 1.5, 16.0, 16.0 + 0x1.0p-48, 16.0, 5.0 * 0x1.0p40};
+  EXPECT_EQ(ExactTally::to_double(v), expected);
 }
 
 }  // namespace
