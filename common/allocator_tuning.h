@@ -19,8 +19,8 @@
 // mapped apart), which grows 64 MiB at a time and is advised as transparent
 // huge pages (where the kernel allows them: "madvise" or "always"): about
 // 1,700 faults per run with the tallies' own huge pages (sim/zeroed_memory.h).
-// Peak memory grows by what the last huge pages hold
-// beyond what is used (a few MiB).
+// Peak memory grows by what the last huge pages hold beyond what is used (a
+// few MiB).
 namespace fiberlab {
 
 // Call once, at the start of main (a program's choice, not a library's).
