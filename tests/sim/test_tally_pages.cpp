@@ -96,33 +96,12 @@ TEST(TallyPages, ScoredClearedReusedCopiedAndAddedEqualDenseSums) {
   expect_equal(from_exact, doubled);
 }
 
-// `run` writes each direction's tally in place (ResultWriter::write(k,
-// Tally), lobe by lobe into rows of the datasets): the file must hold the
-// dense sums exactly, as exact pairs and as float64 = exact / 2^60, with the
-// ledger derived from them.
-TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
-  Settings s = testing::smooth_circle(30.0, 1);
-  s.fiber.sigma_a = {0.1, 0.2, 0.3};
-  s.source.theta_i = {deg_to_rad(10.0), deg_to_rad(40.0)};
-  const BinGrid grid = BinGrid::make(kTheta, kPhi, s.tally.theta_bins);
-  ASSERT_EQ(s.tally.lobes, kLobes);
-  std::vector<Tally> tallies(2, Tally(kLobes, kTheta, kPhi, kChannels));
-  std::vector<DenseSums> dense(2);
-  score(tallies[0], dense[0], 5000, 3);
-  score(tallies[1], dense[1], 2000, 4);
-  const auto dir = test_support::unique_temp_dir("fiberlab_test_tally_write");
-  // One writing thread, and more threads than lobes divide evenly among.
-  for (int threads : {1, 3}) {
-  SCOPED_TRACE(::testing::Message() << threads << " writing threads");
-  const std::string path = (dir / ("r" + std::to_string(threads) + ".h5")).string();
-  ResultWriter w(path, result_header(s, grid));
-  w.set_compression_threads(threads);
-  for (std::size_t k = 0; k < 2; ++k) w.write(k, tallies[k]);
-  w.commit();
-
+// The result file at `path` holds the dense sums exactly, as exact pairs and
+// as float64 = exact / 2^60, with the ledger derived from them.
+void expect_holds_dense_sums(const std::string& path, const std::vector<DenseSums>& dense) {
   const ResultReader reader(path);
   const ResultFile doubles = read_result(path);
-  for (std::size_t k = 0; k < 2; ++k) {
+  for (std::size_t k = 0; k < dense.size(); ++k) {
     const DenseSums& d = dense[k];
     const ExactTally e = reader.read(k);
     EXPECT_EQ(e.photons, d.photons);
@@ -148,6 +127,31 @@ TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
       ASSERT_EQ(doubles.weight_sq_sum[k * cells + i], static_cast<double>(d.s2[i]) / 0x1.0p60) << i;
     }
   }
+}
+
+// `run` writes each direction's tally in place (ResultWriter::write(k,
+// Tally), lobe by lobe into rows of the datasets, the lobes on the writer's
+// threads): the file must hold the dense sums exactly.
+TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
+  Settings s = testing::smooth_circle(30.0, 1);
+  s.fiber.sigma_a = {0.1, 0.2, 0.3};
+  s.source.theta_i = {deg_to_rad(10.0), deg_to_rad(40.0)};
+  const BinGrid grid = BinGrid::make(kTheta, kPhi, s.tally.theta_bins);
+  ASSERT_EQ(s.tally.lobes, kLobes);
+  std::vector<Tally> tallies(2, Tally(kLobes, kTheta, kPhi, kChannels));
+  std::vector<DenseSums> dense(2);
+  score(tallies[0], dense[0], 5000, 3);
+  score(tallies[1], dense[1], 2000, 4);
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_tally_write");
+  // One writing thread, and more threads than lobes divide evenly among.
+  for (int threads : {1, 3}) {
+    SCOPED_TRACE(::testing::Message() << threads << " writing threads");
+    const std::string path = (dir / ("r" + std::to_string(threads) + ".h5")).string();
+    ResultWriter w(path, result_header(s, grid));
+    w.set_compression_threads(threads);
+    for (std::size_t k = 0; k < 2; ++k) w.write(k, tallies[k]);
+    w.commit();
+    expect_holds_dense_sums(path, dense);
   }
 }
 
