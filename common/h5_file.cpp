@@ -496,8 +496,14 @@ File::RowPlan File::plan_rows(const std::string& name) {
 
 namespace {
 
+bool all_zero(const unsigned char* p, std::size_t n) {
+  return n == 0 || (p[0] == 0 && std::memcmp(p, p + 1, n - 1) == 0);
+}
+
 // Each chunk of a row deflated alone; an edge chunk (past the dataset's end)
-// padded with zeros to the whole chunk, as HDF5 stores it.
+// padded with zeros to the whole chunk, as HDF5 stores it. A chunk of zeros
+// only is left empty: it is not stored, and HDF5 reads a chunk never written
+// as the datasets' fill value, 0 (sparse results: few photons, many lobes).
 void deflate_chunks(const File::RowPlan& plan, const unsigned char* data, std::size_t bytes,
                     Deflater& z, File::PreparedRow& out) {
   if (bytes != plan.rows * plan.row_bytes)
@@ -510,8 +516,9 @@ void deflate_chunks(const File::RowPlan& plan, const unsigned char* data, std::s
   out.chunks.resize(chunks);
   const std::size_t chunk_bytes = plan.rows_per_chunk * plan.row_bytes;
   for (std::size_t c = 0; c < chunks; ++c) {
-    const std::size_t first = c * chunk_bytes;
-    z.deflate(data + first, std::min(chunk_bytes, bytes - first), chunk_bytes, out.chunks[c]);
+    const std::size_t first = c * chunk_bytes, valid = std::min(chunk_bytes, bytes - first);
+    if (all_zero(data + first, valid)) out.chunks[c].clear();
+    else z.deflate(data + first, valid, chunk_bytes, out.chunks[c]);
   }
 }
 
@@ -551,6 +558,7 @@ void File::write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRo
   offset[0] = i;
   offset[1] = j;
   for (std::size_t c = 0; c < row.chunks.size(); ++c) {
+    if (row.chunks[c].empty()) continue;  // zeros only: not stored (deflate_chunks)
     offset[2] = c * plan.rows_per_chunk;
     errno = 0;
     check_write(H5Dwrite_chunk(plan.set.id(), H5P_DEFAULT, 0, offset.data(), row.chunks[c].size(),
