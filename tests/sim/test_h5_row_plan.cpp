@@ -67,7 +67,7 @@ TEST(H5RowPlan, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
       // on two threads (even and odd rows), each with its own Deflater.
       std::vector<File::PreparedRow> prepared(8);
       auto prepare = [&](int parity) {
-        Deflater z(1);
+        Deflater z(plans[0].level);
         for (int r = parity; r < 8; r += 2) {
           if (r < 6 && r % 2 == 0) File::prepare_row(plans[0], doubles[3 * i + r / 2], z, prepared[r]);
           else if (r < 6) File::prepare_row(plans[1], words[3 * i + r / 2], z, prepared[r]);
@@ -117,11 +117,11 @@ TEST(H5RowPlan, RefusesRowsThatDoNotFitThePlan) {
   const File::RowPlan plan = f.plan_rows("/d");
   ASSERT_TRUE(plan.direct);
   File::PreparedRow row;
-  Deflater z1(1), z6(6);
-  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3 - 1), z1, row), Error);
-  EXPECT_THROW(File::prepare_row(plan, std::vector<std::uint64_t>(90 * 180 * 3), z1, row), Error);
-  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), z6, row), Error);
-  EXPECT_NO_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), z1, row));
+  Deflater same(plan.level), other(plan.level == 6 ? 5 : 6);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3 - 1), same, row), Error);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<std::uint64_t>(90 * 180 * 3), same, row), Error);
+  EXPECT_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), other, row), Error);
+  EXPECT_NO_THROW(File::prepare_row(plan, std::vector<double>(90 * 180 * 3), same, row));
   f.close();
 }
 
