@@ -1,14 +1,12 @@
 #include "sim/process_group.h"
 
+#include <dlfcn.h>
 #include <fmt/core.h>
 
 #include <cstdlib>
 
 #include "common/error.h"
-
-#ifdef FIBERLAB_HAVE_MPI
-#include <mpi.h>
-#endif
+#include "sim/mpi_calls.h"
 
 namespace fiberlab::sim {
 
@@ -23,36 +21,39 @@ int launched_processes() {
   return 1;
 }
 
-#ifdef FIBERLAB_HAVE_MPI
-// Adds unsigned 128-bit integers stored as two uint64 words (MPI has no such type).
-void add_words(void* in, void* inout, int* len, MPI_Datatype*) {
-  const auto* a = static_cast<const ExactTally::Word*>(in);
-  auto* b = static_cast<ExactTally::Word*>(inout);
-  for (int i = 0; i < *len; ++i) b[i] += a[i];
-}
-#endif
-
-}  // namespace
-
-ProcessGroup::ProcessGroup() {
-  const int launched = launched_processes();
-  if (launched <= 1) return;
-#ifdef FIBERLAB_HAVE_MPI
-  int provided = 0;
-  MPI_Init_thread(nullptr, nullptr, MPI_THREAD_FUNNELED, &provided);
-  mpi_ = true;
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
-  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+// fiberlab's MPI module (sim/mpi/), from the build that compiled this file.
+// RTLD_GLOBAL: Open MPI's own plugins resolve MPI's symbols through it. Never
+// unloaded (MPI cannot be restarted in a process anyway).
+const FiberlabMpiCalls& load_mpi_module(int launched) {
+#ifdef FIBERLAB_MPI_MODULE
+  (void)launched;
+  void* module = dlopen(FIBERLAB_MPI_MODULE, RTLD_NOW | RTLD_GLOBAL);
+  if (!module)
+    throw Error(fmt::format("cannot load fiberlab's MPI module: {} (rebuild fiberlab)",
+                            dlerror()));
+  const auto calls = reinterpret_cast<const FiberlabMpiCalls* (*)()>(dlsym(module, "fiberlab_mpi_calls"));
+  if (!calls || calls()->abi != kFiberlabMpiAbi)
+    throw Error(fmt::format("fiberlab's MPI module {} is from another version of fiberlab "
+                            "(rebuild fiberlab)", FIBERLAB_MPI_MODULE));
+  return *calls();
 #else
   throw Error(fmt::format("started as {} MPI processes, but this fiberlab was built without MPI "
                           "(rebuild with libopenmpi-dev installed, -DFIBERLAB_MPI=ON)", launched));
 #endif
 }
 
+}  // namespace
+
+ProcessGroup::ProcessGroup() {
+  const int launched = launched_processes();
+  if (launched <= 1) return;
+  const FiberlabMpiCalls& mpi = load_mpi_module(launched);
+  mpi.init(&rank_, &size_);
+  mpi_ = &mpi;
+}
+
 ProcessGroup::~ProcessGroup() {
-#ifdef FIBERLAB_HAVE_MPI
-  if (mpi_) MPI_Finalize();
-#endif
+  if (mpi_) mpi_->finalize();
 }
 
 const ProcessGroup& ProcessGroup::single() {
@@ -61,67 +62,32 @@ const ProcessGroup& ProcessGroup::single() {
 }
 
 void ProcessGroup::max(std::vector<std::int64_t>& v) const {
-#ifdef FIBERLAB_HAVE_MPI
-  if (mpi_)
-    MPI_Allreduce(MPI_IN_PLACE, v.data(), static_cast<int>(v.size()), MPI_INT64_T, MPI_MAX,
-                  MPI_COMM_WORLD);
-#else
-  (void)v;
-#endif
+  if (mpi_) mpi_->max_int64(v.data(), v.size());
 }
 
 void ProcessGroup::sum_to_root(std::vector<ExactTally::Word>& v) const {
-#ifdef FIBERLAB_HAVE_MPI
-  if (!mpi_) return;
-  MPI_Datatype word;
-  MPI_Type_contiguous(2, MPI_UINT64_T, &word);
-  MPI_Type_commit(&word);
-  MPI_Op op;
-  MPI_Op_create(add_words, /*commute=*/1, &op);
-  // In pieces of at most 2^24 words, below MPI's int counts.
-  constexpr std::size_t kPiece = std::size_t{1} << 24;
-  for (std::size_t i = 0; i < v.size(); i += kPiece) {
-    const int n = static_cast<int>(std::min(kPiece, v.size() - i));
-    if (is_root())
-      MPI_Reduce(MPI_IN_PLACE, v.data() + i, n, word, op, 0, MPI_COMM_WORLD);
-    else
-      MPI_Reduce(v.data() + i, nullptr, n, word, op, 0, MPI_COMM_WORLD);
-  }
-  MPI_Op_free(&op);
-  MPI_Type_free(&word);
-#else
-  (void)v;
-#endif
+  if (mpi_) mpi_->sum_u128_to_root(v.data(), v.size());
 }
 
 std::optional<std::string> ProcessGroup::agree_on_error(const std::optional<std::string>& mine) const {
-#ifdef FIBERLAB_HAVE_MPI
   if (!mpi_) return mine;
-  int candidate = mine ? rank_ : size_, first = size_;
-  MPI_Allreduce(&candidate, &first, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+  const int first = mpi_->min_int(mine ? rank_ : size_);
   if (first == size_) return std::nullopt;
   std::string message = rank_ == first ? *mine : std::string();
-  int length = static_cast<int>(message.size());
-  MPI_Bcast(&length, 1, MPI_INT, first, MPI_COMM_WORLD);
+  std::uint64_t length = message.size();
+  mpi_->broadcast(&length, sizeof length, first);
   message.resize(length);
-  MPI_Bcast(message.data(), length, MPI_CHAR, first, MPI_COMM_WORLD);
+  mpi_->broadcast(message.data(), length, first);
   if (first != 0) message = fmt::format("rank {}: {}", first, message);
   return message;
-#else
-  return mine;
-#endif
 }
 
 void ProcessGroup::broadcast(std::vector<std::uint64_t>& v) const {
-#ifdef FIBERLAB_HAVE_MPI
   if (!mpi_) return;
   std::uint64_t n = v.size();
-  MPI_Bcast(&n, 1, MPI_UINT64_T, 0, MPI_COMM_WORLD);
+  mpi_->broadcast(&n, sizeof n, 0);
   v.resize(n);
-  MPI_Bcast(v.data(), static_cast<int>(n), MPI_UINT64_T, 0, MPI_COMM_WORLD);
-#else
-  (void)v;
-#endif
+  mpi_->broadcast(v.data(), n * sizeof(std::uint64_t), 0);
 }
 
 }  // namespace fiberlab::sim

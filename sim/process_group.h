@@ -3,7 +3,8 @@
 // launcher (mpirun, srun) and built with MPI (FIBERLAB_MPI), otherwise just
 // this process. Only the calls a run needs: a few flags agreed by every rank,
 // exact sums of 128-bit tallies into rank 0 and one error message for all.
-// Only the calling (main) thread talks to MPI (MPI_THREAD_FUNNELED).
+// Only the calling (main) thread talks to MPI (MPI_THREAD_FUNNELED), through
+// fiberlab's MPI module (sim/mpi_calls.h), loaded only when launched so.
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -11,13 +12,16 @@
 
 #include "sim/exact_tally.h"
 
+extern "C" struct FiberlabMpiCalls;
+
 namespace fiberlab::sim {
 
 class ProcessGroup {
  public:
   // Starts MPI when launched by an MPI launcher; finalizes it on destruction.
   // Throws fiberlab::Error when launched as several processes by a build
-  // without MPI (each would run the whole job and write the same file).
+  // without MPI (each would run the whole job and write the same file), or
+  // when the MPI module cannot be loaded.
   ProcessGroup();
   ~ProcessGroup();
   ProcessGroup(const ProcessGroup&) = delete;
@@ -44,7 +48,7 @@ class ProcessGroup {
   struct Single {};
   explicit ProcessGroup(Single) {}
   int rank_ = 0, size_ = 1;
-  bool mpi_ = false;
+  const FiberlabMpiCalls* mpi_ = nullptr;  // null: this process alone
 };
 
 // Thrown on ranks other than 0 when a rank failed: rank 0 reports the error
