@@ -57,8 +57,9 @@ class ResultWriter {
     std::vector<std::uint64_t> pairs;
     std::optional<Deflater> deflater;
   };
+  // lobe_work[l]: lobe l's relative cost (the lobes are taken heaviest first).
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
-                       const LobeSource& lobe_of);
+                       const LobeSource& lobe_of, const std::vector<std::size_t>& lobe_work);
   void prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of, LobeScratch& s,
                     std::array<h5::File::PreparedRow, 4>& out);
 

@@ -226,4 +226,20 @@ std::vector<double> Tally::absorbed() const { return ExactTally::to_double(exact
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
 std::vector<double> Tally::lost() const { return to_double(lost_); }
 
+std::vector<std::size_t> Tally::touched_bins_per_lobe() const {
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;
+  std::vector<std::size_t> bins(static_cast<std::size_t>(lobes_), 0);
+  for (std::size_t p = 0; p < pages(); ++p) {
+    if (!touched_[p]) continue;
+    // Page p's bins [p * kPageBins, end), split over the lobes they belong to.
+    const std::size_t end = std::min((p + 1) * kPageBins, this->bins());
+    for (std::size_t b = p * kPageBins; b < end;) {
+      const std::size_t l = b / per_lobe, lobe_end = std::min(end, (l + 1) * per_lobe);
+      bins[l] += lobe_end - b;
+      b = lobe_end;
+    }
+  }
+  return bins;
+}
+
 }  // namespace fiberlab::sim

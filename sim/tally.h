@@ -81,6 +81,10 @@ class Tally {
   // streams): lobe l's bins, and the photons and ledger.
   void exact_lobe(int l, ExactLobe& out) const;
   ExactLedger exact_ledger() const;
+  // Per lobe, how many of its bins lie on pages the tally wrote: what
+  // exporting and compressing the lobe costs, roughly (the result writer
+  // starts with the heaviest lobes).
+  std::vector<std::size_t> touched_bins_per_lobe() const;
   void add(const ExactTally& e);
 
   std::uint64_t photons() const { return photons_; }

@@ -157,6 +157,22 @@ TEST(TallyPages, WrittenInPlaceReadsBackAsTheDenseSums) {
 
 // The float64 datasets are the exact sums / 2^60 rounded once, below and
 // above 2^64 (where the high word is used): values whose doubles are known.
+// The result writer's cost hint: per lobe, the bins on pages (64 bins) the
+// tally wrote. Oracle: the pages worked out by hand for 90 x 180 bins a lobe.
+TEST(TallyPages, TouchedBinsPerLobeCountTheWrittenPagesOfEachLobe) {
+  Tally t(kLobes, kTheta, kPhi, kChannels);
+  EXPECT_EQ(t.touched_bins_per_lobe(), (std::vector<std::size_t>{0, 0, 0, 0}));
+  const double w[kChannels] = {0.5, 0.25, 0.125};
+  // Bin 16200 (lobe 1's first): page 253 = bins 16192..16255, of which
+  // 16192..16199 are lobe 0's last 8 and the rest lobe 1's.
+  t.score_exit(1, 0, 0, w);
+  // Bin 64799 (lobe 3's last): page 1012 = bins 64768..64799, the last page.
+  t.score_exit(3, kTheta - 1, kPhi - 1, w);
+  EXPECT_EQ(t.touched_bins_per_lobe(), (std::vector<std::size_t>{8, 56, 0, 32}));
+  t.clear();
+  EXPECT_EQ(t.touched_bins_per_lobe(), (std::vector<std::size_t>{0, 0, 0, 0}));
+}
+
 TEST(ExactTallyToDouble, RoundsOnceBelowAndAbove2To64) {
   using Word = ExactTally::Word;
   const Word two64 = Word{1} << 64;
