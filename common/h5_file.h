@@ -45,6 +45,10 @@ class File {
   static File open_read(const std::string& path);
   const std::string& path() const { return path_; }
   void close();  // flush and close; throws naming the file (e.g. disk full)
+  // Asks the kernel to start writing what was written so far to the disk,
+  // without waiting (sync_file_range), so that the final fsync waits less.
+  // Best effort: an error is left for the fsync to report.
+  void start_writeback() const;
 
   void create_group(const std::string& name);
   bool exists(const std::string& name) const;  // a link at this path

@@ -151,6 +151,7 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
     for (std::size_t r = 0; r < plans.size(); ++r)
       f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
   for (const h5::File::RowPlan& plan : plans) f.end_rows(plan);
+  f.start_writeback();
   f.write_slab("/tally/count", k, counts_);
   f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
   f.write_slab("/ledger/absorbed", k, ExactTally::to_double(ledger.absorbed));
