@@ -80,7 +80,9 @@ Handle open_attr(hid_t file, const std::string& obj, const std::string& name,
 
 // Large arrays are chunked and compressed (most histogram bins are empty),
 // with chunks of at most 65536 cells; `slab_rows`: one chunk never spans two
-// slabs along the first dimension (slab-at-a-time writing).
+// slabs along the first dimension (slab-at-a-time writing), nor two rows
+// along the second when a row holds at least 4096 cells (a lobe of bins: the
+// rows that File::plan_rows can compress on any thread).
 Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& path) {
   hsize_t n = 1;
   for (hsize_t d : dims) n *= d;
@@ -93,7 +95,8 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
       cells /= chunk[i];
       chunk[i] = 1;
       if (cells < 65536) {
-        if (!(i == 0 && slab_rows)) {
+        const bool own_row = slab_rows && (i == 0 || (i == 1 && cells >= 4096));
+        if (!own_row) {
           chunk[i] = std::max<hsize_t>(1, 65536 / std::max<hsize_t>(cells, 1));
           chunk[i] = std::min(chunk[i], dims[i]);
         }

@@ -115,8 +115,7 @@ std::vector<int> heaviest_first(const std::vector<std::size_t>& work) {
 // One direction: each lobe's sums converted and its chunks deflated on the
 // writer's threads (a lobe is a whole number of chunks of the bin datasets,
 // h5::File's chunking), then every chunk handed to HDF5 on this thread (HDF5
-// is serial, and its error settings are per thread). Counts (whose chunks
-// span lobes) are gathered and written once.
+// is serial, and its error settings are per thread).
 void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
                                    const ExactLedger& ledger, const LobeSource& lobe_of,
                                    const std::vector<std::size_t>& lobe_work) {
@@ -125,9 +124,9 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
     throw Error("internal error: writing a tally of the wrong shape or direction");
   h5::File& f = *file_;
   photons_[k] = ledger.photons;
-  counts_.resize(shape_.bins());
   const LobePlans plans{f.plan_rows("/tally/weight_sum"), f.plan_rows("/tally/weight_sq_sum"),
-                        f.plan_rows("/exact/weight_sum"), f.plan_rows("/exact/weight_sq_sum")};
+                        f.plan_rows("/exact/weight_sum"), f.plan_rows("/exact/weight_sq_sum"),
+                        f.plan_rows("/tally/count")};
   prepared_.resize(static_cast<std::size_t>(shape_.lobes));
   const int threads = std::clamp(threads_, 1, shape_.lobes);
   if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
@@ -152,7 +151,6 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
       f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
   for (const h5::File::RowPlan& plan : plans) f.end_rows(plan);
   f.start_writeback();
-  f.write_slab("/tally/count", k, counts_);
   f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
   f.write_slab("/ledger/absorbed", k, ExactTally::to_double(ledger.absorbed));
   f.write_slab("/ledger/truncated", k, ExactTally::to_double(ledger.truncated));
@@ -163,13 +161,11 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
 }
 
-// Lobe l's four rows (float64 and exact sums and squared sums), on one
-// thread with its scratch; its counts into counts_ (each lobe its own range).
+// Lobe l's five rows (float64 and exact sums and squared sums, counts), on one
+// thread with its scratch.
 void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of,
-                                LobeScratch& s, std::array<h5::File::PreparedRow, 4>& out) {
+                                LobeScratch& s, std::array<h5::File::PreparedRow, 5>& out) {
   lobe_of(l, s.lobe);
-  std::copy(s.lobe.count.begin(), s.lobe.count.end(),
-            counts_.begin() + static_cast<std::ptrdiff_t>(l * s.lobe.count.size()));
   const auto deflater = [&](const h5::File::RowPlan& plan) -> Deflater& {
     const int level = plan.direct ? plan.level : 1;  // (unused when not direct)
     if (!s.deflater || s.deflater->level() != level) s.deflater.emplace(level);
@@ -183,6 +179,7 @@ void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource&
   h5::File::prepare_row(plans[2], s.pairs, deflater(plans[2]), out[2]);
   ExactTally::to_pairs(s.lobe.weight_sq_sum, s.pairs);
   h5::File::prepare_row(plans[3], s.pairs, deflater(plans[3]), out[3]);
+  h5::File::prepare_row(plans[4], s.lobe.count, deflater(plans[4]), out[4]);
 }
 
 void ResultWriter::commit() {

@@ -46,8 +46,8 @@ class ResultWriter {
  private:
   using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
   // The bin datasets written a lobe (a row) at a time: S1 and S2 as float64,
-  // then as exact pairs.
-  using LobePlans = std::array<h5::File::RowPlan, 4>;
+  // then as exact pairs, then the counts.
+  using LobePlans = std::array<h5::File::RowPlan, 5>;
   // One writing thread's buffers, kept across lobes and directions: fresh
   // memory costs a page fault per 4 KiB, which on these machines costs more
   // than the conversions.
@@ -61,15 +61,14 @@ class ResultWriter {
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
                        const LobeSource& lobe_of, const std::vector<std::size_t>& lobe_work);
   void prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of, LobeScratch& s,
-                    std::array<h5::File::PreparedRow, 4>& out);
+                    std::array<h5::File::PreparedRow, 5>& out);
 
   AtomicOutput out_;
   std::optional<h5::File> file_;
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
-  std::vector<std::uint64_t> counts_;  // a direction's [lobe][theta][phi]
   std::vector<LobeScratch> scratch_;   // [thread]
-  std::vector<std::array<h5::File::PreparedRow, 4>> prepared_;  // [lobe][dataset], until written
+  std::vector<std::array<h5::File::PreparedRow, 5>> prepared_;  // [lobe][dataset], until written
   int threads_ = 1;
 };
 
