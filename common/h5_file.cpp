@@ -79,30 +79,44 @@ Handle open_attr(hid_t file, const std::string& obj, const std::string& name,
 }
 
 // Large arrays are chunked and compressed (most histogram bins are empty),
-// with chunks of at most 65536 cells; `slab_rows`: one chunk never spans two
+// with chunks of at most 65536 cells. `slab_rows`: a chunk never spans two
 // slabs along the first dimension (slab-at-a-time writing), nor two rows
 // along the second when a row holds at least 4096 cells (a lobe of bins: the
-// rows that File::plan_rows can compress on any thread).
+// rows that File::plan_rows compresses on any thread).
+Dims chunk_shape(const Dims& dims, bool slab_rows) {
+  Dims chunk = dims;
+  hsize_t cells = 1;
+  for (hsize_t d : dims) cells *= d;
+  std::size_t i = 0;
+  if (slab_rows) {
+    cells /= chunk[0];
+    chunk[0] = 1;
+    i = 1;
+    if (chunk.size() > 2 && cells / chunk[1] >= 4096) {
+      cells /= chunk[1];
+      chunk[1] = 1;
+      i = 2;
+    }
+  }
+  // The leading dimensions split until a chunk holds at most 65536 cells.
+  for (; i < chunk.size() && cells > 65536; ++i) {
+    cells /= chunk[i];
+    chunk[i] = 1;
+    if (cells < 65536) {
+      chunk[i] = std::min(dims[i], std::max<hsize_t>(1, 65536 / std::max<hsize_t>(cells, 1)));
+      break;
+    }
+  }
+  return chunk;
+}
+
 Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& path) {
   hsize_t n = 1;
   for (hsize_t d : dims) n *= d;
   Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list", path);
   if ((n >= 4096 || slab_rows) && !dims.empty() && n > 0 &&
       H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
-    Dims chunk = dims;
-    hsize_t cells = n;
-    for (std::size_t i = 0; i < chunk.size() && (cells > 65536 || (i == 0 && slab_rows)); ++i) {
-      cells /= chunk[i];
-      chunk[i] = 1;
-      if (cells < 65536) {
-        const bool own_row = slab_rows && (i == 0 || (i == 1 && cells >= 4096));
-        if (!own_row) {
-          chunk[i] = std::max<hsize_t>(1, 65536 / std::max<hsize_t>(cells, 1));
-          chunk[i] = std::min(chunk[i], dims[i]);
-        }
-        break;
-      }
-    }
+    const Dims chunk = chunk_shape(dims, slab_rows);
     H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
     // Level 2: libdeflate (the row plans' compressor) runs 2.4x faster there
     // than at level 1 on zeros and sparse bins (870 against 360 MB/s), 1.15x

@@ -108,6 +108,22 @@ TEST(H5RowPlan, ChunksDeflatedOnThreadsReadBackThroughHdf5) {
   }
 }
 
+// Chunking of slab datasets (h5::File::create_dataset): a row along the
+// second dimension (a lobe) is its own chunk when it holds 4096 cells or more
+// (the counts of 90 x 180 bins: rows prepared on threads), and shares a chunk
+// with the next rows when smaller (30 x 60 bins: written through HDF5).
+TEST(H5RowPlan, ARowOf4096CellsOrMoreIsItsOwnChunk) {
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_row_chunks");
+  File f = File::create((dir / "chunks.h5").string());
+  f.create_dataset("/count", {1, 8, 90, 180}, File::Type::UInt64);
+  f.create_dataset("/small", {1, 8, 30, 60}, File::Type::UInt64);
+  f.create_dataset("/edge", {1, 8, 64, 64}, File::Type::UInt64);  // exactly 4096 cells a row
+  EXPECT_TRUE(f.plan_rows("/count").direct);
+  EXPECT_FALSE(f.plan_rows("/small").direct);
+  EXPECT_TRUE(f.plan_rows("/edge").direct);
+  f.close();
+}
+
 // A row of the wrong length or type, or a Deflater at another level, is an
 // internal error named for the dataset, never a corrupt chunk.
 TEST(H5RowPlan, RefusesRowsThatDoNotFitThePlan) {
