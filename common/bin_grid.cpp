@@ -43,9 +43,8 @@ int BinGrid::phi_bin(double phi) const {
   return j;
 }
 
-double BinGrid::solid_angle(int i, int j) const {
-  return (std::sin(theta_edges[i + 1]) - std::sin(theta_edges[i])) *
-         (phi_edges[j + 1] - phi_edges[j]);
+double BinGrid::theta_band(int i) const {
+  return std::sin(theta_edges[i + 1]) - std::sin(theta_edges[i]);
 }
 
 std::string to_string(ThetaBinning b) {

@@ -25,8 +25,12 @@ struct BinGrid {
   int theta_bin(double theta) const;
   int phi_bin(double phi) const;
 
-  // Omega_b = (sin theta_hi - sin theta_lo)(phi_hi - phi_lo), SPEC section 6.
-  double solid_angle(int i_theta, int i_phi) const;
+  // Omega_b = (sin theta_hi - sin theta_lo)(phi_hi - phi_lo), SPEC section 6:
+  // the product of the theta band's and the phi bin's factors (a whole grid's
+  // solid angles take one band per row, not two sines per bin).
+  double solid_angle(int i_theta, int i_phi) const { return theta_band(i_theta) * phi_width(i_phi); }
+  double theta_band(int i_theta) const;  // sin theta_hi - sin theta_lo
+  double phi_width(int i_phi) const { return phi_edges[i_phi + 1] - phi_edges[i_phi]; }
 };
 
 std::string to_string(ThetaBinning b);

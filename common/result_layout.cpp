@@ -40,8 +40,10 @@ void write_bins(h5::File& f, const BinGrid& grid) {
   f.write("/bins/phi_edges", {grid.phi_edges.size()}, grid.phi_edges);
   std::vector<double> omega;
   omega.reserve(static_cast<std::size_t>(grid.n_theta()) * grid.n_phi());
-  for (int i = 0; i < grid.n_theta(); ++i)
-    for (int j = 0; j < grid.n_phi(); ++j) omega.push_back(grid.solid_angle(i, j));
+  for (int i = 0; i < grid.n_theta(); ++i) {
+    const double band = grid.theta_band(i);  // solid_angle(i, j), its band once a row
+    for (int j = 0; j < grid.n_phi(); ++j) omega.push_back(band * grid.phi_width(j));
+  }
   f.write("/bins/solid_angle",
           {static_cast<hsize_t>(grid.n_theta()), static_cast<hsize_t>(grid.n_phi())}, omega);
   f.set_attr("/bins", "theta_bins", to_string(grid.theta_binning));
