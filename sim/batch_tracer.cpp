@@ -1,10 +1,11 @@
 #include "sim/batch_tracer.h"
 
 #include <algorithm>
-#include <cstring>
+#include <bit>
 #include <memory>
 
 #include "common/error.h"
+#include "sim/lane_packing.h"
 #include "sim/source.h"
 
 namespace fiberlab::sim {
@@ -13,11 +14,8 @@ namespace {
 
 using life::load;
 using life::load_bits;
-using life::store;
-using life::store_bits;
 using life::MaskOf;
 constexpr int W = kBatchWidth;
-static_assert(W <= 8, "the hand-over reads a vector's finished flags into one 64-bit word");
 constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many rounds of candidate normals per
@@ -35,8 +33,9 @@ struct Pool {
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
   enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
-  // W spare lanes past the end: new photons are written a whole vector at a
-  // time from any lane (launch_vector in BatchTracer::trace_with).
+  // W spare lanes past the end: new photons, and the photons in flight
+  // packed to the front, are written a whole vector at a time from any lane
+  // (BatchTracer::trace_with).
   static constexpr int kLanes = kPoolLanes + W;
   alignas(64) double col[kColumns][kLanes];
   alignas(64) std::uint64_t bits[kBitColumns][kLanes];
@@ -65,18 +64,10 @@ struct Pool {
     return s;
   }
 
-  // The state of lanes [o, o + W) (T a vector; o a multiple of W unless
-  // kAligned is false) or of lane o (T = double).
-  template <class T, class Light, bool kAligned = true>
-  void store_state(int o, const life::PhotonState<T, Light>& s) {
-    const auto put = [&](const auto& x, auto* column) {
-      if constexpr (kAligned) {
-        if constexpr (std::is_same_v<std::decay_t<decltype(*column)>, double>) store(x, column + o);
-        else store_bits(x, column + o);
-      } else {
-        life::store_unaligned(x, column + o);
-      }
-    };
+  // Writes a photon state through put(value, column): one lane, or a vector
+  // of lanes wherever `put` places them.
+  template <class T, class Light, class Put>
+  void put_state(const life::PhotonState<T, Light>& s, Put&& put) {
     put(s.px, col[kPx]);
     put(s.py, col[kPy]);
     put(s.d.x, col[kDx]);
@@ -98,12 +89,6 @@ struct Pool {
       put(s.light.e1.y, col[kE1y]);
       put(s.light.e1.z, col[kE1z]);
     }
-  }
-
-  void move(int to, int from, bool polarized) {
-    const int n = polarized ? kColumns : kScalarColumns;
-    for (int c = 0; c < n; ++c) col[c][to] = col[c][from];
-    for (int c = 0; c < kBitColumns; ++c) bits[c][to] = bits[c][from];
   }
 };
 
@@ -129,6 +114,49 @@ void exit_angles(FinishedPhotons& f) {
     xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), x))).store_aligned(f.theta + i);
     xsimd::atan2(z, y).store_aligned(f.phi + i);
   }
+}
+
+// The photons of a vector whose lanes `lanes` finished this step, appended
+// to the block f (which has room for W more past them: sim/lane_packing.h).
+// Their fates and exit directions as finished_outcome (sim/tracer.h) gives
+// them; a model's exit_direction needs each photon's own stream.
+template <class Model, class Light>
+void hand_over(const Model& model, const life::PhotonState<Batch, Light>& s, const Batch& phi_i,
+               const life::BitsOf<Batch>& photon, std::uint64_t lanes, FinishedPhotons& f) {
+  using life::pack_store;
+  if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
+  const int n = f.n, k = std::popcount(lanes);
+  pack_store(s.d.x, lanes, f.dx + n);
+  pack_store(s.d.y, lanes, f.dy + n);
+  pack_store(s.d.z, lanes, f.dz + n);
+  pack_store(s.path, lanes, f.path + n);
+  pack_store(s.weight, lanes, f.weight + n);
+  pack_store(phi_i, lanes, f.phi_i + n);
+  pack_store(photon, lanes, f.photon + n);
+  alignas(64) double code[W], segments[W];
+  pack_store(s.code, lanes, code);
+  pack_store(s.segments, lanes, segments);
+  for (int j = 0; j < k; ++j) {
+    const PhotonFate fate = fate_of(static_cast<int>(code[j]));
+    f.segments[n + j] = static_cast<int>(segments[j]);
+    f.exited[n + j] = fate == PhotonFate::Exited;
+    f.lost[n + j] = fate == PhotonFate::Lost;
+    if (fate != PhotonFate::Exited) f.dx[n + j] = f.dy[n + j] = f.dz[n + j] = 0.0;  // no exit direction
+  }
+  if constexpr (requires(PhotonRandom& r) { model.exit_direction(Vec3(), 0, r); }) {
+    alignas(64) std::uint64_t w[4][W];
+    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
+    for (int j = 0; j < k; ++j) {
+      if (!f.exited[n + j]) continue;
+      PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
+      const Vec3 d = model.exit_direction(Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                          f.segments[n + j], rng);
+      f.dx[n + j] = d.x();
+      f.dy[n + j] = d.y();
+      f.dz[n + j] = d.z();
+    }
+  }
+  f.n = n + k;
 }
 
 }  // namespace
@@ -177,7 +205,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     const auto lanes = source.template launch_lanes<Batch>(photon);
     Batch pv, pw;
     ellipse.entry_point_in_beam(beam, lanes.h, pv, pw);
-    pool.store_state<Batch, Light, false>(o, life::start_photon<Light>(pv, pw, d_lanes, lanes.rng));
+    pool.put_state(life::start_photon<Light>(pv, pw, d_lanes, lanes.rng),
+                   [o](const auto& x, auto* column) { life::store_unaligned(x, column + o); });
     Batch(phi_i).store_unaligned(pool.col[Pool::kPhiI] + o);
     photon.store_unaligned(pool.bits[Pool::kPhoton] + o);
   };
@@ -187,31 +216,24 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     const Vec3 d = -p.wi;
     const Point2 entry = ellipse.entry_point_in_beam(
         source.fixed_direction() ? beam : ellipse.beam_direction(d), p.h);
-    pool.store_state(i, life::start_photon<OneLight>(entry, d, p.rng.core()));
+    pool.put_state(life::start_photon<OneLight>(entry, d, p.rng.core()),
+                   [i](const auto& x, auto* column) { column[i] = x; });
     pool.col[Pool::kPhiI][i] = p.phi_i;
     pool.bits[Pool::kPhoton][i] = photon;
   };
-  // The photon in lane i is done: to the block of finished photons.
-  auto finish = [&](int i) {
-    PhotonRandom rng(life::LaneRandom<double>(pool.bits[Pool::kS0][i], pool.bits[Pool::kS1][i],
-                                              pool.bits[Pool::kS2][i], pool.bits[Pool::kS3][i]));
-    const Vec3 d(pool.col[Pool::kDx][i], pool.col[Pool::kDy][i], pool.col[Pool::kDz][i]);
-    const PhotonOutcome out = finished_outcome(
-        model, static_cast<int>(pool.col[Pool::kCode][i]), d,
-        static_cast<int>(pool.col[Pool::kSegments][i]), pool.col[Pool::kPath][i],
-        pool.col[Pool::kWeight][i], rng);
-    done->add(pool.bits[Pool::kPhoton][i], pool.col[Pool::kPhiI][i], out);
-    if (done->full()) {
-      exit_angles(*done);
-      sink(*done);
-      done->n = 0;
-    }
+  auto flush = [&] {
+    exit_angles(*done);
+    sink(*done);
+    done->n = 0;
   };
+  // A pass over the pool appends at most every lane it holds, and a vector's
+  // worth of scratch past them (sim/lane_packing.h).
+  constexpr int kFlushAbove = FinishedPhotons::kCapacity - (kPoolLanes + W);
+  static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
 
   const std::uint64_t end = first + n;
   std::uint64_t next = first;
   int n_active = 0;
-  alignas(64) bool finished[kPoolLanes];  // lanes that finished this step
   while (true) {
     if (vector_launch) {
       while (n_active < kPoolLanes && next < end) {
@@ -225,32 +247,31 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       while (n_active < kPoolLanes && next < end) launch(n_active++, next++);
     }
     if (n_active == 0) break;
+    if (done->n > kFlushAbove) flush();
+    // One step for every photon in flight, a vector at a time. The finished
+    // ones go to the block; the others are packed to the front of the pool as
+    // the pass goes (`kept` never passes the vector being stepped, which is
+    // already loaded). The order of photons in the pool does not matter:
+    // tallies are exact integer sums.
+    int kept = 0;
     for (int o = 0; o < n_active; o += W) {
       const MaskOf<Batch> live = (iota + Batch(o)) < Batch(n_active);
       auto s = pool.load_state<Batch, Light>(o);
+      const Batch phi_lanes = load<Batch>(pool.col[Pool::kPhiI] + o);
+      const life::BitsOf<Batch> photon = load_bits<Batch>(pool.bits[Pool::kPhoton] + o);
       life::step(config_, model, s, live, counts, kRoundsPerStep);
-      pool.store_state(o, s);
-      (live & (s.code != Batch(life::kAtBoundary))).store_aligned(finished + o);
+      const MaskOf<Batch> at_boundary = s.code == Batch(life::kAtBoundary);
+      const std::uint64_t finished = life::lane_bits(live & !at_boundary);
+      const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
+      if (finished != 0) hand_over(model, s, phi_lanes, photon, finished, *done);
+      pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
+      life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
+      life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
+      kept += std::popcount(in_flight);
     }
-    // Hand over the finished photons, highest lane first: the last lane takes
-    // a finished lane's slot, and every lane above it is already settled, so
-    // the lane moved down is one still in flight. (The order photons reach
-    // the sink does not matter: tallies are exact integer sums.)
-    for (int o = (n_active - 1) / W * W; o >= 0; o -= W) {
-      std::uint64_t lanes = 0;  // byte k: lane o + k finished (0 or 1)
-      std::memcpy(&lanes, finished + o, W);
-      while (lanes != 0) {
-        const int top_byte = (63 - __builtin_clzll(lanes)) / 8;
-        lanes &= ~(std::uint64_t{0xff} << (8 * top_byte));
-        finish(o + top_byte);
-        pool.move(o + top_byte, --n_active, Light::kPolarized);
-      }
-    }
+    n_active = kept;
   }
-  if (done->n > 0) {
-    exit_angles(*done);
-    sink(*done);
-  }
+  if (done->n > 0) flush();
   counters.events += static_cast<long>(xsimd::hadd(counts.events));
   counters.normal_draws += static_cast<long>(xsimd::hadd(counts.normal_draws));
   counters.sampler_caps += static_cast<long>(xsimd::hadd(counts.sampler_caps));

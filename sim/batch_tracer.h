@@ -2,9 +2,11 @@
 // The photon life of sim/photon_life.h traced for many photons at once:
 // photons live in a pool of lanes kept in structure-of-arrays form, and each
 // step (an interface event and the next segment) runs on a SIMD vector of
-// lanes (xsimd: 8 doubles with AVX-512). Lanes whose photon is done are
-// handed to the sink and refilled with new photons from the Source, so the
-// few light-guided photons that run to max_segments do not hold up the rest.
+// lanes (xsimd: 8 doubles with AVX-512). After each step the finished
+// photons of a vector are packed into a block for the sink and the others to
+// the front of the pool, which is then refilled with new photons from the
+// Source, so the few light-guided photons that run to max_segments do not
+// hold up the rest.
 // This file only manages lanes; the physics is the life's, shared with the
 // reference Tracer, for every roughness model and for scalar and Stokes light.
 #include <cstdint>

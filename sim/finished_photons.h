@@ -10,7 +10,7 @@
 namespace fiberlab::sim {
 
 struct FinishedPhotons {
-  static constexpr int kCapacity = 256;  // a multiple of every SIMD width
+  static constexpr int kCapacity = 512;  // a multiple of every SIMD width
   int n = 0;
   alignas(64) double path[kCapacity] = {};  // internal 3D path length
   alignas(64) double weight[kCapacity] = {};  // throughput before absorption (PhotonOutcome::weight)

@@ -45,15 +45,20 @@ struct TracerCounters {
   }
 };
 
+// The fate of a photon whose life ended with `code` (life::LaneCode).
+inline PhotonFate fate_of(int code) {
+  return code == life::kExited      ? PhotonFate::Exited
+         : code == life::kTruncated ? PhotonFate::Truncated
+                                    : PhotonFate::Lost;
+}
+
 // The outcome of a photon whose life ended with `code`: the exit direction
 // goes through the model's exit hook (exit_blur), if it has one.
 template <class Model>
 PhotonOutcome finished_outcome(const Model& model, int code, const Vec3& d, int segments,
                                double path, double weight, PhotonRandom& rng) {
   PhotonOutcome out;
-  out.fate = code == life::kExited      ? PhotonFate::Exited
-             : code == life::kTruncated ? PhotonFate::Truncated
-                                        : PhotonFate::Lost;
+  out.fate = fate_of(code);
   out.segments = segments;
   out.path_length = path;
   out.weight = weight;

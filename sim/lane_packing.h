@@ -1,0 +1,56 @@
+#pragma once
+// Packing the lanes of a SIMD vector that a mask selects (sim/lanes.h):
+// what the batched tracer (sim/batch_tracer.cpp) uses to keep its photons in
+// flight at the front of its pool and to hand the finished ones over, a
+// vector at a time instead of a lane at a time.
+//
+// pack_store(x, lanes, p) writes the selected lanes of x, lowest first, to
+// p[0], p[1], ... . With AVX-512 it packs in a register (one compress
+// instruction) and writes a whole vector from p, so p must have room for W
+// values and the values past the selected ones are scratch. (A compress
+// straight to memory is avoided: it is microcoded and slow on AMD Zen 4.)
+// Other instruction sets write the selected lanes one at a time.
+#include <bit>
+#include <cstdint>
+
+#include "sim/lanes.h"
+
+namespace fiberlab::sim::life {
+
+// Bit k set where lane k of m is.
+inline std::uint64_t lane_bits(const MaskOf<Batch>& m) {
+#if defined(__AVX512F__)
+  if constexpr (kBatchWidth == 8) return static_cast<std::uint64_t>(static_cast<__mmask8>(m.data));
+#endif
+  alignas(64) bool b[kBatchWidth];
+  m.store_aligned(b);
+  std::uint64_t bits = 0;
+  for (int k = 0; k < kBatchWidth; ++k) bits |= static_cast<std::uint64_t>(b[k]) << k;
+  return bits;
+}
+
+inline void pack_store(const Batch& x, std::uint64_t lanes, double* p) {
+#if defined(__AVX512F__)
+  if constexpr (kBatchWidth == 8) {
+    _mm512_storeu_pd(p, _mm512_maskz_compress_pd(static_cast<__mmask8>(lanes), x));
+    return;
+  }
+#endif
+  alignas(64) double v[kBatchWidth];
+  x.store_aligned(v);
+  for (; lanes != 0; lanes &= lanes - 1) *p++ = v[std::countr_zero(lanes)];
+}
+
+inline void pack_store(const BitsOf<Batch>& x, std::uint64_t lanes, std::uint64_t* p) {
+#if defined(__AVX512F__)
+  if constexpr (kBatchWidth == 8) {
+    _mm512_storeu_si512(p, _mm512_maskz_compress_epi64(static_cast<__mmask8>(lanes), x));
+    return;
+  }
+#endif
+  alignas(64) std::uint64_t v[kBatchWidth];
+  x.store_aligned(v);
+  for (; lanes != 0; lanes &= lanes - 1) *p++ = v[std::countr_zero(lanes)];
+}
+
+}  // namespace fiberlab::sim::life
