@@ -15,8 +15,10 @@ namespace {
 using life::load;
 using life::load_bits;
 using life::MaskOf;
-constexpr int W = kBatchWidth;
-constexpr int kPoolLanes = 32 * W;  // photons in flight per thread
+// The number type the pool is stepped in: two SIMD vectors (sim/lane_pair.h).
+using Lanes = life::Batch2;
+constexpr int W = life::NumberTraits<Lanes>::kWidth;
+constexpr int kPoolLanes = 16 * W;  // photons in flight per thread
 
 // A vector of lanes draws at most this many rounds of candidate normals per
 // step, a round after the first only while a lane whose candidates are
@@ -93,22 +95,22 @@ struct Pool {
 };
 
 // 0, 1, ..., W - 1 as stream words.
-life::BitsOf<Batch> lane_photon_offsets() {
+life::BitsOf<Lanes> lane_photon_offsets() {
   alignas(64) std::uint64_t idx[W];
   for (int i = 0; i < W; ++i) idx[i] = static_cast<std::uint64_t>(i);
-  return life::BitsOf<Batch>::load_aligned(idx);
+  return life::BitsOf<Lanes>::load_aligned(idx);
 }
 
-Batch lane_index() {
+Lanes lane_index() {
   alignas(64) double idx[W];
   for (int i = 0; i < W; ++i) idx[i] = i;
-  return Batch::load_aligned(idx);
+  return Lanes::load_aligned(idx);
 }
 
 // inclination() and azimuth() of the exit directions of a block, vectorised
 // (truncated photons get angles too; they are not used).
 void exit_angles(FinishedPhotons& f) {
-  for (int i = 0; i < f.n; i += W) {
+  for (int i = 0; i < f.n; i += kBatchWidth) {
     const Batch x = Batch::load_aligned(f.dx + i), y = Batch::load_aligned(f.dy + i),
                 z = Batch::load_aligned(f.dz + i);
     xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), x))).store_aligned(f.theta + i);
@@ -121,8 +123,8 @@ void exit_angles(FinishedPhotons& f) {
 // Their fates and exit directions as finished_outcome (sim/tracer.h) gives
 // them; a model's exit_direction needs each photon's own stream.
 template <class Model, class Light>
-void hand_over(const Model& model, const life::PhotonState<Batch, Light>& s, const Batch& phi_i,
-               const life::BitsOf<Batch>& photon, std::uint64_t lanes, FinishedPhotons& f) {
+void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, const Lanes& phi_i,
+               const life::BitsOf<Lanes>& photon, std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
   if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
   const int n = f.n, k = std::popcount(lanes);
@@ -172,9 +174,9 @@ void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::
         if constexpr (requires { Model::kScalarOnly; }) {
           throw Error("internal error: this roughness model runs on the reference tracer only");
         } else if (settings_.polarization == Polarization::Stokes)
-          trace_with<life::StokesLight<Batch>>(model, theta_i, phi_i, first, n, sink, counters);
+          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, first, n, sink, counters);
         else
-          trace_with<life::ScalarLight<Batch>>(model, theta_i, phi_i, first, n, sink, counters);
+          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, first, n, sink, counters);
       },
       roughness_);
 }
@@ -190,8 +192,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const Source source(settings_, theta_i, phi_i);
   const EllipseCrossSection& ellipse = config_.ellipse;
   const Eigen::Vector2d beam = ellipse.beam_direction(-direction_from_angles(theta_i, phi_i));
-  const Batch iota = lane_index();
-  life::LifeCounts<Batch> counts;
+  const Lanes iota = lane_index();
+  life::LifeCounts<Lanes> counts;
 
   // New photons into lanes [o, o + W), photons first, first + 1, ...: the
   // Source's streams and impact parameters and the life's start, a vector at
@@ -199,15 +201,15 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   // free lanes (or the pool's spare ones): what is written there is never read.
   const bool vector_launch = source.fixed_direction();
   const Vec3 d_fixed = -direction_from_angles(theta_i, phi_i);
-  const life::Vec3Of<Batch> d_lanes{Batch(d_fixed.x()), Batch(d_fixed.y()), Batch(d_fixed.z())};
+  const life::Vec3Of<Lanes> d_lanes{Lanes(d_fixed.x()), Lanes(d_fixed.y()), Lanes(d_fixed.z())};
   auto launch_vector = [&](int o, std::uint64_t first_photon) {
-    const life::BitsOf<Batch> photon = life::BitsOf<Batch>(first_photon) + lane_photon_offsets();
-    const auto lanes = source.template launch_lanes<Batch>(photon);
-    Batch pv, pw;
+    const life::BitsOf<Lanes> photon = life::BitsOf<Lanes>(first_photon) + lane_photon_offsets();
+    const auto lanes = source.template launch_lanes<Lanes>(photon);
+    Lanes pv, pw;
     ellipse.entry_point_in_beam(beam, lanes.h, pv, pw);
     pool.put_state(life::start_photon<Light>(pv, pw, d_lanes, lanes.rng),
                    [o](const auto& x, auto* column) { life::store_unaligned(x, column + o); });
-    Batch(phi_i).store_unaligned(pool.col[Pool::kPhiI] + o);
+    Lanes(phi_i).store_unaligned(pool.col[Pool::kPhiI] + o);
     photon.store_unaligned(pool.bits[Pool::kPhoton] + o);
   };
   // A new photon into lane i: the Source's launch, the life's start.
@@ -255,12 +257,12 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     // tallies are exact integer sums.
     int kept = 0;
     for (int o = 0; o < n_active; o += W) {
-      const MaskOf<Batch> live = (iota + Batch(o)) < Batch(n_active);
-      auto s = pool.load_state<Batch, Light>(o);
-      const Batch phi_lanes = load<Batch>(pool.col[Pool::kPhiI] + o);
-      const life::BitsOf<Batch> photon = load_bits<Batch>(pool.bits[Pool::kPhoton] + o);
+      const MaskOf<Lanes> live = (iota + Lanes(o)) < Lanes(n_active);
+      auto s = pool.load_state<Lanes, Light>(o);
+      const Lanes phi_lanes = load<Lanes>(pool.col[Pool::kPhiI] + o);
+      const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
       life::step(config_, model, s, live, counts, kRoundsPerStep);
-      const MaskOf<Batch> at_boundary = s.code == Batch(life::kAtBoundary);
+      const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
       if (finished != 0) hand_over(model, s, phi_lanes, photon, finished, *done);
@@ -272,9 +274,9 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     n_active = kept;
   }
   if (done->n > 0) flush();
-  counters.events += static_cast<long>(xsimd::hadd(counts.events));
-  counters.normal_draws += static_cast<long>(xsimd::hadd(counts.normal_draws));
-  counters.sampler_caps += static_cast<long>(xsimd::hadd(counts.sampler_caps));
+  counters.events += static_cast<long>(life::lane_sum(counts.events));
+  counters.normal_draws += static_cast<long>(life::lane_sum(counts.normal_draws));
+  counters.sampler_caps += static_cast<long>(life::lane_sum(counts.sampler_caps));
 }
 
 }  // namespace fiberlab::sim

@@ -13,6 +13,7 @@
 #include <bit>
 #include <cstdint>
 
+#include "sim/lane_pair.h"
 #include "sim/lanes.h"
 
 namespace fiberlab::sim::life {
@@ -51,6 +52,18 @@ inline void pack_store(const BitsOf<Batch>& x, std::uint64_t lanes, std::uint64_
   alignas(64) std::uint64_t v[kBatchWidth];
   x.store_aligned(v);
   for (; lanes != 0; lanes &= lanes - 1) *p++ = v[std::countr_zero(lanes)];
+}
+
+// The same for a Pair of vectors (sim/lane_pair.h): lanes [0, W) are the
+// first vector's, [W, 2 W) the second's.
+inline std::uint64_t lane_bits(const MaskOf<Batch2>& m) {
+  return lane_bits(m.a) | (lane_bits(m.b) << kBatchWidth);
+}
+template <class V, class P>
+void pack_store(const Pair<V>& x, std::uint64_t lanes, P* p) {
+  const std::uint64_t low = lanes & ((std::uint64_t{1} << kBatchWidth) - 1);
+  pack_store(x.a, low, p);
+  pack_store(x.b, lanes >> kBatchWidth, p + std::popcount(low));
 }
 
 }  // namespace fiberlab::sim::life

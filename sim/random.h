@@ -74,14 +74,7 @@ class LaneRandom {
 
  private:
   static Bits rotl(const Bits& x, int k) { return (x << k) | (x >> (64 - k)); }
-  static T to_unit(const Bits& x) {
-    if constexpr (std::is_same_v<T, double>) {
-      return static_cast<double>(x >> 11) * 0x1.0p-53;
-    } else {
-      return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x >> 11)) *
-             T(0x1.0p-53);
-    }
-  }
+  static T to_unit(const Bits& x) { return to_double(x >> 11) * T(0x1.0p-53); }
   Bits next(const MaskOf<T>& m) {
     Bits s[4] = {s_[0], s_[1], s_[2], s_[3]};
     const Bits result = step(s);

@@ -45,6 +45,7 @@
 // consistency rule and truncation then apply to it unchanged.
 #include <vector>
 
+#include "sim/lane_pair.h"
 #include "sim/lanes.h"
 #include "sim/random.h"
 
@@ -70,6 +71,9 @@ inline constexpr int kMaxNormalTries = 100000;
 inline bool another_round(bool pending, bool /*slow*/) { return pending; }
 inline bool another_round(const MaskOf<Batch>& pending, const MaskOf<Batch>& slow) {
   return xsimd::any(pending & slow);
+}
+inline bool another_round(const MaskOf<Batch2>& pending, const MaskOf<Batch2>& slow) {
+  return any(pending & slow);
 }
 
 // The macro normals of the boundary point as the photon sees them.
