@@ -56,14 +56,16 @@ inline void pack_store(const BitsOf<Batch>& x, std::uint64_t lanes, std::uint64_
 
 // The same for a Pair of vectors (sim/lane_pair.h): lanes [0, W) are the
 // first vector's, [W, 2 W) the second's.
-inline std::uint64_t lane_bits(const MaskOf<Batch2>& m) {
-  return lane_bits(m.a) | (lane_bits(m.b) << kBatchWidth);
+template <class M>
+std::uint64_t lane_bits(const Pair<M>& m) {
+  return lane_bits(m.a) | (lane_bits(m.b) << (Pair<M>::size / 2));
 }
 template <class V, class P>
 void pack_store(const Pair<V>& x, std::uint64_t lanes, P* p) {
-  const std::uint64_t low = lanes & ((std::uint64_t{1} << kBatchWidth) - 1);
+  constexpr int kHalf = Pair<V>::size / 2;
+  const std::uint64_t low = lanes & ((std::uint64_t{1} << kHalf) - 1);
   pack_store(x.a, low, p);
-  pack_store(x.b, lanes >> kBatchWidth, p + std::popcount(low));
+  pack_store(x.b, lanes >> kHalf, p + std::popcount(low));
 }
 
 }  // namespace fiberlab::sim::life

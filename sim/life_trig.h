@@ -32,8 +32,14 @@ inline double round_half_up(double x) { return std::floor(x + 0.5); }
 inline Batch round_half_up(const Batch& x) { return xsimd::floor(x + Batch(0.5)); }
 inline double floor_of(double x) { return std::floor(x); }
 inline Batch floor_of(const Batch& x) { return xsimd::floor(x); }
-inline Batch2 round_half_up(const Batch2& x) { return floor(x + Batch2(0.5)); }
-inline Batch2 floor_of(const Batch2& x) { return floor(x); }
+template <class V>
+Pair<V> round_half_up(const Pair<V>& x) {
+  return floor(x + Pair<V>(0.5));
+}
+template <class V>
+Pair<V> floor_of(const Pair<V>& x) {
+  return floor(x);
+}
 
 // sin x and cos x for |x| <= pi/4 (Taylor, see above).
 template <class T>

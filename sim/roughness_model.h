@@ -72,7 +72,8 @@ inline bool another_round(bool pending, bool /*slow*/) { return pending; }
 inline bool another_round(const MaskOf<Batch>& pending, const MaskOf<Batch>& slow) {
   return xsimd::any(pending & slow);
 }
-inline bool another_round(const MaskOf<Batch2>& pending, const MaskOf<Batch2>& slow) {
+template <class M>
+bool another_round(const Pair<M>& pending, const Pair<M>& slow) {
   return any(pending & slow);
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "sim/lane_pair.h"
 #include "sim/lane_packing.h"
 
 namespace fiberlab::sim::life {
@@ -49,6 +50,25 @@ TEST(LanePacking, PackStoreWritesTheSelectedLanesInOrder) {
     }
     for (int i = 0; i < 3; ++i) EXPECT_EQ(out[i], kSentinel) << "mask " << bits;
     for (int i = 3 + W; i < W + 6; ++i) EXPECT_EQ(out[i], kSentinel) << "mask " << bits;
+  }
+}
+
+// A Pair of vectors (sim/lane_pair.h) packs as one vector of 2 W lanes.
+TEST(LanePacking, APairPacksAsOneVectorOfTwiceTheLanes) {
+  constexpr int W2 = NumberTraits<Batch2>::kWidth;
+  alignas(64) double v[W2];
+  for (int k = 0; k < W2; ++k) v[k] = 100.0 + k;
+  const Batch2 x = Batch2::load_aligned(v);
+  for (std::uint64_t bits = 0; bits < (std::uint64_t{1} << W2); bits += 1 + (bits % 7)) {
+    const std::uint64_t low = bits & ((std::uint64_t{1} << W) - 1);
+    const MaskOf<Batch2> m(mask_of(low), mask_of(bits >> W));
+    EXPECT_EQ(lane_bits(m), bits);
+    std::vector<double> out(W2 + 2, kSentinel);
+    pack_store(x, bits, out.data());
+    int j = 0;
+    for (int k = 0; k < W2; ++k)
+      if ((bits >> k) & 1) EXPECT_EQ(out[j++], v[k]) << "mask " << bits << " lane " << k;
+    for (int i = W2; i < W2 + 2; ++i) EXPECT_EQ(out[i], kSentinel) << "mask " << bits;
   }
 }
 
