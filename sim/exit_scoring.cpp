@@ -12,8 +12,7 @@ namespace fiberlab::sim {
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
     : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
-      weights_(sigma_a_.size() * FinishedPhotons::kCapacity),
-      words_(2 * sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
+      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()) {}
 
 namespace {
@@ -74,20 +73,12 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   constexpr int W = static_cast<int>(Batch::size);
   constexpr int kCap = FinishedPhotons::kCapacity;
   const int channels = static_cast<int>(sigma_a_.size());
-  // Per channel and photon: the weight, and its words in the tally's sums
-  // (Tally::fixed_word of w and of w^2), a vector of photons at a time.
   for (int c = 0; c < channels; ++c) {
     const Batch minus_sigma(-sigma_a_[c]);
     double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
-    std::int64_t* s1 = words_.data() + static_cast<std::size_t>(c) * kCap;
-    std::int64_t* s2 = words_.data() + static_cast<std::size_t>(channels + c) * kCap;
-    for (int i = 0; i < f.n; i += W) {
-      const Batch wi =
-          Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i));
-      wi.store_aligned(w + i);
-      Tally::fixed_word(wi).store_aligned(s1 + i);
-      Tally::fixed_word(wi * wi).store_aligned(s2 + i);
-    }
+    for (int i = 0; i < f.n; i += W)
+      (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
+          .store_unaligned(w + i);
   }
   alignas(64) std::int64_t theta_bin[kCap], phi_bin[kCap];
   block_bins(f, theta_bin, phi_bin);
@@ -99,17 +90,10 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     tally.prefetch(bin[i]);
   }
   double* weight = one_photon_.data();
-  const std::int64_t* s1 = words_.data();
-  const std::int64_t* s2 = words_.data() + static_cast<std::size_t>(channels) * kCap;
   for (int i = 0; i < f.n; ++i) {
-    if (f.exited[i]) {
-      for (int c = 0; c < channels; ++c)
-        tally.score_exit_words(bin[i], c, s1[c * kCap + i], s2[c * kCap + i]);
-      tally.count_exit(bin[i]);
-    } else if (!f.lost[i]) {
-      for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
-      tally.score_truncated(weight);
-    }
+    for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
+    if (f.exited[i]) tally.score_exit(bin[i], weight);
+    else if (!f.lost[i]) tally.score_truncated(weight);
   }
   // Masking's removals (issue 12), each absorbed along the path up to it,
   // summed per photon (a photon's removals are consecutive in f.losses).

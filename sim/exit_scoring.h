@@ -3,8 +3,6 @@
 // Beer-Lambert weight exp(-sigma_a[c] l) per channel along the whole internal
 // path (times the photon's masking throughput), the lobe min(p, L - 1) and the
 // (theta_r, phi_r - phi_i) bin; weight removed by masking as the ledger's lost.
-#include <xsimd/xsimd.hpp>
-
 #include <cstdint>
 #include <vector>
 
@@ -28,9 +26,7 @@ class ExitScorer {
   const BinGrid& grid_;
   std::vector<double> sigma_a_;
   int last_lobe_;
-  std::vector<double, xsimd::aligned_allocator<double>> weights_;  // [channel][photon]
-  // [S1 words per channel, then S2 words per channel][photon] (Tally::fixed_word)
-  std::vector<std::int64_t, xsimd::aligned_allocator<std::int64_t>> words_;
+  std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
 };

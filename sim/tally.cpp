@@ -23,11 +23,15 @@ Tally& Tally::operator=(const Tally& o) {
 }
 
 void Tally::score_exit(std::size_t bin, const double* weight) {
+  touched_[bin / kPageBins] = 1;
+  Fixed* cell = cells() + bin * block();
+  ++cell[0];
+  Fixed* s1 = cell + 1;
+  Fixed* s2 = cell + 1 + channels_;
   for (int c = 0; c < channels_; ++c) {
-    const std::int64_t s1 = fixed_word(weight[c]), s2 = fixed_word(weight[c] * weight[c]);
-    score_exit_words(bin, c, s1, s2);
+    s1[c] += to_fixed(weight[c]);
+    s2[c] += to_fixed(weight[c] * weight[c]);
   }
-  count_exit(bin);
 }
 
 void Tally::clear() {

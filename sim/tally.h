@@ -12,8 +12,6 @@
 // remembers which pages of bins it wrote: adding, clearing, copying and
 // exporting a tally visit only those, so a thread's tally costs what it holds
 // (a 90 x 180 x 8-lobe, 3-channel tally is 14.5 MB; a run touches 1-40% of it).
-#include <xsimd/xsimd.hpp>
-
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -46,22 +44,6 @@ class Tally {
     score_exit(bin_index(lobe, i_theta, i_phi), weight);
   }
   void score_exit(std::size_t bin, const double* weight);
-  // The same a part at a time, with the sums' words already computed
-  // (ExitScorer does a block of photons at once): channel c's words s1 =
-  // fixed_word(weight[c]) and s2 = fixed_word(weight[c]^2), and the count.
-  void score_exit_words(std::size_t bin, int c, std::int64_t s1, std::int64_t s2) {
-    touched_[bin / kPageBins] = 1;
-    Fixed* cell = cells() + bin * block();
-    cell[1 + c] += s1;
-    cell[1 + channels_ + c] += s2;
-  }
-  void count_exit(std::size_t bin) { ++cells()[bin * block()]; }
-  // A weight in [0, 1] in the sums' fixed point (rounded to the nearest
-  // 2^-60), for one weight or a SIMD vector of them: the same numbers.
-  static std::int64_t fixed_word(double w) { return static_cast<std::int64_t>(w * kScale + 0.5); }
-  static xsimd::batch<std::int64_t> fixed_word(const xsimd::batch<double>& w) {
-    return xsimd::to_int(w * xsimd::batch<double>(kScale) + xsimd::batch<double>(0.5));
-  }
   // Every sum back to zero (only the touched pages are written): a thread's
   // tally is reused across rounds and incident directions.
   void clear();
@@ -124,7 +106,7 @@ class Tally {
   std::size_t page_begin(std::size_t p) const { return p * kPageBins * block(); }
   std::size_t page_end(std::size_t p) const { return std::min((p + 1) * kPageBins, bins()) * block(); }
   Fixed* cells() const { return static_cast<Fixed*>(memory_.data()); }
-  static Fixed to_fixed(double w) { return fixed_word(w); }
+  static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
   // that scoring a photon touches one or two cache lines, not three arrays.
