@@ -6,8 +6,9 @@
 //
 // T = double traces one photon: sim/tracer.cpp runs step() until the photon
 // is done, the readable reference. T = xsimd::batch<double> traces a SIMD
-// vector of photons: sim/batch_tracer.cpp keeps a pool of photons in lanes,
-// runs step() on each vector of lanes, refills the lanes whose photon is done.
+// vector of photons, and T = Pair<Batch> (sim/lane_pair.h) two of them:
+// sim/batch_tracer.cpp keeps a pool of photons in lanes, runs step() on each
+// Pair of vectors of lanes, refills the lanes whose photon is done.
 // A photon draws the same random numbers in the same order either way (every
 // draw is masked to the lanes that make it), so both give the same path up to
 // the last bits of the vectorised log/sin/cos (tests/sim/test_batch_tracer.cpp).
