@@ -6,10 +6,11 @@
 //
 // pack_store(x, lanes, p) writes the selected lanes of x, lowest first, to
 // p[0], p[1], ... . With AVX-512 it packs in a register (one compress
-// instruction) and writes a whole vector from p, so p must have room for W
-// values and the values past the selected ones are scratch. (A compress
-// straight to memory is avoided: it is microcoded and slow on AMD Zen 4.)
-// Other instruction sets write the selected lanes one at a time.
+// instruction; AVX2: one permutation from a table of the 16 masks of 4
+// lanes) and writes a whole vector from p, so p must have room for W values
+// and the values past the selected ones are scratch. (A compress straight
+// to memory is avoided: it is microcoded and slow on AMD Zen 4.) Other
+// instruction sets write the selected lanes one at a time.
 #include <bit>
 #include <cstdint>
 
@@ -22,6 +23,8 @@ namespace fiberlab::sim::life {
 inline std::uint64_t lane_bits(const MaskOf<Batch>& m) {
 #if defined(__AVX512F__)
   if constexpr (kBatchWidth == 8) return static_cast<std::uint64_t>(static_cast<__mmask8>(m.data));
+#elif defined(__AVX2__)
+  if constexpr (kBatchWidth == 4) return static_cast<std::uint64_t>(_mm256_movemask_pd(m.data));
 #endif
   alignas(64) bool b[kBatchWidth];
   m.store_aligned(b);
@@ -30,10 +33,41 @@ inline std::uint64_t lane_bits(const MaskOf<Batch>& m) {
   return bits;
 }
 
+#if !defined(__AVX512F__) && defined(__AVX2__)
+namespace packing_detail {
+// For each mask of 4 lanes, the permutation of 32-bit elements that moves
+// its lanes (two elements each) to the front, lowest first.
+struct PackTable {
+  alignas(32) std::int32_t index[16][8];
+  constexpr PackTable() : index{} {
+    for (int m = 0; m < 16; ++m) {
+      int j = 0;
+      for (int k = 0; k < 4; ++k)
+        if ((m >> k) & 1) {
+          index[m][2 * j] = 2 * k;
+          index[m][2 * j + 1] = 2 * k + 1;
+          ++j;
+        }
+    }
+  }
+};
+inline constexpr PackTable kPackTable{};
+inline __m256i pack_index(std::uint64_t lanes) {
+  return _mm256_load_si256(reinterpret_cast<const __m256i*>(kPackTable.index[lanes & 15]));
+}
+}  // namespace packing_detail
+#endif
+
 inline void pack_store(const Batch& x, std::uint64_t lanes, double* p) {
 #if defined(__AVX512F__)
   if constexpr (kBatchWidth == 8) {
     _mm512_storeu_pd(p, _mm512_maskz_compress_pd(static_cast<__mmask8>(lanes), x));
+    return;
+  }
+#elif defined(__AVX2__)
+  if constexpr (kBatchWidth == 4) {
+    const __m256 v = _mm256_permutevar8x32_ps(_mm256_castpd_ps(x), packing_detail::pack_index(lanes));
+    _mm256_storeu_pd(p, _mm256_castps_pd(v));
     return;
   }
 #endif
@@ -46,6 +80,12 @@ inline void pack_store(const BitsOf<Batch>& x, std::uint64_t lanes, std::uint64_
 #if defined(__AVX512F__)
   if constexpr (kBatchWidth == 8) {
     _mm512_storeu_si512(p, _mm512_maskz_compress_epi64(static_cast<__mmask8>(lanes), x));
+    return;
+  }
+#elif defined(__AVX2__)
+  if constexpr (kBatchWidth == 4) {
+    _mm256_storeu_si256(reinterpret_cast<__m256i*>(p),
+                        _mm256_permutevar8x32_epi32(x, packing_detail::pack_index(lanes)));
     return;
   }
 #endif
