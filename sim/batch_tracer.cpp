@@ -145,14 +145,14 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     f.lost[n + j] = fate == PhotonFate::Lost;
     if (fate != PhotonFate::Exited) f.dx[n + j] = f.dy[n + j] = f.dz[n + j] = 0.0;  // no exit direction
   }
-  if constexpr (requires(PhotonRandom& r) { model.exit_direction(Vec3(), 0, r); }) {
+  if constexpr (HasExitHook<Model>) {
     alignas(64) std::uint64_t w[4][W];
     for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
     for (int j = 0; j < k; ++j) {
       if (!f.exited[n + j]) continue;
       PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
-      const Vec3 d = model.exit_direction(Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
-                                          f.segments[n + j], rng);
+      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                       f.segments[n + j], rng);
       f.dx[n + j] = d.x();
       f.dy[n + j] = d.y();
       f.dz[n + j] = d.z();

@@ -2,6 +2,7 @@
 // The reference tracer: one photon's life (sim/photon_life.h) at a time, the
 // scalar instantiation of the same steps the batched tracer runs on SIMD
 // vectors of photons (sim/batch_tracer.h).
+#include <concepts>
 #include <vector>
 
 #include "common/fiber_frame.h"
@@ -52,8 +53,21 @@ inline PhotonFate fate_of(int code) {
                                     : PhotonFate::Lost;
 }
 
-// The outcome of a photon whose life ended with `code`: the exit direction
-// goes through the model's exit hook (exit_blur), if it has one.
+// A roughness model with an exit hook (exit_blur): the direction a photon
+// leaves along is drawn from its own stream when it exits.
+template <class Model>
+concept HasExitHook = requires(const Model& m, const Vec3& d, int segments, PhotonRandom& rng) {
+  { m.exit_direction(d, segments, rng) } -> std::same_as<Vec3>;
+};
+
+// The direction of a photon that exited along d after `segments` segments.
+template <class Model>
+Vec3 exit_direction_of(const Model& model, const Vec3& d, int segments, PhotonRandom& rng) {
+  if constexpr (HasExitHook<Model>) return model.exit_direction(d, segments, rng);
+  else return d;
+}
+
+// The outcome of a photon whose life ended with `code`.
 template <class Model>
 PhotonOutcome finished_outcome(const Model& model, int code, const Vec3& d, int segments,
                                double path, double weight, PhotonRandom& rng) {
@@ -62,11 +76,7 @@ PhotonOutcome finished_outcome(const Model& model, int code, const Vec3& d, int 
   out.segments = segments;
   out.path_length = path;
   out.weight = weight;
-  if (out.fate == PhotonFate::Exited) {
-    out.direction = d;
-    if constexpr (requires { model.exit_direction(d, segments, rng); })
-      out.direction = model.exit_direction(d, segments, rng);
-  }
+  if (out.fate == PhotonFate::Exited) out.direction = exit_direction_of(model, d, segments, rng);
   return out;
 }
 
