@@ -224,6 +224,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     pool.bits[Pool::kPhoton][i] = photon;
   };
   auto flush = [&] {
+    done->clear_tail();
     exit_angles(*done);
     sink(*done);
     done->n = 0;

@@ -2,6 +2,7 @@
 // Photons that a tracer has finished, handed to the scorer a block at a time
 // (structure of arrays), so that weights are computed vectorised and the
 // tally's cells fetched ahead, instead of one call per photon.
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -11,6 +12,7 @@ namespace fiberlab::sim {
 
 struct FinishedPhotons {
   static constexpr int kCapacity = 512;  // a multiple of every SIMD width
+  static_assert(kCapacity % kBatchWidth == 0);
   int n = 0;
   alignas(64) double path[kCapacity] = {};  // internal 3D path length
   alignas(64) double weight[kCapacity] = {};  // throughput before absorption (PhotonOutcome::weight)
@@ -29,6 +31,15 @@ struct FinishedPhotons {
   std::vector<Loss> losses;
 
   bool full() const { return n == kCapacity; }
+  // Zeroes the numbers of slots [n, the end of n's SIMD vector): the scorer's
+  // vectorised loops read a whole vector, and a batched tracer appends whole
+  // vectors, whose lanes past its photons hold scratch (any bits, possibly a
+  // value that would overflow a conversion to an integer).
+  void clear_tail() {
+    const int end = (n + kBatchWidth - 1) / kBatchWidth * kBatchWidth;
+    for (double* column : {path, weight, phi_i, dx, dy, dz})
+      std::fill(column + n, column + end, 0.0);
+  }
   void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
     if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
     for (const WeightLoss& l : o.losses) losses.push_back({n, l});
