@@ -148,6 +148,10 @@ BitsOf<Pair<V>> to_bits(const Pair<V>& x) {
   return {to_bits(x.a), to_bits(x.b)};
 }
 template <class U>
+auto bits_as_double(const Pair<U>& x) {
+  return pair_of(bits_as_double(x.a), bits_as_double(x.b));
+}
+template <class U>
 auto to_double(const Pair<U>& x) {
   return pair_of(to_double(x.a), to_double(x.b));
 }

@@ -4,7 +4,7 @@
 //
 // - sincos_turn(u) = (sin 2 pi u, cos 2 pi u) for u in [0, 1): a uniform
 //   direction in a plane. The quadrant comes from u itself (u - q/4 is exact
-//   for the generator's multiples of 2^-53), so no range reduction of an
+//   for the generator's multiples of 2^-52), so no range reduction of an
 //   angle is needed.
 // - sincos_small(x) for any x: the kernel below where every lane has
 //   |x| <= pi/4 (the gaussian sampler's offsets for betas up to about 10

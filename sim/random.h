@@ -4,7 +4,14 @@
 // photon's path depends neither on which thread traces it, in which order,
 // nor on where its direction sits in a sweep: a sweep split into jobs and
 // merged equals one run (OpenMC's scheme; SPEC section 6, reproducibility).
-// Generator: xoshiro256** (Blackman & Vigna 2018) seeded through SplitMix64.
+// Generator: xoshiro256+ (Blackman & Vigna, "Scrambled linear pseudorandom
+// number generators", ACM TOMS 2021), seeded through SplitMix64. The authors
+// recommend it for floating-point numbers: its output is the sum s0 + s3 of
+// two state words, whose lowest bits have low linear complexity, and a
+// uniform double keeps only the top 52 bits. It replaced xoshiro256** (the
+// same state and steps, a scrambler of seven integer operations instead of
+// one), which cost 4-6% of a whole run on an AVX2 machine (README,
+// Performance).
 //
 // LaneRandom<T> is the generator written once for a number type (sim/lanes.h):
 // one stream (T = double) or W streams side by side (T = Batch), each
@@ -57,7 +64,7 @@ class LaneRandom {
 
   // Uniform in [0, 1) where m (other lanes: any value, stream untouched).
   T uniform(const MaskOf<T>& m) { return to_unit(next(m)); }
-  // Uniform in (0, 1]: safe under log().
+  // Uniform in (0, 1): safe under log().
   T uniform_open0(const MaskOf<T>& m) { return open0(uniform(m)); }
   // N uniforms in [0, 1) where m: the same numbers as N calls of uniform(m),
   // the stream's state masked once instead of N times.
@@ -69,24 +76,27 @@ class LaneRandom {
     commit(m, s);
     return u;
   }
-  // A uniform in [0, 1) moved to (0, 1].
+  // A uniform in [0, 1) moved to (0, 1): k 2^-52 becomes (k + 1/2) 2^-52,
+  // exact (2k + 1 < 2^53).
   static T open0(const T& u) { return u + T(0x1.0p-53); }
 
  private:
   static Bits rotl(const Bits& x, int k) { return (x << k) | (x >> (64 - k)); }
-  static T to_unit(const Bits& x) { return to_double(x >> 11) * T(0x1.0p-53); }
+  // The top 52 bits of x as k 2^-52 in [0, 1), exactly: they become the
+  // mantissa of a double in [1, 2), and 1 is subtracted (no integer to
+  // floating-point conversion, which AVX2 lacks for 64-bit words).
+  static T to_unit(const Bits& x) {
+    return bits_as_double((x >> 12) | Bits(0x3FF0000000000000ULL)) - T(1.0);
+  }
   Bits next(const MaskOf<T>& m) {
     Bits s[4] = {s_[0], s_[1], s_[2], s_[3]};
     const Bits result = step(s);
     commit(m, s);
     return result;
   }
-  // xoshiro256**: result = rotl(s1 * 5, 7) * 9 (multiplies as shifts and adds,
-  // which every SIMD unit has), and the state s steps.
+  // xoshiro256+: result = s0 + s3, and the state s steps.
   static Bits step(Bits (&s)[4]) {
-    const Bits x5 = (s[1] << 2) + s[1];
-    const Bits r7 = rotl(x5, 7);
-    const Bits result = (r7 << 3) + r7;
+    const Bits result = s[0] + s[3];
     const Bits t = s[1] << 17;
     s[2] = s[2] ^ s[0];
     s[3] = s[3] ^ s[1];
