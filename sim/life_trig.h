@@ -11,13 +11,17 @@
 //   degrees), a reduction by multiples of pi/2 then the kernel where every
 //   lane has |x| <= 2^20, the library's sincos beyond.
 //
-// The kernel is the Taylor series of sin (to x^17) and cos (to x^18) in
-// Horner form with explicit fused multiply-adds. For |x| <= pi/4 the first
-// omitted terms are x^19/19! < 8e-20 and x^20/20! < 3e-21, far below the
-// rounding of the sum (about 1e-16), so the result is as accurate as the
-// library's, not an approximation of it; the scalar and vector forms perform
-// the same operations and give the same bits (photon-by-photon equivalence,
-// tests/sim/test_batch_tracer.cpp). tests/sim/test_life_trig.cpp compares
+// The kernel: polynomials in z = x^2 of degree 6 (sin x = x + x z S(z)) and
+// 5 (cos x = 1 - z (1/2 - z C(z))) in Horner form with explicit fused
+// multiply-adds. S and C interpolate at Chebyshev nodes (near-minimax), in
+// 60-digit decimals, by scripts/life_trig_coefficients.py: with the
+// coefficients rounded to double, the polynomials differ from sin and cos by
+// at most 0.06 and 0.012 units of 2^-53 (relative) on |x| <= pi/4, far below
+// the rounding of the evaluation (about 2^-53), so the result is as accurate
+// as the library's, not an approximation of it. (Until the tenth session the
+// Taylor series to x^17 and x^18: five more operations per pair.) The
+// scalar and vector forms perform the same operations and give the same
+// bits (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp). tests/sim/test_life_trig.cpp compares
 // both with std::sin / std::cos.
 #include <utility>
 
@@ -41,30 +45,27 @@ Pair<V> floor_of(const Pair<V>& x) {
   return floor(x);
 }
 
-// sin x and cos x for |x| <= pi/4 (Taylor, see above).
+// sin x and cos x for |x| <= pi/4 (near-minimax polynomials, see above).
 template <class T>
 [[gnu::always_inline]] inline std::pair<T, T> kernel(const T& x) {
   const T z = x * x;
-  // sin x = x (1 - z/3! + z^2/5! - ... + z^8/17!)
-  T s(1.0 / 355687428096000.0);  // 1/17!
-  s = fma(s, z, T(-1.0 / 1307674368000.0));
-  s = fma(s, z, T(1.0 / 6227020800.0));
-  s = fma(s, z, T(-1.0 / 39916800.0));
-  s = fma(s, z, T(1.0 / 362880.0));
-  s = fma(s, z, T(-1.0 / 5040.0));
-  s = fma(s, z, T(1.0 / 120.0));
-  s = fma(s, z, T(-1.0 / 6.0));
+  // sin x = x + x z S(z)
+  T s(-0x1.ab17d404de5b3p-41);
+  s = fma(s, z, T(0x1.61217f0b800d5p-33));
+  s = fma(s, z, T(-0x1.ae645412c560cp-26));
+  s = fma(s, z, T(0x1.71de3a546095bp-19));
+  s = fma(s, z, T(-0x1.a01a01a019938p-13));
+  s = fma(s, z, T(0x1.1111111111110p-7));
+  s = fma(s, z, T(-0x1.5555555555555p-3));
   s = fma(s * z, x, x);
-  // cos x = 1 - z/2! + z^2/4! - ... + z^9/18!
-  T c(1.0 / 6402373705728000.0);  // 1/18!
-  c = fma(c, z, T(-1.0 / 20922789888000.0));
-  c = fma(c, z, T(1.0 / 87178291200.0));
-  c = fma(c, z, T(-1.0 / 479001600.0));
-  c = fma(c, z, T(1.0 / 3628800.0));
-  c = fma(c, z, T(-1.0 / 40320.0));
-  c = fma(c, z, T(1.0 / 720.0));
-  c = fma(c, z, T(-1.0 / 24.0));
-  c = fma(c, z, T(0.5));
+  // cos x = 1 - z (1/2 - z C(z))
+  T c(-0x1.907da367a37cbp-37);
+  c = fma(c, z, T(0x1.1eeb68e93b64cp-29));
+  c = fma(c, z, T(-0x1.27e4fa17da09ep-22));
+  c = fma(c, z, T(0x1.a01a019f4eb01p-16));
+  c = fma(c, z, T(-0x1.6c16c16c16967p-10));
+  c = fma(c, z, T(0x1.5555555555555p-5));
+  c = fma(-c, z, T(0.5));
   c = fma(-c, z, T(1.0));
   return {s, c};
 }
