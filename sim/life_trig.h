@@ -21,8 +21,8 @@
 // as the library's, not an approximation of it. (Until the tenth session the
 // Taylor series to x^17 and x^18: five more operations per pair.) The
 // scalar and vector forms perform the same operations and give the same
-// bits (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp). tests/sim/test_life_trig.cpp compares
-// both with std::sin / std::cos.
+// bits (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp).
+// tests/sim/test_life_trig.cpp compares both with std::sin / std::cos.
 #include <utility>
 
 #include "sim/lane_pair.h"

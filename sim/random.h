@@ -153,7 +153,7 @@ class PhotonRandom {
 
   // Uniform in [0, 1).
   double uniform() { return core_.uniform(true); }
-  // Uniform in (0, 1]: safe under log().
+  // Uniform in (0, 1): safe under log().
   double uniform_open0() { return core_.uniform_open0(true); }
 
   // Standard normal deviate (Box-Muller, both values used).
