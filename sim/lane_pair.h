@@ -151,6 +151,10 @@ template <class U>
 auto bits_as_double(const Pair<U>& x) {
   return pair_of(bits_as_double(x.a), bits_as_double(x.b));
 }
+template <class V>
+BitsOf<Pair<V>> double_as_bits(const Pair<V>& x) {
+  return {double_as_bits(x.a), double_as_bits(x.b)};
+}
 template <class U>
 auto to_double(const Pair<U>& x) {
   return pair_of(to_double(x.a), to_double(x.b));

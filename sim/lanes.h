@@ -94,9 +94,13 @@ inline std::uint64_t to_bits(double x) { return static_cast<std::uint64_t>(x); }
 inline BitsOf<Batch> to_bits(const Batch& x) {
   return xsimd::bitwise_cast<BitsOf<Batch>>(xsimd::to_int(x));
 }
-// A word's 64 bits read as a double's.
+// A word's 64 bits read as a double's, and back.
 inline double bits_as_double(std::uint64_t x) { return std::bit_cast<double>(x); }
 inline Batch bits_as_double(const BitsOf<Batch>& x) { return xsimd::bitwise_cast<Batch>(x); }
+inline std::uint64_t double_as_bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+inline BitsOf<Batch> double_as_bits(const Batch& x) {
+  return xsimd::bitwise_cast<BitsOf<Batch>>(x);
+}
 inline double to_double(std::uint64_t x) { return static_cast<double>(x); }
 inline Batch to_double(const BitsOf<Batch>& x) {
   return xsimd::to_float(xsimd::bitwise_cast<xsimd::batch<std::int64_t>>(x));

@@ -14,7 +14,7 @@
 // The kernel: polynomials in z = x^2 of degree 6 (sin x = x + x z S(z)) and
 // 5 (cos x = 1 - z (1/2 - z C(z))) in Horner form with explicit fused
 // multiply-adds. S and C interpolate at Chebyshev nodes (near-minimax), in
-// 60-digit decimals, by scripts/life_trig_coefficients.py: with the
+// 60-digit decimals, by scripts/life_kernel_coefficients.py: with the
 // coefficients rounded to double, the polynomials differ from sin and cos by
 // at most 0.06 and 0.012 units of 2^-53 (relative) on |x| <= pi/4, far below
 // the rounding of the evaluation (about 2^-53), so the result is as accurate

@@ -6,14 +6,16 @@
 // the tracers use instead (make_roughness in sim/roughness_models.h).
 //
 // The sampler: one exact rejection sampler for every incidence, with the same
-// work for every candidate (a fixed block of five uniforms, one log, two
-// square roots, three sine-cosine pairs, sim/life_trig.h), so that a SIMD
-// vector of photons never waits on a branch only some of its lanes take. Its
+// work for every candidate (a fixed block of five uniforms, one log
+// (sim/life_log.h), two square roots, three sine-cosine pairs
+// (sim/life_trig.h)), so that a SIMD vector of photons never waits on a
+// branch only some of its lanes take. Its
 // proposal, and the proof that it bounds the target, is in
 // sim/gaussian_envelope.h.
 #include <optional>
 
 #include "sim/gaussian_envelope.h"
+#include "sim/life_log.h"
 #include "sim/life_trig.h"
 #include "sim/roughness_model.h"
 #include "sim/settings.h"
@@ -49,7 +51,7 @@ class GaussianRoughness {
       const T pick = u_pick * mass;
       const MaskOf<T> gamma2 = pick >= a_end;
       const MaskOf<T> lobe = (pick >= env.a_flat) & (pick < lobe_end);
-      const T e = -log(u1 * select(gamma2, u2, T(1.0)));
+      const T e = -log_normal(u1 * select(gamma2, u2, T(1.0)));
       const T rho = sqrt(T(2.0) * (env.w0 + e));
       const Direction<T> dir = direction(env, lobe, u_psi);
       const Vec3Of<T> m = rotated_normal(sin_n, cos_n, pv, pw, T(widths_.beta_long) * rho * dir.cos,

@@ -1,4 +1,5 @@
-"""The coefficients of sim/life_trig.h's sine and cosine kernel for |x| <= pi/4.
+"""The coefficients of the photon life's kernels: sim/life_trig.h's sine and
+cosine for |x| <= pi/4 and sim/life_log.h's logarithm.
 
 In z = x^2, with 60-digit decimal arithmetic (Python's decimal module, no
 other dependency):
@@ -10,7 +11,12 @@ rounded to double) and the largest error, relative to sin x or cos x, of the
 polynomial with the rounded coefficients over 2000 points of z (exact
 arithmetic otherwise): about 0.06 and 0.012 units of 2^-53.
 
-Run: /usr/bin/python3 scripts/life_trig_coefficients.py
+The logarithm: log(1 + f) = f - f^2/2 + s (f^2/2 + z P(z)) for 1 + f in
+[sqrt(2)/2, sqrt(2)), s = f / (2 + f), z = s^2, P of degree 6 interpolating
+sum_k 2 z^(k-1) / (2k + 1) at the Chebyshev nodes of [0, s_max^2]; s z P(z)
+is within about 0.04 units of 2^-53 of its target, relative to log(1 + f).
+
+Run: /usr/bin/python3 scripts/life_kernel_coefficients.py
 """
 from decimal import Decimal as D, getcontext
 getcontext().prec = 60
@@ -77,3 +83,28 @@ for name, g, deg in (("sin", g_sin, 6), ("cos", g_cos, 5)):
             f = 1 - z / 2 + z * z * g_cos(z); err = abs(z * z * (p - g(z))) / f
         worst = max(worst, err)
     print(name, "worst relative error of the polynomial (coefficients rounded):", float(worst), "=", float(worst / D(2) ** -53), "ulp-ish (2^-53)")
+
+# The logarithm's kernel (sim/life_log.h): log(1 + f) = f - f^2/2 + s (f^2/2 + z P(z)),
+# s = f / (2 + f), z = s^2, for 1 + f in [sqrt(2)/2, sqrt(2)): |s| <= (sqrt 2 - 1) / (sqrt 2 + 1).
+# P of degree 6 ~ sum_{k>=1} 2 z^(k-1) / (2k + 1) (the series of log((1+s)/(1-s)) = 2s + s z P(z)).
+def g_log(z):
+    s = D(0); k = 1; t = D(1)
+    while True:
+        term = 2 * t / (2 * k + 1)
+        if abs(term) < D(10) ** -70: return s
+        s += term; t *= z; k += 1
+
+SQ2 = D(2).sqrt()
+S_MAX = (SQ2 - 1) / (SQ2 + 1)
+ZL = S_MAX * S_MAX
+c = interpolate(g_log, 6, ZL)
+print("log", [float(v).hex() for v in c])
+cd = [D(float(v)) for v in c]
+worst = D(0)
+for i in range(1, 2001):
+    z = ZL * i / 2000
+    sz = z.sqrt()
+    p = sum(cd[j] * z ** j for j in range(7))
+    f = abs(2 * sz + sz * z * g_log(z))  # |log((1 + s) / (1 - s))|
+    worst = max(worst, sz * z * abs(p - g_log(z)) / f)
+print("log worst relative error of s z P(z) (coefficients rounded):", float(worst), "=", float(worst / D(2) ** -53), "units of 2^-53")
