@@ -1,8 +1,10 @@
 // The batched, vectorised tracer against the reference tracer, photon by
 // photon: each photon draws from its own stream in the same order in both,
 // so paths agree to rounding (1e-7 allows the drift of light-guided photons
-// over a hundred segments), except where the vectorised sin/cos/log round
-// differently in the last bit and that flips a random decision (rare).
+// over a hundred segments), except where the two round differently in the
+// last bit and that flips a random decision (rare: the sampler's sin, cos
+// and log are one code for both, sim/life_trig.h and sim/life_log.h, but the
+// compiler may fuse a product into a sum in one form and not the other).
 #include <gtest/gtest.h>
 
 #include <cstdio>
