@@ -9,7 +9,6 @@
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
-#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -56,15 +55,6 @@ inline double max(double a, double b) { return std::max(a, b); }
 inline double asin(double x) { return std::asin(x); }
 inline std::pair<double, double> sincos(double x) { return {std::sin(x), std::cos(x)}; }
 inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
-
-// c[0] z^(N-1) + c[1] z^(N-2) + ... + c[N-1] by Horner's rule, one fused
-// multiply-add a coefficient (the life's polynomial kernels).
-template <class T, std::size_t N>
-[[gnu::always_inline]] inline T horner(const T& z, const std::array<double, N>& c) {
-  T r(c[0]);
-  for (std::size_t i = 1; i < N; ++i) r = fma(r, z, T(c[i]));
-  return r;
-}
 
 // A mask over doubles as a mask over the random streams' 64-bit words.
 inline bool bits_mask(bool m) { return m; }

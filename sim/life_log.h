@@ -19,8 +19,6 @@
 // evaluation. k ln 2 is added in two parts (ln 2's first 32 bits, exact
 // when multiplied by any k here, and the rest). tests/sim/test_life_log.cpp
 // compares with std::log.
-#include <array>
-
 #include "sim/lane_pair.h"
 #include "sim/lanes.h"
 
@@ -28,10 +26,6 @@ namespace fiberlab::sim::life {
 
 namespace log_detail {
 
-// P's coefficients, highest first (scripts/life_kernel_coefficients.py).
-inline constexpr std::array<double, 7> kLogP = {
-    0x1.2b584aae78a57p-3, 0x1.39fe606542ddep-3, 0x1.7462b4ab2ef6bp-3, 0x1.c71c62e5800a1p-3,
-    0x1.2492492df148dp-2, 0x1.99999999952e2p-2, 0x1.5555555555558p-1};
 // ln 2 = kLn2Hi + kLn2Lo: kLn2Hi has 32 significant bits.
 inline constexpr double kLn2Hi = 0x1.62e42fee00000p-1;
 inline constexpr double kLn2Lo = 0x1.a39ef35793c76p-33;
@@ -53,7 +47,13 @@ template <class T>
   const T f = m - T(1.0);
   const T s = f / (T(2.0) + f);
   const T z = s * s;
-  const T p = horner(z, kLogP);
+  T p(0x1.2b584aae78a57p-3);
+  p = fma(p, z, T(0x1.39fe606542ddep-3));
+  p = fma(p, z, T(0x1.7462b4ab2ef6bp-3));
+  p = fma(p, z, T(0x1.c71c62e5800a1p-3));
+  p = fma(p, z, T(0x1.2492492df148dp-2));
+  p = fma(p, z, T(0x1.99999999952e2p-2));
+  p = fma(p, z, T(0x1.5555555555558p-1));
   const T hfsq = fma(T(0.5) * f, f, T(0.0));  // f^2/2, never contracted into a sum below
   const T tail = fma(s, fma(z, p, hfsq), k * T(kLn2Lo));
   return fma(k, T(kLn2Hi), (tail - hfsq) + f);

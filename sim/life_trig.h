@@ -23,7 +23,6 @@
 // scalar and vector forms perform the same operations and give the same
 // bits (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp).
 // tests/sim/test_life_trig.cpp compares both with std::sin / std::cos.
-#include <array>
 #include <utility>
 
 #include "sim/lane_pair.h"
@@ -46,20 +45,27 @@ Pair<V> floor_of(const Pair<V>& x) {
   return floor(x);
 }
 
-// The kernel's coefficients, highest first (scripts/life_kernel_coefficients.py).
-inline constexpr std::array<double, 7> kSinS = {
-    -0x1.ab17d404de5b3p-41, 0x1.61217f0b800d5p-33, -0x1.ae645412c560cp-26, 0x1.71de3a546095bp-19,
-    -0x1.a01a01a019938p-13, 0x1.1111111111110p-7,  -0x1.5555555555555p-3};
-inline constexpr std::array<double, 6> kCosC = {
-    -0x1.907da367a37cbp-37, 0x1.1eeb68e93b64cp-29, -0x1.27e4fa17da09ep-22,
-    0x1.a01a019f4eb01p-16,  -0x1.6c16c16c16967p-10, 0x1.5555555555555p-5};
-
 // sin x and cos x for |x| <= pi/4 (near-minimax polynomials, see above).
 template <class T>
 [[gnu::always_inline]] inline std::pair<T, T> kernel(const T& x) {
   const T z = x * x;
-  const T s = fma(horner(z, kSinS) * z, x, x);  // sin x = x + x z S(z)
-  T c = fma(-horner(z, kCosC), z, T(0.5));      // cos x = 1 - z (1/2 - z C(z))
+  // sin x = x + x z S(z)
+  T s(-0x1.ab17d404de5b3p-41);
+  s = fma(s, z, T(0x1.61217f0b800d5p-33));
+  s = fma(s, z, T(-0x1.ae645412c560cp-26));
+  s = fma(s, z, T(0x1.71de3a546095bp-19));
+  s = fma(s, z, T(-0x1.a01a01a019938p-13));
+  s = fma(s, z, T(0x1.1111111111110p-7));
+  s = fma(s, z, T(-0x1.5555555555555p-3));
+  s = fma(s * z, x, x);
+  // cos x = 1 - z (1/2 - z C(z))
+  T c(-0x1.907da367a37cbp-37);
+  c = fma(c, z, T(0x1.1eeb68e93b64cp-29));
+  c = fma(c, z, T(-0x1.27e4fa17da09ep-22));
+  c = fma(c, z, T(0x1.a01a019f4eb01p-16));
+  c = fma(c, z, T(-0x1.6c16c16c16967p-10));
+  c = fma(c, z, T(0x1.5555555555555p-5));
+  c = fma(-c, z, T(0.5));
   c = fma(-c, z, T(1.0));
   return {s, c};
 }
