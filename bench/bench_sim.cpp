@@ -61,8 +61,9 @@ Settings bench_case(char which) {
 }
 
 // `batch`: photons per call of the tracer (0: 65536, 2048 for case d). Each
-// call ends with its lane pool draining; `run` makes calls of up to 16 chunks
-// of 4096 (Simulation::kMaxRunChunks), trace_per_chunk shows one chunk per call.
+// call ends with its lane pool draining; `run` makes one call per thread and
+// round, fed runs of chunks of 4096 (sim/photon_feed.h), so it drains less
+// often than here; trace_per_chunk shows one chunk per call.
 void trace(benchmark::State& state, char which, std::uint64_t batch = 0) {
   const Simulation sim(bench_case(which));
   if (batch == 0) batch = which == 'd' ? 2048 : 65536;

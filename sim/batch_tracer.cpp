@@ -166,24 +166,24 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
 BatchTracer::BatchTracer(const Settings& s)
     : settings_(s), config_(s), roughness_(make_roughness(s)) {}
 
-void BatchTracer::trace(double theta_i, double phi_i, std::uint64_t first, std::uint64_t n,
-                        const Sink& sink, TracerCounters& counters) const {
+void BatchTracer::trace(double theta_i, double phi_i, const PhotonFeed& feed, const Sink& sink,
+                        TracerCounters& counters) const {
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
         if constexpr (requires { Model::kScalarOnly; }) {
           throw Error("internal error: this roughness model runs on the reference tracer only");
         } else if (settings_.polarization == Polarization::Stokes)
-          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, first, n, sink, counters);
+          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
         else
-          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, first, n, sink, counters);
+          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
       },
       roughness_);
 }
 
 template <class Light, class Model>
 void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
-                             std::uint64_t first, std::uint64_t n, const Sink& sink,
+                             const PhotonFeed& feed, const Sink& sink,
                              TracerCounters& counters) const {
   using OneLight = typename Light::template Rebind<double>;  // the same light, one photon
   auto pool_owner = std::make_unique<Pool>();
@@ -234,12 +234,22 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   constexpr int kFlushAbove = FinishedPhotons::kCapacity - (kPoolLanes + W);
   static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
 
-  const std::uint64_t end = first + n;
-  std::uint64_t next = first;
+  // Photons [next, end) of the current run are still to launch.
+  std::uint64_t next = 0, end = 0;
+  bool fed_out = false;
+  auto more_to_launch = [&] {
+    while (next == end && !fed_out) {
+      const PhotonRun run = feed();
+      fed_out = run.n == 0;
+      next = run.first;
+      end = run.first + run.n;
+    }
+    return next < end;
+  };
   int n_active = 0;
   while (true) {
     if (vector_launch) {
-      while (n_active < kPoolLanes && next < end) {
+      while (n_active < kPoolLanes && more_to_launch()) {
         launch_vector(n_active, next);
         const int n = static_cast<int>(std::min<std::uint64_t>(
             std::min(W, kPoolLanes - n_active), end - next));
@@ -247,7 +257,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         next += n;
       }
     } else {
-      while (n_active < kPoolLanes && next < end) launch(n_active++, next++);
+      while (n_active < kPoolLanes && more_to_launch()) launch(n_active++, next++);
     }
     if (n_active == 0) break;
     if (done->n > kFlushAbove) flush();

@@ -107,12 +107,14 @@ std::uint64_t Simulation::Runner::photons_done() const {
 // Traces this rank's chunks of photons [first, end) of direction k: rank r
 // takes a contiguous share of the round's chunks, and its threads take runs
 // of consecutive chunks from it in order (guided: long runs first, single
-// chunks at the end, so threads finish together). A run is one call of the
-// tracer, whose pool of lanes then drains once per run rather than once per
-// chunk (the drain, where a few light-guided photons hold a vector for up to
-// max_segments steps, was most of a chunk's vector iterations). Which thread
-// or rank traces a photon changes no bit of the sums. A lone process stops
-// early on a signal, after a prefix of the round's chunks; returns the end of
+// chunks at the end, so threads finish together). Each thread makes one call
+// of the tracer for the round, which takes the runs as its pool has room
+// (sim/photon_feed.h), so the pool drains once per thread and round (the
+// drain, where a few light-guided photons hold a vector for up to
+// max_segments steps, was most of a chunk's vector iterations when each
+// chunk was a call). Which thread or rank traces a photon changes no bit of
+// the sums. A lone process stops early on a signal, after a prefix of the
+// round's chunks (every run taken is traced in full); returns the end of
 // what was traced.
 std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first, std::uint64_t end) {
   const std::uint64_t chunks = (end - first) / kChunk + ((end - first) % kChunk != 0);
@@ -142,15 +144,18 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
       const TallyShape s = sim_.tally_shape();
       if (!mine_tally) mine_tally = std::make_unique<Tally>(s.lobes, s.n_theta, s.n_phi, s.channels);
       Tally& tally = *mine_tally;
-      while (!failed.load(std::memory_order_relaxed)) {
-        if (may_stop_early && interrupt_requested()) break;
+      // This thread's next run: none once a thread failed or (a lone
+      // process) a signal came.
+      auto feed = [&]() -> PhotonRun {
+        if (failed.load(std::memory_order_relaxed) || (may_stop_early && interrupt_requested()))
+          return {};
         std::uint64_t n_chunks = 0;
         const std::uint64_t i = take_run(n_chunks);
-        if (n_chunks == 0) break;
+        if (n_chunks == 0) return {};
         const std::uint64_t a = first + (c0 + i) * kChunk;
-        const std::uint64_t n = std::min(n_chunks * kChunk, end - a);
-        sim_.trace_photons(k, a, n, tally, counters, &progress_done_, size);
-      }
+        return {a, std::min(n_chunks * kChunk, end - a)};
+      };
+      sim_.trace_photons(k, feed, tally, counters, &progress_done_, size);
     } catch (...) {
       failed = true;
       std::lock_guard<std::mutex> lock(error_mutex_);
@@ -319,9 +324,9 @@ TallyShape Simulation::tally_shape() const {
           static_cast<int>(settings_.fiber.sigma_a.size())};
 }
 
-void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n,
-                               Tally& tally, TracerCounters& counters,
-                               std::atomic<std::uint64_t>* traced, std::uint64_t per_photon) const {
+void Simulation::trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tally,
+                               TracerCounters& counters, std::atomic<std::uint64_t>* traced,
+                               std::uint64_t per_photon) const {
   const Settings::Incidence inc = incidences_[k];
   ExitScorer scorer(grid_, settings_.fiber.sigma_a, tally.lobes());
   // Progress is published per block of finished photons (at most 256): a
@@ -331,21 +336,29 @@ void Simulation::trace_photons(std::size_t k, std::uint64_t first, std::uint64_t
     if (traced) traced->fetch_add(static_cast<std::uint64_t>(f.n) * per_photon,
                                   std::memory_order_relaxed);
   };
+  // Every run handed out is launched in full, so it counts as launched here.
+  auto counted_feed = [&] {
+    const PhotonRun run = feed();
+    tally.add_launched(run.n);
+    return run;
+  };
   if (use_batch_tracer_) {
-    batch_tracer_.trace(inc.theta_i, inc.phi_i, first, n, score, counters);
-  } else {
-    const Source source(settings_, inc.theta_i, inc.phi_i);
-    auto done = std::make_unique<FinishedPhotons>();
-    for (std::uint64_t i = first; i < first + n; ++i) {
+    batch_tracer_.trace(inc.theta_i, inc.phi_i, counted_feed, score, counters);
+    return;
+  }
+  const Source source(settings_, inc.theta_i, inc.phi_i);
+  auto done = std::make_unique<FinishedPhotons>();
+  for (PhotonRun run = counted_feed(); run.n != 0; run = counted_feed()) {
+    for (std::uint64_t i = run.first; i < run.first + run.n; ++i) {
       LaunchedPhoton p = source.launch(i);
       done->add(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));
-      if (done->full() || i + 1 == first + n) {
+      if (done->full()) {
         score(*done);
         done->n = 0;
       }
     }
   }
-  tally.add_launched(n);
+  if (done->n > 0) score(*done);
 }
 
 RunProgress Simulation::start() const {

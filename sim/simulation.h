@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "sim/batch_tracer.h"
+#include "sim/photon_feed.h"
 #include "sim/process_group.h"
 #include "sim/settings.h"
 #include "sim/tally.h"
@@ -60,8 +61,9 @@ class Simulation {
   // waits for the slowest (light-guided) photon of each call, and 256-photon
   // chunks ran at half the speed. Progress is counted per photon instead.
   static constexpr std::uint64_t kChunk = 4096;
-  // A thread traces up to kMaxRunChunks consecutive chunks in one call (a
-  // signal waits for the run: 64 Ki photons, a few hundredths of a second).
+  // A thread takes up to kMaxRunChunks consecutive chunks at a time (a
+  // signal waits for the runs a thread has taken: 64 Ki photons, a few
+  // hundredths of a second).
   static constexpr std::uint64_t kMaxRunChunks = 16;
   // --target-error is judged after every kTargetBatch photons of a direction
   // (and at its last photon): a fixed schedule, so the stopping point depends
@@ -85,13 +87,20 @@ class Simulation {
   RunProgress start() const;
   RunOutcome run(RunProgress& state, const RunControl& control, RunStatistics* stats = nullptr) const;
 
-  // Traces photons [first, first + n) of incident configuration k into `tally`
-  // (with the batched tracer for scalar light, the reference tracer for Stokes
-  // light and the microfacet roughness models).
-  // `traced`, when given, grows by `per_photon` as each photon is scored (progress).
-  void trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n, Tally& tally,
+  // Traces the photons of every run the feed hands out (sim/photon_feed.h)
+  // of incident configuration k into `tally` (with the batched tracer where
+  // it runs the roughness model, the reference tracer for the microfacet
+  // models). `traced`, when given, grows by `per_photon` as each photon is
+  // scored (progress).
+  void trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tally,
                      TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,
                      std::uint64_t per_photon = 1) const;
+  // Photons [first, first + n).
+  void trace_photons(std::size_t k, std::uint64_t first, std::uint64_t n, Tally& tally,
+                     TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,
+                     std::uint64_t per_photon = 1) const {
+    trace_photons(k, single_run(first, n), tally, counters, traced, per_photon);
+  }
 
   // Largest relative standard error of any lobe energy in any channel (lobes
   // with zero energy are skipped: no relative error exists for them); what
