@@ -47,7 +47,7 @@ template <class T>
   const T f = m - T(1.0);
   const T s = f / (T(2.0) + f);
   const T z = s * s;
-  T p(0x1.2b584aae78a57p-3);
+  T p(0x1.2b584aae78a57p-3);  // written out, as in sim/life_trig.h's kernel
   p = fma(p, z, T(0x1.39fe606542ddep-3));
   p = fma(p, z, T(0x1.7462b4ab2ef6bp-3));
   p = fma(p, z, T(0x1.c71c62e5800a1p-3));
