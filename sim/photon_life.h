@@ -94,7 +94,7 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
       Vec3Of<T>(sin_n, side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z), side * n0,
       sin_n, T(c.cos_tilt)};
   const FacetDraw<T> f = model.draw_normal(s.d, frame, live, s.rng, s.tries, counts, rounds);
-  const MaskOf<T> act = f.ready & !f.failed;
+  const MaskOf<T> act = f.ready;  // never failed too (sim/roughness_model.h)
   const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
                                 select(inside, T(c.eta), T(1.0 / c.eta))};
   const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng);
@@ -108,7 +108,7 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
     s.weight = select(act, select(lost, T(0.0), s.weight * w.factor), s.weight);
   }
   const MaskOf<T> flip = act & r.refracted;
-  const MaskOf<T> now_inside = (flip & (!inside)) | ((!flip) & inside);
+  const MaskOf<T> now_inside = flip ^ inside;
   const T dn = d.dot(n0);
   const MaskOf<T> consistent = (now_inside & (dn < T(0.0))) | ((!now_inside) & (dn > T(0.0)));
   T code = select(consistent, select(now_inside, T(kTravel), T(kExited)), T(kAtBoundary));

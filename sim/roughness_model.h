@@ -26,7 +26,8 @@
 // draw_normal rules, for every lane in `live` (leave the other lanes' random
 // streams untouched: draw with rng.uniform(mask) masks within `live`):
 // - return m with d.m < 0 in the lanes of `ready`; lanes whose sampler gave
-//   up go in `failed` (the photon is truncated: SPEC section 3 wants none);
+//   up go in `failed` (the photon is truncated: SPEC section 3 wants none),
+//   never both;
 // - a rejection sampler draws at most `rounds` candidates per call, and a
 //   round after the first only while another_round(pending, slow): lanes
 //   neither ready nor failed are called again with the same inputs and
@@ -97,7 +98,7 @@ template <class T>
 struct FacetDraw {
   Vec3Of<T> m;
   MaskOf<T> ready;   // lanes with a normal for this event
-  MaskOf<T> failed;  // lanes that gave up: truncated
+  MaskOf<T> failed;  // lanes that gave up: truncated (never ready)
 };
 
 // One event as the optional event_weight hook sees it.

@@ -123,5 +123,31 @@ TEST(GaussianNormal, FarTailNeverReachesTheCap) {
   }
 }
 
+// sim/roughness_model.h's contract, which the photon life relies on (its
+// event acts on `ready` lanes alone): a draw that gives up is never also
+// ready. One candidate a call, from one try short of the cap, so that every
+// call ends ready or failed; about a fifth are accepted here.
+TEST(GaussianNormal, AGivenUpDrawIsNeverReady) {
+  const Vec3 nf = Vec3(-std::sin(0.05), std::cos(0.05), 0.0);
+  const Vec3 d = facing_away_direction(nf, deg_to_rad(4.0));
+  const life::GaussianRoughness model(deg_to_rad(5.0), deg_to_rad(5.0));
+  const auto frame = life::BoundaryFrame<double>::from_facing(life::Vec3Of<double>(nf));
+  PhotonRandom rng(11, 12.0, 0.0, 13);
+  life::LifeCounts<double> counts;
+  int ready = 0, failed = 0;
+  for (int k = 0; k < 20000; ++k) {
+    double tries = life::kMaxNormalTries - 1;
+    const life::FacetDraw<double> f =
+        model.draw_normal(life::Vec3Of<double>(d), frame, true, rng.core(), tries, counts, 1);
+    ASSERT_FALSE(f.ready && f.failed) << "call " << k;
+    ASSERT_TRUE(f.ready || f.failed) << "call " << k;
+    ready += f.ready;
+    failed += f.failed;
+  }
+  std::printf("from one try short of the cap: %d ready, %d given up\n", ready, failed);
+  EXPECT_GT(ready, 1000);
+  EXPECT_GT(failed, 1000);
+}
+
 }  // namespace
 }  // namespace fiberlab::sim
