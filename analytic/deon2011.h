@@ -102,7 +102,7 @@ class Deon2011 : public Model {
   // Zero roughness reproduces the exact smooth cylinder bin for bin.
   // Tested against a slow direct evaluation of Eqs. 7 and 10-12 at 64 bins
   // of the four lobes (beta_azim 5 and 2 deg): within 1e-11 absolute.
-  // Speed (README "Performance"): ~20 ms per incidence on 90 x 180 bins x 4
+  // Speed (docs/PERFORMANCE.md): ~20 ms per incidence on 90 x 180 bins x 4
   // lobes x 3 channels with beta_azim = 5 deg (Fourier deposit); narrower
   // detectors (erfc deposit: beta_azim below ~3.9 deg at 180 phi bins) and
   // white fibers (many orders) take 0.1 s to a few s.

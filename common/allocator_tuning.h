@@ -8,8 +8,8 @@
 // kernel, so each of those allocations starts on untouched pages: a page
 // fault per 4 KiB, which on these virtual machines costs more than the work
 // done in the memory (measured: the fixed part of `fiberlab run` on a
-// 90 x 180 x 8-lobe, 3-channel tally went from about 0.3 s to 0.12 s; README
-// "Performance"). Here blocks up to 32 MiB (glibc's largest threshold) come
+// 90 x 180 x 8-lobe, 3-channel tally went from about 0.3 s to 0.12 s;
+// docs/PERFORMANCE.md). Here blocks up to 32 MiB (glibc's largest threshold) come
 // from the heap, and up to 256 MiB of freed heap is kept for reuse.
 //
 // Even first use is dear: a 4 KiB page fault costs about 12 us here (against

@@ -1,7 +1,7 @@
 #pragma once
 // A deflate compressor writing the zlib stream format (RFC 1950), which
 // HDF5's deflate filter reads like its own output: libdeflate (measured
-// faster than zlib's compressor, README "Performance"), with its buffers kept
+// faster than zlib's compressor, docs/PERFORMANCE.md), with its buffers kept
 // across calls, since fresh memory costs a page fault per 4 KiB on these
 // machines. Not thread-safe: one Deflater per thread.
 #include <cstddef>

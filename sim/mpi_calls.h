@@ -3,7 +3,7 @@
 // fiberlab and its MPI module (libfiberlab_mpi.so, built from sim/mpi/), which
 // ProcessGroup loads (dlopen) only when an MPI launcher started the process.
 // Why a module: linking Open MPI into every program made each run, MPI or not,
-// load 9 more shared libraries at start-up (about 7 ms, README "Performance").
+// load 9 more shared libraries at start-up (about 7 ms, docs/PERFORMANCE.md).
 // Change kFiberlabMpiAbi with any change to the table.
 #include <cstddef>
 #include <cstdint>

@@ -10,8 +10,8 @@
 // two state words, whose lowest bits have low linear complexity, and a
 // uniform double keeps only the top 52 bits. It replaced xoshiro256** (the
 // same state and steps, a scrambler of seven integer operations instead of
-// one), which cost 4-6% of a whole run on an AVX2 machine (README,
-// Performance).
+// one), which cost 4-6% of a whole run on an AVX2 machine
+// (docs/PERFORMANCE.md).
 //
 // LaneRandom<T> is the generator written once for a number type (sim/lanes.h):
 // one stream (T = double) or W streams side by side (T = Batch), each
