@@ -20,18 +20,27 @@ namespace {
 using Batch = xsimd::batch<double>;
 using Index = xsimd::batch<std::int64_t>;
 
+// A whole number 0 <= x < 2^52 as an integer: the low bits of 2^52 + x.
+// (AVX2 has no conversion from double to 64-bit integers, and xsimd's
+// to_int converts there one lane at a time.)
+Index whole_to_int(const Batch& x) {
+  const Batch two_52(0x1.0p52);
+  return xsimd::bitwise_cast<Index>(x + two_52) - xsimd::bitwise_cast<Index>(two_52);
+}
+
 // BinGrid::theta_bin / phi_bin (common/bin_grid.cpp, the definition) for a
 // vector of values: the closed-form index, clamped, then settled on the
 // grid's own edges, so the result is the scalar one exactly (a test compares
-// them at and next to every edge).
+// them at and next to every edge). A NaN fraction gives bin 0 (max(NaN, 0)
+// is 0); such photons did not exit and their bins are never read.
 Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges) {
   Batch i = xsimd::min(xsimd::max(xsimd::floor(fraction * Batch(n)), Batch(0.0)), Batch(n - 1));
-  const Index k = xsimd::to_int(i);
+  const Index k = whole_to_int(i);
   const Batch lo = Batch::gather(edges.data(), k), hi = Batch::gather(edges.data(), k + Index(1));
   const auto down = (i > Batch(0.0)) & (v < lo);
   const auto up = (!down) & (i < Batch(n - 1)) & (v >= hi);
   i = i - xsimd::select(down, Batch(1.0), Batch(0.0)) + xsimd::select(up, Batch(1.0), Batch(0.0));
-  return xsimd::to_int(i);
+  return whole_to_int(i);
 }
 
 // wrap_angle(a) (common/units.h) where a + pi lies in (-2 pi, 4 pi): there
@@ -91,9 +100,12 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   }
   double* weight = one_photon_.data();
   for (int i = 0; i < f.n; ++i) {
-    for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
-    if (f.exited[i]) tally.score_exit(bin[i], weight);
-    else if (!f.lost[i]) tally.score_truncated(weight);
+    if (f.exited[i]) {
+      tally.score_exit(bin[i], weights_.data() + i, kCap);
+    } else if (!f.lost[i]) {
+      for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
+      tally.score_truncated(weight);
+    }
   }
   // Masking's removals (issue 12), each absorbed along the path up to it,
   // summed per photon (a photon's removals are consecutive in f.losses).

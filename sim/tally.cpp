@@ -22,18 +22,6 @@ Tally& Tally::operator=(const Tally& o) {
   return *this;
 }
 
-void Tally::score_exit(std::size_t bin, const double* weight) {
-  touched_[bin / kPageBins] = 1;
-  Fixed* cell = cells() + bin * block();
-  ++cell[0];
-  Fixed* s1 = cell + 1;
-  Fixed* s2 = cell + 1 + channels_;
-  for (int c = 0; c < channels_; ++c) {
-    s1[c] += to_fixed(weight[c]);
-    s2[c] += to_fixed(weight[c] * weight[c]);
-  }
-}
-
 void Tally::clear() {
   Fixed* cell = cells();
   for (std::size_t p = 0; p < touched_.size(); ++p) {

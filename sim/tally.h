@@ -43,7 +43,22 @@ class Tally {
   void score_exit(int lobe, int i_theta, int i_phi, const double* weight) {
     score_exit(bin_index(lobe, i_theta, i_phi), weight);
   }
-  void score_exit(std::size_t bin, const double* weight);
+  void score_exit(std::size_t bin, const double* weight) { score_exit(bin, weight, 1); }
+  // The same with channel c's weight at weight[c * stride] (the scorer's
+  // weights are [channel][photon]). Inline: the scorer's constant stride
+  // then costs nothing.
+  void score_exit(std::size_t bin, const double* weight, std::size_t stride) {
+    touched_[bin / kPageBins] = 1;
+    Fixed* cell = cells() + bin * block();
+    ++cell[0];
+    Fixed* s1 = cell + 1;
+    Fixed* s2 = cell + 1 + channels_;
+    for (int c = 0; c < channels_; ++c) {
+      const double w = weight[c * stride];
+      s1[c] += to_fixed(w);
+      s2[c] += to_fixed(w * w);
+    }
+  }
   // Every sum back to zero (only the touched pages are written): a thread's
   // tally is reused across rounds and incident directions.
   void clear();
