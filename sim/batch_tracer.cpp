@@ -209,7 +209,6 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     ellipse.entry_point_in_beam(beam, lanes.h, pv, pw);
     pool.put_state(life::start_photon<Light>(pv, pw, d_lanes, lanes.rng),
                    [o](const auto& x, auto* column) { life::store_unaligned(x, column + o); });
-    Lanes(phi_i).store_unaligned(pool.col[Pool::kPhiI] + o);
     photon.store_unaligned(pool.bits[Pool::kPhoton] + o);
   };
   // A new photon into lane i: the Source's launch, the life's start.
@@ -270,7 +269,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     for (int o = 0; o < n_active; o += W) {
       const MaskOf<Lanes> live = (iota + Lanes(o)) < Lanes(n_active);
       auto s = pool.load_state<Lanes, Light>(o);
-      const Lanes phi_lanes = load<Lanes>(pool.col[Pool::kPhiI] + o);
+      // A fixed incident direction keeps phi_i out of the pool.
+      const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
       const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
       life::step(config_, model, s, live, counts, kRoundsPerStep);
       const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
@@ -278,7 +278,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
       if (finished != 0) hand_over(model, s, phi_lanes, photon, finished, *done);
       pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
-      life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
+      if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
       life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
       kept += std::popcount(in_flight);
     }
