@@ -40,7 +40,10 @@ std::string number_text(double x) { return fmt::format("{:g}", x); }
 
 std::string list_text(const std::vector<double>& v, double scale) {
   std::string s;
-  for (double x : v) s += (s.empty() ? "" : ",") + number_text(x / scale);
+  for (double x : v) {
+    if (!s.empty()) s += ',';
+    s += number_text(x / scale);
+  }
   return s;
 }
 
