@@ -56,6 +56,21 @@ inline double asin(double x) { return std::asin(x); }
 inline std::pair<double, double> sincos(double x) { return {std::sin(x), std::cos(x)}; }
 inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
 
+// Where xsimd 8.1 (Debian 12's libxsimd-dev) is wrong with AVX-512, and what
+// the photon life uses instead (tests/sim/test_lane_words.cpp checks both):
+// - its fma there is the generic x * y + z, rounded twice unless the
+//   compiler happens to contract it, so a vector lane and std::fma differed
+//   in the last bit: this overload (found before xsimd's by overload
+//   resolution: not a template) fuses on every instruction set;
+// - its ^ of two masks is their or: generic code writes a != b instead.
+inline Batch fma(const Batch& a, const Batch& b, const Batch& c) {
+#if defined(__AVX512F__)
+  return _mm512_fmadd_pd(a, b, c);
+#else
+  return xsimd::fma(a, b, c);
+#endif
+}
+
 // A mask over doubles as a mask over the random streams' 64-bit words.
 inline bool bits_mask(bool m) { return m; }
 inline NumberTraits<Batch>::Bits::batch_bool_type bits_mask(const MaskOf<Batch>& m) {

@@ -108,7 +108,9 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
     s.weight = select(act, select(lost, T(0.0), s.weight * w.factor), s.weight);
   }
   const MaskOf<T> flip = act & r.refracted;
-  const MaskOf<T> now_inside = flip ^ inside;
+  // != is exclusive or on masks (not ^: xsimd 8.1's ^ of AVX-512 masks is an
+  // or; sim/lanes.h).
+  const MaskOf<T> now_inside = flip != inside;
   const T dn = d.dot(n0);
   const MaskOf<T> consistent = (now_inside & (dn < T(0.0))) | ((!now_inside) & (dn > T(0.0)));
   T code = select(consistent, select(now_inside, T(kTravel), T(kExited)), T(kAtBoundary));

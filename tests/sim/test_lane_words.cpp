@@ -1,8 +1,11 @@
-// The vector forms of 64-bit word operations: life::to_bits (sim/lanes.h: a
-// whole number in [0, 2^53) as a word) and life::times (sim/random.h: a word
+// The vector forms of 64-bit word operations that AVX2 lacks and the tracer
+// builds from other instructions: life::to_bits (sim/lanes.h: a whole number
+// in [0, 2^52) as a word, through 2^52) and life::times (sim/random.h: a word
 // times a constant modulo 2^64, built from 32-bit products on AVX2, which has
 // no 64-bit multiply). Each lane must equal the scalar C++ operation, at the
-// edges and on random words.
+// edges and on random words. Also the two operations xsimd 8.1 gets wrong
+// with AVX-512 (sim/lanes.h): fma, which must fuse as std::fma does, and a
+// mask's exclusive or, written a != b.
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -65,6 +68,46 @@ TEST(LaneWords, TimesIsTheProductModulo2To64) {
       times(BitsOf<Batch>::load_unaligned(z), c).store_aligned(out);
       for (int k = 0; k < W; ++k) ASSERT_EQ(out[k], z[k] * c) << z[k] << " * " << c;
     });
+  }
+}
+
+// Triples whose product needs more than 53 bits, so that rounding it before
+// the add changes the result (an unfused x * y + z fails most of them).
+// xsimd 8.1's own AVX-512 fma may pass here, where GCC contracts its inlined
+// x * y + z; in the photon life it did not, and LifeLog.VectorLanesGiveTheScalarBits
+// catches that mutation.
+TEST(LaneWords, FmaRoundsOnceAsStdFma) {
+  std::mt19937_64 gen(11);
+  std::uniform_real_distribution<double> u(-2.0, 2.0);
+  std::vector<double> xs, ys, zs;
+  for (int k = 0; k < 4000 * W; ++k) {
+    const double x = u(gen), y = u(gen);
+    xs.push_back(x), ys.push_back(y), zs.push_back(-x * y + u(gen) * 0x1.0p-40);
+  }
+  int unfused_differs = 0;
+  for (std::size_t i = 0; i < xs.size(); i += W) {
+    alignas(64) double out[W];
+    store_unaligned(fma(Batch::load_unaligned(&xs[i]), Batch::load_unaligned(&ys[i]),
+                        Batch::load_unaligned(&zs[i])),
+                    out);
+    for (int k = 0; k < W; ++k) {
+      const std::size_t j = i + k;
+      ASSERT_EQ(out[k], std::fma(xs[j], ys[j], zs[j])) << xs[j] << " " << ys[j] << " " << zs[j];
+      volatile double product = xs[j] * ys[j];  // rounded: GCC would contract x * y + z
+      unfused_differs += out[k] != product + zs[j];
+    }
+  }
+  EXPECT_GT(unfused_differs, 1000);  // the inputs do tell fused from unfused
+}
+
+TEST(LaneWords, MasksDifferIsExclusiveOr) {
+  alignas(64) double a[W], b[W];
+  for (int pattern = 0; pattern < (1 << W) && pattern < 256; ++pattern) {
+    for (int k = 0; k < W; ++k) a[k] = (pattern >> k) & 1, b[k] = (pattern >> (k / 2 + 1)) & 1;
+    const MaskOf<Batch> x = Batch::load_aligned(a) > Batch(0.5), y = Batch::load_aligned(b) > Batch(0.5);
+    const MaskOf<Batch> differ = x != y;
+    for (int k = 0; k < W; ++k)
+      ASSERT_EQ(differ.get(k), (a[k] > 0.5) != (b[k] > 0.5)) << "pattern " << pattern << " lane " << k;
   }
 }
 
