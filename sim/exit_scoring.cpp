@@ -20,13 +20,8 @@ namespace {
 using Batch = xsimd::batch<double>;
 using Index = xsimd::batch<std::int64_t>;
 
-// A whole number 0 <= x < 2^52 as an integer: the low bits of 2^52 + x.
-// (AVX2 has no conversion from double to 64-bit integers, and xsimd's
-// to_int converts there one lane at a time.)
-Index whole_to_int(const Batch& x) {
-  const Batch two_52(0x1.0p52);
-  return xsimd::bitwise_cast<Index>(x + two_52) - xsimd::bitwise_cast<Index>(two_52);
-}
+// A bin index (a whole number below 2^52) as an integer (sim/lanes.h).
+Index to_index(const Batch& x) { return xsimd::bitwise_cast<Index>(life::to_bits(x)); }
 
 // BinGrid::theta_bin / phi_bin (common/bin_grid.cpp, the definition) for a
 // vector of values: the closed-form index, clamped, then settled on the
@@ -35,12 +30,12 @@ Index whole_to_int(const Batch& x) {
 // is 0); such photons did not exit and their bins are never read.
 Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges) {
   Batch i = xsimd::min(xsimd::max(xsimd::floor(fraction * Batch(n)), Batch(0.0)), Batch(n - 1));
-  const Index k = whole_to_int(i);
+  const Index k = to_index(i);
   const Batch lo = Batch::gather(edges.data(), k), hi = Batch::gather(edges.data(), k + Index(1));
   const auto down = (i > Batch(0.0)) & (v < lo);
   const auto up = (!down) & (i < Batch(n - 1)) & (v >= hi);
   i = i - xsimd::select(down, Batch(1.0), Batch(0.0)) + xsimd::select(up, Batch(1.0), Batch(0.0));
-  return whole_to_int(i);
+  return to_index(i);
 }
 
 // wrap_angle(a) (common/units.h) where a + pi lies in (-2 pi, 4 pi): there

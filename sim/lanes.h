@@ -104,17 +104,20 @@ inline void store_unaligned(const Batch& x, double* p) { x.store_unaligned(p); }
 inline void store_unaligned(std::uint64_t x, std::uint64_t* p) { *p = x; }
 inline void store_unaligned(const BitsOf<Batch>& x, std::uint64_t* p) { x.store_unaligned(p); }
 
-// A whole number in [0, 2^53) as a stream word, and back (exact both ways).
-inline std::uint64_t to_bits(double x) { return static_cast<std::uint64_t>(x); }
-inline BitsOf<Batch> to_bits(const Batch& x) {
-  return xsimd::bitwise_cast<BitsOf<Batch>>(xsimd::to_int(x));
-}
 // A word's 64 bits read as a double's, and back.
 inline double bits_as_double(std::uint64_t x) { return std::bit_cast<double>(x); }
 inline Batch bits_as_double(const BitsOf<Batch>& x) { return xsimd::bitwise_cast<Batch>(x); }
 inline std::uint64_t double_as_bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 inline BitsOf<Batch> double_as_bits(const Batch& x) {
   return xsimd::bitwise_cast<BitsOf<Batch>>(x);
+}
+// A whole number in [0, 2^52) as a stream word, and back (exact both ways).
+// Vectors: x + 2^52 is exact and its low bits are x (AVX2 has no double to
+// 64-bit integer conversion, and xsimd's to_int converts one lane at a time).
+inline std::uint64_t to_bits(double x) { return static_cast<std::uint64_t>(x); }
+inline BitsOf<Batch> to_bits(const Batch& x) {
+  const Batch two_52(0x1.0p52);
+  return double_as_bits(x + two_52) - double_as_bits(two_52);
 }
 inline double to_double(std::uint64_t x) { return static_cast<double>(x); }
 inline Batch to_double(const BitsOf<Batch>& x) {

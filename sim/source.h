@@ -99,7 +99,7 @@ class Source {
     using Bits = life::BitsOf<T>;
     using life::select;  // and xsimd's, by argument-dependent lookup
     static_assert(kStrata == 1 << 12, "a stratum is 12 bits");
-    const Bits x = life::to_bits(u * T(0x1.0p53));  // u's 52 random bits, then a 0
+    const Bits x = life::to_bits(u * T(0x1.0p52)) << 1;  // u's 52 random bits, then a 0
     const Bits strata = ((photon & Bits(kStrata - 1)) << 41) | (x >> 12);
     return life::to_double(select(photon < Bits(stratified_end_), strata, x)) * T(0x1.0p-52) - T(1.0);
   }
