@@ -62,7 +62,9 @@ inline double fma(double a, double b, double c) { return std::fma(a, b, c); }
 //   compiler happens to contract it, so a vector lane and std::fma differed
 //   in the last bit: this overload (found before xsimd's by overload
 //   resolution: not a template) fuses on every instruction set;
-// - its ^ of two masks is their or: generic code writes a != b instead.
+// - its ^ of two masks is their or: generic code writes a != b instead
+//   (a Pair of masks has no ^, sim/lane_pair.h, so a mask ^ in the photon
+//   life fails to compile on every instruction set).
 inline Batch fma(const Batch& a, const Batch& b, const Batch& c) {
 #if defined(__AVX512F__)
   return _mm512_fmadd_pd(a, b, c);
