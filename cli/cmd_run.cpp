@@ -136,7 +136,7 @@ void write_output(const sim::Simulation& simulation, const Job& job, int threads
 }
 
 void report(const RunOptions& o, const Job& job, const sim::Simulation& simulation,
-            const sim::RunStatistics& stats) {
+            const sim::RunStatistics& stats, double write_seconds) {
   if (o.quiet) return;
   const sim::ResultFile result = sim::make_result(simulation.settings(), simulation.grid(), job.state.tallies);
   print_summary(stdout, result);
@@ -152,7 +152,7 @@ void report(const RunOptions& o, const Job& job, const sim::Simulation& simulati
   fmt::print("{:.0f} photons in {:.2f} s on {} rank(s) x {} threads: {:.3f} M photons/s "
              "({:.3f} M/s per thread)\n", n, t, stats.ranks, stats.threads, n / t * 1e-6,
              n / t / (stats.threads * stats.ranks) * 1e-6);
-  fmt::print("wrote {}\n", job.settings.output);
+  fmt::print("wrote {} in {:.2f} s\n", job.settings.output, write_seconds);
 }
 
 // Runs `step` on every rank; when it fails anywhere, every rank stops, rank 0
@@ -216,10 +216,13 @@ void run(const RunOptions& o) {
       exit_code = 128 + sig;
       return;
     }
+    const auto write_start = std::chrono::steady_clock::now();
     on_all_ranks(group, [&] {
       if (group.is_root()) write_output(*simulation, job, threads);
     });
-    if (group.is_root()) report(o, job, *simulation, stats);
+    const double write_seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - write_start).count();
+    if (group.is_root()) report(o, job, *simulation, stats, write_seconds);
   } catch (const sim::FailedElsewhere&) {
     exit_code = 2;  // rank 0 reports
   }
