@@ -84,8 +84,8 @@ Pair<V> operator-(const Pair<V>& x) {
   return {-x.a, -x.b};
 }
 template <class V>
-Pair<V> operator!(const Pair<V>& x) {
-  return {!x.a, !x.b};
+[[gnu::always_inline]] inline Pair<V> operator!(const Pair<V>& x) {
+  return {mask_not(x.a), mask_not(x.b)};  // (sim/lanes.h: why not !)
 }
 template <class V>
 Pair<V> operator<<(const Pair<V>& x, int k) {
