@@ -5,7 +5,8 @@
 // no 64-bit multiply). Each lane must equal the scalar C++ operation, at the
 // edges and on random words. Also the two operations xsimd 8.1 gets wrong
 // with AVX-512 (sim/lanes.h): fma, which must fuse as std::fma does, and a
-// mask's exclusive or, written a != b.
+// mask's exclusive or, written a != b. And mask_not, the inline ! the
+// photon life uses (built from the mask register's bits with AVX-512).
 #include <gtest/gtest.h>
 
 #include <cstdint>
@@ -107,6 +108,17 @@ TEST(LaneWords, MasksDifferIsExclusiveOr) {
     const MaskOf<Batch> differ = x != y;
     for (int k = 0; k < W; ++k)
       ASSERT_EQ(differ.get(k), (a[k] > 0.5) != (b[k] > 0.5)) << "pattern " << pattern << " lane " << k;
+  }
+}
+
+TEST(LaneWords, MaskNotFlipsEveryLane) {
+  alignas(64) double a[W];
+  for (int pattern = 0; pattern < (1 << W) && pattern < 256; ++pattern) {
+    for (int k = 0; k < W; ++k) a[k] = (pattern >> k) & 1;
+    const MaskOf<Batch> m = Batch::load_aligned(a) > Batch(0.5);
+    const MaskOf<Batch> flipped = mask_not(m);
+    for (int k = 0; k < W; ++k) ASSERT_EQ(flipped.get(k), !(a[k] > 0.5)) << "pattern " << pattern << " lane " << k;
+    EXPECT_EQ(xsimd::any(flipped), pattern != (1 << W) - 1) << "pattern " << pattern;
   }
 }
 
