@@ -475,7 +475,9 @@ void File::create_dataset(const std::string& name, const Dims& dims, Type type) 
   Handle space = checked(H5Screate_simple(static_cast<int>(dims.size()), dims.data(), nullptr),
                          H5Sclose, "dataspace for " + name, path_);
   Handle dcpl = dataset_creation(dims, true, path_);
-  const hid_t file_type = type == Type::Float64 ? H5T_IEEE_F64LE : H5T_STD_U64LE;
+  const hid_t file_type = type == Type::Float64 ? H5T_IEEE_F64LE
+                          : type == Type::Int64 ? H5T_STD_I64LE
+                                                : H5T_STD_U64LE;
   checked(H5Dcreate2(handle_.id(), name.c_str(), file_type, space.id(), H5P_DEFAULT, dcpl.id(),
                      H5P_DEFAULT),
           H5Dclose, "cannot create " + name, path_);
@@ -490,7 +492,9 @@ File::RowPlan File::plan_rows(const std::string& name) {
   plan.name = name;
   plan.set = checked(H5Dopen2(handle_.id(), name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path_);
   Handle type = checked(H5Dget_type(plan.set.id()), H5Tclose, "type of " + name, path_);
-  plan.type = H5Tget_class(type.id()) == H5T_FLOAT ? Type::Float64 : Type::UInt64;
+  plan.type = H5Tget_class(type.id()) == H5T_FLOAT      ? Type::Float64
+              : H5Tget_sign(type.id()) == H5T_SGN_2 ? Type::Int64
+                                                    : Type::UInt64;
   if constexpr (std::endian::native != std::endian::little) return plan;  // file types are LE
   // Direct: chunk dims (1, 1, rows_per_chunk, whole trailing dims), deflate the only filter.
   Handle dcpl = checked(H5Dget_create_plist(plan.set.id()), H5Pclose, "creation list of " + name, path_);
@@ -514,7 +518,7 @@ File::RowPlan File::plan_rows(const std::string& name) {
   }
   plan.rows = dims[2];
   plan.rows_per_chunk = chunk[2];
-  plan.row_bytes = cells * sizeof(double);  // float64 and uint64 alike
+  plan.row_bytes = cells * sizeof(double);  // float64 and (u)int64 alike
   plan.level = static_cast<int>(cd[0]);
   plan.direct = true;
   return plan;
@@ -573,9 +577,15 @@ void File::prepare_row(const RowPlan& plan, const std::vector<std::uint64_t>& va
   prepare(plan, Type::UInt64, values, z, out, out.words);
 }
 
+void File::prepare_row(const RowPlan& plan, const std::vector<std::int64_t>& values, Deflater& z,
+                       PreparedRow& out) {
+  prepare(plan, Type::Int64, values, z, out, out.signed_words);
+}
+
 void File::write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRow& row) {
   if (!plan.direct) {
     if (plan.type == Type::Float64) write_slab_row(plan.name, i, j, row.doubles);
+    else if (plan.type == Type::Int64) write_slab_row(plan.name, i, j, row.signed_words);
     else write_slab_row(plan.name, i, j, row.words);
     return;
   }
@@ -608,6 +618,11 @@ void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j,
   slab_io<std::uint64_t>(handle_.id(), path_, name, {i, j}, nullptr, &data, H5T_NATIVE_UINT64);
 }
 
+void File::write_slab_row(const std::string& name, hsize_t i, hsize_t j,
+                          const std::vector<std::int64_t>& data) {
+  slab_io<std::int64_t>(handle_.id(), path_, name, {i, j}, nullptr, &data, H5T_NATIVE_INT64);
+}
+
 void File::write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data) {
   slab_io<std::uint64_t>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_UINT64);
 }
@@ -621,6 +636,12 @@ std::vector<double> File::read_slab_doubles(const std::string& name, hsize_t i) 
 std::vector<std::uint64_t> File::read_slab_uint64s(const std::string& name, hsize_t i) const {
   std::vector<std::uint64_t> v;
   slab_io<std::uint64_t>(handle_.id(), path_, name, {i}, &v, nullptr, H5T_NATIVE_UINT64);
+  return v;
+}
+
+std::vector<std::int64_t> File::read_slab_int64s(const std::string& name, hsize_t i) const {
+  std::vector<std::int64_t> v;
+  slab_io<std::int64_t>(handle_.id(), path_, name, {i}, &v, nullptr, H5T_NATIVE_INT64);
   return v;
 }
 

@@ -74,7 +74,7 @@ class File {
                                           const std::string& meaning) const;
   // Datasets written and read one slab at a time (slab i = index i along the
   // first dimension), so that a file larger than memory can be streamed.
-  enum class Type { Float64, UInt64 };
+  enum class Type { Float64, UInt64, Int64 };
   void create_dataset(const std::string& name, const Dims& dims, Type type);
   void write_slab(const std::string& name, hsize_t i, const std::vector<double>& data);
   void write_slab(const std::string& name, hsize_t i, const std::vector<std::uint64_t>& data);
@@ -83,6 +83,8 @@ class File {
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j, const std::vector<double>& data);
   void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
                       const std::vector<std::uint64_t>& data);
+  void write_slab_row(const std::string& name, hsize_t i, hsize_t j,
+                      const std::vector<std::int64_t>& data);
   // Rows stored as chunks deflated ahead of HDF5 (H5Dwrite_chunk), so that
   // the deflating, which needs no HDF5 call, can run on threads:
   //   RowPlan plan = f.plan_rows(name);                 // serial: HDF5's layout
@@ -105,6 +107,7 @@ class File {
     std::vector<std::vector<unsigned char>> chunks;  // direct: one stream per chunk
     std::vector<double> doubles;                     // otherwise: the values
     std::vector<std::uint64_t> words;
+    std::vector<std::int64_t> signed_words;
   };
   RowPlan plan_rows(const std::string& name);
   // Throws fiberlab::Error if the values do not fill a row of the plan's
@@ -113,11 +116,14 @@ class File {
                           PreparedRow& out);
   static void prepare_row(const RowPlan& plan, const std::vector<std::uint64_t>& values,
                           Deflater& z, PreparedRow& out);
+  static void prepare_row(const RowPlan& plan, const std::vector<std::int64_t>& values,
+                          Deflater& z, PreparedRow& out);
   void write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRow& row);
   // After a plan's last row: flushes, so that a failed write is reported here.
   void end_rows(const RowPlan& plan);
   std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;
   std::vector<std::uint64_t> read_slab_uint64s(const std::string& name, hsize_t i) const;
+  std::vector<std::int64_t> read_slab_int64s(const std::string& name, hsize_t i) const;
   Dims dims(const std::string& name) const;  // of a dataset
 
   // Attributes on an object ("/" for the root).

@@ -2,6 +2,9 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+#include <cstdint>
+
 #include "common/error.h"
 
 namespace fiberlab::sim {
@@ -98,6 +101,59 @@ void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out)
   for (std::size_t i = 0; i < v.size(); ++i)
     out[i] = (v[i] >> 64 == 0 ? static_cast<double>(static_cast<std::uint64_t>(v[i]))
                               : static_cast<double>(v[i])) / kScale;
+}
+
+namespace {
+
+// The float64 nearest E (ties to even), as an integer: E itself below 2^53.
+double nearest_double(ExactTally::Word e) {
+  return e >> 64 == 0 ? static_cast<double>(static_cast<std::uint64_t>(e)) : static_cast<double>(e);
+}
+
+}  // namespace
+
+void ExactTally::split(const std::vector<Word>& v, std::vector<double>& value,
+                       std::vector<std::int64_t>& residual) {
+  value.resize(v.size());
+  residual.resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    const Word e = v[i];
+    if (e >> 53 == 0) {  // nearly every bin: exact as a double
+      value[i] = static_cast<double>(static_cast<std::uint64_t>(e)) / kScale;
+      residual[i] = 0;
+      continue;
+    }
+    const double nearest = nearest_double(e);
+    // Below 2^116 an ulp of E is at most 2^63, so |r| <= 2^62.
+    if (e >> 116 != 0)
+      throw Error(fmt::format("a bin sum of {:g} is too large for the result file's exact residual "
+                              "(below 2^56, about 7.2e16)", nearest / kScale));
+    const Word back = static_cast<Word>(nearest);  // exact: a whole number below 2^117
+    const __int128 r = e >= back ? static_cast<__int128>(e - back) : -static_cast<__int128>(back - e);
+    value[i] = nearest / kScale;
+    residual[i] = static_cast<std::int64_t>(r);
+  }
+}
+
+std::ptrdiff_t ExactTally::join(const std::vector<double>& value,
+                                const std::vector<std::int64_t>& residual, std::vector<Word>& out) {
+  if (value.size() != residual.size()) throw Error("internal error: joining arrays of different sizes");
+  out.resize(value.size());
+  for (std::size_t i = 0; i < value.size(); ++i) {
+    const double scaled = value[i] * kScale;  // exact (a power of two) for v below 2^68
+    // Not a whole number >= 0 below 2^128 (NaN fails every comparison).
+    if (!(scaled >= 0.0 && scaled < 0x1.0p128 && scaled == std::floor(scaled)))
+      return static_cast<std::ptrdiff_t>(i);
+    const Word base = static_cast<Word>(scaled);
+    const std::int64_t r = residual[i];
+    const Word magnitude = r >= 0 ? static_cast<Word>(r) : static_cast<Word>(-static_cast<__int128>(r));
+    Word e;
+    if (r >= 0 ? __builtin_add_overflow(base, magnitude, &e) : __builtin_sub_overflow(base, magnitude, &e))
+      return static_cast<std::ptrdiff_t>(i);
+    if (nearest_double(e) != scaled) return static_cast<std::ptrdiff_t>(i);  // does not round to v
+    out[i] = e;
+  }
+  return -1;
 }
 
 std::vector<std::uint64_t> ExactTally::to_pairs(const std::vector<Word>& v) {

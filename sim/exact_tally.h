@@ -7,6 +7,7 @@
 // totals do not depend on how photons were split across threads, ranks,
 // checkpoints or files, nor on the order the parts are added. float64 values
 // are derived once, from the final integers (value / 2^60).
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -67,7 +68,22 @@ struct ExactTally {
   ExactLedger ledger() const { return {photons, exited, absorbed, truncated, lost}; }
 
   static std::vector<double> to_double(const std::vector<Word>& v);
-  // Two uint64 per word, (high, low): how files store them.
+  // Format 2 stores a bin sum E as its float64 value v = E / 2^60, rounded
+  // once (to_double), and the residual r = E - v 2^60, an int64 (|r| is at
+  // most half an ulp of E: 0 below 2^53, below 2^20 for sums of about 10^5
+  // photons), which deflates to a fraction of E's (high, low) pair.
+  // split() throws fiberlab::Error if a residual does not fit 64 bits (a bin
+  // sum of 2^56 or more, about 7e16 photons of weight 1). join() is its inverse and
+  // accepts only what split() gives: it returns the index of the first cell
+  // where v is not a finite, non-negative multiple of 2^-60 below 2^68, or
+  // v 2^60 + r is not a 128-bit sum that rounds to v; -1 when every cell is
+  // one.
+  static void split(const std::vector<Word>& v, std::vector<double>& value,
+                    std::vector<std::int64_t>& residual);
+  static std::ptrdiff_t join(const std::vector<double>& value,
+                             const std::vector<std::int64_t>& residual, std::vector<Word>& out);
+  // Two uint64 per word, (high, low): how format 1 files stored them (and
+  // how files store the ledger's sums).
   static std::vector<std::uint64_t> to_pairs(const std::vector<Word>& v);
   // The same into `out` (resized), so that a caller can reuse its buffer.
   static void to_double(const std::vector<Word>& v, std::vector<double>& out);

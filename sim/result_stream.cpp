@@ -15,24 +15,41 @@ namespace fiberlab::sim {
 
 namespace {
 
-struct DatasetShape {
-  const char* name;
-  bool exact;  // a trailing dimension of 2 (high, low)
-  int rank;    // 5: K L T P C, 4: K L T P, 3: K L C, 2: K C
+enum class Stored {
+  Float64,   // float64
+  Count,     // uint64
+  Pairs,     // uint64, a trailing dimension of 2: (high, low) of a 128-bit sum
+  Residual,  // int64: a 128-bit sum minus its float64 dataset's value x 2^60
 };
 
-constexpr DatasetShape kTallyDatasets[] = {
-    {"/tally/weight_sum", false, 5}, {"/tally/weight_sq_sum", false, 5},
-    {"/tally/count", false, 4},      {"/ledger/exited", false, 3},
-    {"/ledger/absorbed", false, 2},  {"/ledger/truncated", false, 2},
-    {"/exact/weight_sum", true, 5},  {"/exact/weight_sq_sum", true, 5},
-    {"/exact/exited", true, 3},      {"/exact/absorbed", true, 2},
-    {"/exact/truncated", true, 2},
+struct DatasetShape {
+  const char* name;
+  Stored stored;
+  int rank;  // 5: K L T P C, 4: K L T P, 3: K L C, 2: K C
 };
+
+// Format 2 (kFormatVersion): the bin sums' exact values as residuals.
+constexpr DatasetShape kTallyDatasets[] = {
+    {"/tally/weight_sum", Stored::Float64, 5},
+    {"/tally/weight_sq_sum", Stored::Float64, 5},
+    {"/tally/count", Stored::Count, 4},
+    {"/ledger/exited", Stored::Float64, 3},
+    {"/ledger/absorbed", Stored::Float64, 2},
+    {"/ledger/truncated", Stored::Float64, 2},
+    {"/exact/weight_sum_residual", Stored::Residual, 5},
+    {"/exact/weight_sq_sum_residual", Stored::Residual, 5},
+    {"/exact/exited", Stored::Pairs, 3},
+    {"/exact/absorbed", Stored::Pairs, 2},
+    {"/exact/truncated", Stored::Pairs, 2},
+};
+// Format 1 stored the bin sums as pairs too (read for merge and resume).
+constexpr DatasetShape kFormat1BinSums[] = {{"/exact/weight_sum", Stored::Pairs, 5},
+                                            {"/exact/weight_sq_sum", Stored::Pairs, 5}};
 
 // The ledger's `lost` (issue 12: weight removed by masking). Files written
 // before it existed have neither dataset: their lost is 0.
-constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", false, 2}, {"/exact/lost", true, 2}};
+constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", Stored::Float64, 2},
+                                          {"/exact/lost", Stored::Pairs, 2}};
 
 h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
   const hsize_t L = s.lobes, T = s.n_theta, P = s.n_phi, C = s.channels;
@@ -43,7 +60,7 @@ h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
     case 3: dims = {K, L, C}; break;
     default: dims = {K, C}; break;
   }
-  if (d.exact) dims.push_back(2);
+  if (d.stored == Stored::Pairs) dims.push_back(2);
   return dims;
 }
 
@@ -64,9 +81,10 @@ ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
   f.create_group("/exact");
   const hsize_t K = photons_.size();
   auto create = [&](const DatasetShape& d) {
-    const bool integer = d.exact || d.rank == 4;
     f.create_dataset(d.name, dims_of(d, K, shape_),
-                     integer ? h5::File::Type::UInt64 : h5::File::Type::Float64);
+                     d.stored == Stored::Float64    ? h5::File::Type::Float64
+                     : d.stored == Stored::Residual ? h5::File::Type::Int64
+                                                    : h5::File::Type::UInt64);
   };
   for (const DatasetShape& d : kTallyDatasets) create(d);
   for (const DatasetShape& d : kLostDatasets) create(d);
@@ -125,7 +143,8 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   h5::File& f = *file_;
   photons_[k] = ledger.photons;
   const LobePlans plans{f.plan_rows("/tally/weight_sum"), f.plan_rows("/tally/weight_sq_sum"),
-                        f.plan_rows("/exact/weight_sum"), f.plan_rows("/exact/weight_sq_sum"),
+                        f.plan_rows("/exact/weight_sum_residual"),
+                        f.plan_rows("/exact/weight_sq_sum_residual"),
                         f.plan_rows("/tally/count")};
   prepared_.resize(static_cast<std::size_t>(shape_.lobes));
   const int threads = std::clamp(threads_, 1, shape_.lobes);
@@ -161,8 +180,8 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
 }
 
-// Lobe l's five rows (float64 and exact sums and squared sums, counts), on one
-// thread with its scratch.
+// Lobe l's five rows (the sums and squared sums as float64 and residuals,
+// the counts), on one thread with its scratch.
 void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of,
                                 LobeScratch& s, std::array<h5::File::PreparedRow, 5>& out) {
   lobe_of(l, s.lobe);
@@ -171,14 +190,12 @@ void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource&
     if (!s.deflater || s.deflater->level() != level) s.deflater.emplace(level);
     return *s.deflater;
   };
-  ExactTally::to_double(s.lobe.weight_sum, s.doubles);
+  ExactTally::split(s.lobe.weight_sum, s.doubles, s.residuals);
   h5::File::prepare_row(plans[0], s.doubles, deflater(plans[0]), out[0]);
-  ExactTally::to_double(s.lobe.weight_sq_sum, s.doubles);
+  h5::File::prepare_row(plans[2], s.residuals, deflater(plans[2]), out[2]);
+  ExactTally::split(s.lobe.weight_sq_sum, s.doubles, s.residuals);
   h5::File::prepare_row(plans[1], s.doubles, deflater(plans[1]), out[1]);
-  ExactTally::to_pairs(s.lobe.weight_sum, s.pairs);
-  h5::File::prepare_row(plans[2], s.pairs, deflater(plans[2]), out[2]);
-  ExactTally::to_pairs(s.lobe.weight_sq_sum, s.pairs);
-  h5::File::prepare_row(plans[3], s.pairs, deflater(plans[3]), out[3]);
+  h5::File::prepare_row(plans[3], s.residuals, deflater(plans[3]), out[3]);
   h5::File::prepare_row(plans[4], s.lobe.count, deflater(plans[4]), out[4]);
 }
 
@@ -202,9 +219,12 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-histogram")
     throw Error(fmt::format("{}: not a fiberlab result file (root attribute format is not "
                             "\"fiber-histogram\")", path));
-  if (!f.has_attr("/", "format_version") || f.attr_int("/", "format_version") != kFormatVersion)
-    throw Error(fmt::format("{}: format_version is not {} (written by another fiberlab version)",
-                            path, kFormatVersion));
+  if (!f.has_attr("/", "format_version"))
+    throw Error(fmt::format("{}: root attribute format_version is missing", path));
+  version_ = f.attr_int("/", "format_version");
+  if (version_ < 1 || version_ > kFormatVersion)
+    throw Error(fmt::format("{}: format_version = {} is not supported (this fiberlab reads 1 to {})",
+                            path, version_, kFormatVersion));
   ResultFile& h = header_;
   h.config_yaml = f.attr_string("/", "config_yaml");
   h.settings = parse_settings_yaml(h.config_yaml, path + ":/config_yaml");
@@ -234,10 +254,15 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   if (!f.exists("/exact"))
     throw Error(fmt::format("{}: has no exact sums (/exact; files written before fiberlab 0.2 "
                             "cannot be merged exactly)", path));
-  for (const DatasetShape& d : kTallyDatasets)
+  auto check_shape = [&](const DatasetShape& d) {
     if (f.dims(d.name) != dims_of(d, K, shape_))
       throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
                               d.name));
+  };
+  for (const DatasetShape& d : kTallyDatasets)
+    if (version_ >= 2 || d.stored != Stored::Residual) check_shape(d);
+  if (version_ == 1)
+    for (const DatasetShape& d : kFormat1BinSums) check_shape(d);
   has_lost_ = f.exists(kLostDatasets[1].name);
   for (const DatasetShape& d : kLostDatasets)
     if (has_lost_ && f.dims(d.name) != dims_of(d, K, shape_))
@@ -261,13 +286,34 @@ ExactTally ResultReader::read(std::size_t k) const {
   ExactTally t(shape_);
   t.photons = header_.photons.at(k);
   t.count = file_.read_slab_uint64s("/tally/count", k);
-  t.weight_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sum", k));
-  t.weight_sq_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sq_sum", k));
+  if (version_ == 1) {
+    t.weight_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sum", k));
+    t.weight_sq_sum = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/weight_sq_sum", k));
+  } else {
+    read_bin_sums(k, "weight_sum", t.weight_sum);
+    read_bin_sums(k, "weight_sq_sum", t.weight_sq_sum);
+  }
   t.exited = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/exited", k));
   t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
   if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
   return t;
+}
+
+// Format 2: a direction's bin sums from /tally/<name> and
+// /exact/<name>_residual, refused unless every cell is one that
+// ExactTally::split writes (a file altered by hand, or damaged, otherwise
+// gives sums that merge would add as if exact).
+void ResultReader::read_bin_sums(std::size_t k, const std::string& name,
+                                 std::vector<ExactTally::Word>& out) const {
+  const std::string value_name = "/tally/" + name, residual_name = "/exact/" + name + "_residual";
+  const std::vector<double> value = file_.read_slab_doubles(value_name, k);
+  const std::vector<std::int64_t> residual = file_.read_slab_int64s(residual_name, k);
+  const std::ptrdiff_t bad = ExactTally::join(value, residual, out);
+  if (bad >= 0)
+    throw Error(fmt::format("{}: {} and {} disagree in direction {}, cell {} ({} and {}): the "
+                            "float64 sum must be the exact sum / 2^60 rounded once",
+                            path_, value_name, residual_name, k, bad, value[bad], residual[bad]));
 }
 
 }  // namespace fiberlab::sim

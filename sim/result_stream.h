@@ -4,11 +4,13 @@
 // direction's tally per file in memory beyond what it holds anyway.
 //
 // Besides the float64 datasets of SPEC section 9, files carry the exact sums
-// (fiberlab's own addition; docs in README "The result file"):
-//   /exact/weight_sum, /exact/weight_sq_sum  K x L x n_theta x n_phi x C x 2
+// (fiberlab's own addition; docs in docs/FILE_FORMAT.md), integers E whose
+// value is E / 2^60; the float64 datasets are these values rounded once:
+//   /exact/weight_sum_residual, /exact/weight_sq_sum_residual
+//       K x L x n_theta x n_phi x C int64: E - (the float64 value) x 2^60
+//       (format 2; format 1 stored these sums as the ledger's, below)
 //   /exact/exited  K x L x C x 2,  /exact/absorbed, /exact/truncated, /exact/lost  K x C x 2
-// uint64 pairs (high, low) of an unsigned 128-bit integer; the value is
-// integer / 2^60. The float64 datasets are these integers / 2^60 rounded once.
+//       uint64 pairs (high, low) of E.
 #include <array>
 #include <cstdint>
 #include <functional>
@@ -46,7 +48,7 @@ class ResultWriter {
  private:
   using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
   // The bin datasets written a lobe (a row) at a time: S1 and S2 as float64,
-  // then as exact pairs, then the counts.
+  // then their residuals, then the counts.
   using LobePlans = std::array<h5::File::RowPlan, 5>;
   // One writing thread's buffers, kept across lobes and directions: fresh
   // memory costs a page fault per 4 KiB, which on these machines costs more
@@ -54,7 +56,7 @@ class ResultWriter {
   struct LobeScratch {
     ExactLobe lobe;
     std::vector<double> doubles;
-    std::vector<std::uint64_t> pairs;
+    std::vector<std::int64_t> residuals;
     std::optional<Deflater> deflater;
   };
   // lobe_work[l]: lobe l's relative cost (the lobes are taken heaviest first).
@@ -78,7 +80,7 @@ void write_result_exact(const std::string& path, const ResultFile& header,
 
 class ResultReader {
  public:
-  // Opens and checks a result file: format and version, the stored config,
+  // Opens and checks a result file: format and version (1 or 2), the stored config,
   // every dataset's shape against K, lobes, bins and channels, photons >= 1,
   // and the presence of the exact sums. Throws fiberlab::Error naming the file.
   // allow_empty_directions: directions of 0 photons (a checkpoint's).
@@ -90,12 +92,14 @@ class ResultReader {
   const h5::File& file() const { return file_; }
 
  private:
+  void read_bin_sums(std::size_t k, const std::string& name, std::vector<ExactTally::Word>& out) const;
   std::string path_;
   h5::File file_;
   ResultFile header_;
   DirectionSeeds direction_seeds_;
   TallyShape shape_;
   bool has_lost_ = false;  // /exact/lost (absent in files written before it: lost 0)
+  std::int64_t version_ = 0;  // format_version: 1 (bin sums as pairs) or 2 (as residuals)
 };
 
 }  // namespace fiberlab::sim

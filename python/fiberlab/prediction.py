@@ -75,7 +75,7 @@ def predict(result_or_config, model, **params):
                       phi_edges=d["phi_edges"])
 
 
-SUPPORTED_FORMAT_VERSION = 1
+SUPPORTED_FORMAT_VERSION = 2  # common/result_layout.h kFormatVersion (2 changed result files only)
 
 
 def load_prediction(path):

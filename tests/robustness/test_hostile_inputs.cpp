@@ -192,7 +192,7 @@ TEST_F(Hostile, ConfigDisagreesWithBins) {
 
 TEST_F(Hostile, WrongFormatOrVersion) {
   expect_every_reader_refuses(crafted("v99.h5", "f.attrs['format_version'] = 99"),
-                              {"format_version = 99", "reads 1 to 1"});
+                              {"format_version = 99", "reads 1 to 2"});
   expect_refused("info " + crafted("fmt.h5", "f.attrs['format'] = 'fiber-prediction-x'"),
                  {"not a fiberlab result file"});
   expect_refused("info " + crafted("nover.h5", "del f.attrs['format_version']"), {"format_version is missing"});
@@ -236,6 +236,45 @@ TEST_F(Hostile, LargestSeedRoundTripsExactly) {
   // fiberlab 0.1 stored the seed as int64: -1 is read back as 2^64 - 1.
   const auto legacy = crafted("legacy.h5", "f.attrs['seed'] = np.int64(-1); del f.attrs['merged_seeds']");
   EXPECT_NE(fiberlab("info " + legacy).out.find("seeds: 18446744073709551615"), std::string::npos);
+}
+
+// Format 2 stores the exact bin sums as residuals against the float64 sums
+// (sim/exact_tally.h): merge, which adds the exact sums, refuses a residual
+// that does not belong to its float64 value.
+TEST_F(Hostile, ExactResidualThatDisagreesWithItsFloatSum) {
+  const auto f = crafted("residual.h5",
+                         "i = tuple(np.argwhere(f['tally/weight_sum'][...] == 0)[0])\n"
+                         "f['exact/weight_sum_residual'][i] = 1");
+  expect_refused("merge " + f + " " + (shared_ / "good2.h5").string() + " -o " + path("merged.h5"),
+                 {"/tally/weight_sum and /exact/weight_sum_residual disagree", "rounded once"});
+}
+
+// Format 1 files (fiberlab before format 2: the bin sums as (high, low)
+// pairs) still merge, to the same file as their format 2 form. The pairs
+// are made here from the format 2 file in Python's exact integers.
+TEST_F(Hostile, Format1FilesMergeAsBefore) {
+  const auto v1 = crafted("v1.h5",
+                          "for n in ('weight_sum', 'weight_sq_sum'):\n"
+                          "    v = f['tally/' + n][...]; r = f['exact/' + n + '_residual'][...]\n"
+                          "    e = [int(a * 2.0**60) + int(b) for a, b in zip(v.ravel(), r.ravel())]\n"
+                          "    p = np.array([[x >> 64, x & (2**64 - 1)] for x in e], np.uint64)\n"
+                          "    del f['exact/' + n + '_residual']\n"
+                          "    f['exact/' + n] = p.reshape(v.shape + (2,))\n"
+                          "f.attrs['format_version'] = 1");
+  const std::string good = (shared_ / "good1.h5").string(), other = (shared_ / "good2.h5").string();
+  ASSERT_EQ(fiberlab("merge " + v1 + " " + other + " -o " + path("m1.h5")).status, 0);
+  ASSERT_EQ(fiberlab("merge " + good + " " + other + " -o " + path("m2.h5")).status, 0);
+  std::ofstream(path("same.py"))
+      << "import h5py, numpy as np, sys\n"
+         "a, b = h5py.File(sys.argv[1]), h5py.File(sys.argv[2])\n"
+         "assert a.attrs['format_version'] == 2\n"
+         "names = []\n"
+         "b.visititems(lambda n, o: names.append(n) if isinstance(o, h5py.Dataset) else None)\n"
+         "assert 'exact/weight_sum_residual' in names and 'tally/weight_sum' in names, names\n"
+         "assert any(np.any(b[n][...] != 0) for n in ('exact/weight_sum_residual', 'exact/weight_sq_sum_residual'))\n"
+         "for n in names: assert np.array_equal(a[n][...], b[n][...]), n\n";
+  const Outcome c = run("/usr/bin/python3 " + path("same.py") + " " + path("m1.h5") + " " + path("m2.h5"));
+  EXPECT_EQ(c.status, 0) << c.err;
 }
 
 TEST_F(Hostile, IntegerFlags) {
@@ -351,14 +390,14 @@ TEST_F(Hostile, DiskFullLeavesNothingAndDoesNotCrash) {
   const fs::path small = dir_ / "small";
   fs::create_directories(small);
   std::ofstream(path("c.yaml")) << "photons: 2000\ntally: {n_theta: 90, n_phi: 180}\nsource: {theta_i: [10, 20, 30, 40]}\n";
-  // The whole result is ~130 kB: the disk fills in the header's attributes
-  // (8k), in the tallies (40k) and near the end (120k); `predict` writes
+  // The whole result is ~94 kB: the disk fills in the header's attributes
+  // (8k), in the tallies (40k) and near the end (88k); `predict` writes
   // whole datasets (write_dataset) instead of slabs.
   const std::string out = (small / "r.h5").string();
   for (const auto& [size, command] : std::vector<std::pair<std::string, std::string>>{
            {"8k", "run " + path("c.yaml") + " --quiet -o " + out},
            {"40k", "run " + path("c.yaml") + " --quiet -o " + out},
-           {"120k", "run " + path("c.yaml") + " --quiet -o " + out},
+           {"88k", "run " + path("c.yaml") + " --quiet -o " + out},
            {"40k", "predict " + path("c.yaml") + " --model exact -o " + out}}) {
     if (mount("tmpfs", small.c_str(), "tmpfs", 0, ("size=" + size).c_str()) != 0)
       GTEST_SKIP() << "cannot mount a tmpfs here (" << std::strerror(errno) << ")";
