@@ -79,13 +79,19 @@ std::vector<ExactTally::Word> ExactTally::lobe_moments() const {
   return m;
 }
 
-void ExactTally::lobe(int l, ExactLobe& out) const {
+void ExactTally::lobe_counts(int l, std::vector<std::uint64_t>& out) const {
   const std::size_t bins = static_cast<std::size_t>(shape.n_theta) * shape.n_phi;
-  const std::size_t first = static_cast<std::size_t>(l) * bins, C = shape.channels;
-  out.count.assign(count.begin() + first, count.begin() + first + bins);
-  out.weight_sum.assign(weight_sum.begin() + first * C, weight_sum.begin() + (first + bins) * C);
-  out.weight_sq_sum.assign(weight_sq_sum.begin() + first * C,
-                           weight_sq_sum.begin() + (first + bins) * C);
+  const auto first = count.begin() + static_cast<std::ptrdiff_t>(l * bins);
+  out.assign(first, first + static_cast<std::ptrdiff_t>(bins));
+}
+
+void ExactTally::lobe_sums(int l, BinSum which, std::vector<double>& value,
+                           std::vector<std::int64_t>& residual) const {
+  const std::size_t cells = static_cast<std::size_t>(shape.n_theta) * shape.n_phi * shape.channels;
+  const Word* sums = (which == BinSum::S1 ? weight_sum : weight_sq_sum).data() + l * cells;
+  value.resize(cells);
+  residual.resize(cells);
+  for (std::size_t i = 0; i < cells; ++i) split(sums[i], value[i], residual[i]);
 }
 
 std::vector<double> ExactTally::to_double(const std::vector<Word>& v) {
@@ -116,23 +122,19 @@ void ExactTally::split(const std::vector<Word>& v, std::vector<double>& value,
                        std::vector<std::int64_t>& residual) {
   value.resize(v.size());
   residual.resize(v.size());
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    const Word e = v[i];
-    if (e >> 53 == 0) {  // nearly every bin: exact as a double
-      value[i] = static_cast<double>(static_cast<std::uint64_t>(e)) / kScale;
-      residual[i] = 0;
-      continue;
-    }
-    const double nearest = nearest_double(e);
-    // Below 2^116 an ulp of E is at most 2^63, so |r| <= 2^62.
-    if (e >> 116 != 0)
-      throw Error(fmt::format("a bin sum of {:g} is too large for the result file's exact residual "
-                              "(below 2^56, about 7.2e16)", nearest / kScale));
-    const Word back = static_cast<Word>(nearest);  // exact: a whole number below 2^117
-    const __int128 r = e >= back ? static_cast<__int128>(e - back) : -static_cast<__int128>(back - e);
-    value[i] = nearest / kScale;
-    residual[i] = static_cast<std::int64_t>(r);
-  }
+  for (std::size_t i = 0; i < v.size(); ++i) split(v[i], value[i], residual[i]);
+}
+
+void ExactTally::split_large(Word e, double& value, std::int64_t& residual) {
+  const double nearest = nearest_double(e);
+  // Below 2^116 an ulp of E is at most 2^63, so |r| <= 2^62.
+  if (e >> 116 != 0)
+    throw Error(fmt::format("a bin sum of {:g} is too large for the result file's exact residual "
+                            "(below 2^56, about 7.2e16)", nearest / kScale));
+  const Word back = static_cast<Word>(nearest);  // exact: a whole number below 2^117
+  value = nearest / kScale;
+  residual = static_cast<std::int64_t>(e >= back ? static_cast<__int128>(e - back)
+                                                 : -static_cast<__int128>(back - e));
 }
 
 std::ptrdiff_t ExactTally::join(const std::vector<double>& value,

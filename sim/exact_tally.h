@@ -21,14 +21,8 @@ struct TallyShape {
   friend bool operator==(const TallyShape&, const TallyShape&) = default;
 };
 
-// One lobe of a direction's bin sums, in file order: count [theta][phi],
-// weight_sum and weight_sq_sum [theta][phi][channel]. The result writer
-// streams a direction one lobe at a time (sim/result_stream.h), so that
-// writing needs no copy of a whole tally.
-struct ExactLobe {
-  std::vector<std::uint64_t> count;
-  std::vector<unsigned __int128> weight_sum, weight_sq_sum;
-};
+// Which bin sum: S1 (weight_sum) or S2 (weight_sq_sum).
+enum class BinSum { S1, S2 };
 
 // A direction's photons and energy ledger (SPEC section 4) as exact words
 // ([lobe][channel] for exited, [channel] for the others).
@@ -64,7 +58,14 @@ struct ExactTally {
   // [lobe][channel], S1 first, then S2. What --target-error judges.
   std::vector<Word> lobe_moments() const;
 
-  void lobe(int l, ExactLobe& out) const;  // lobe l's bins, into out (resized)
+  // Lobe l's bins in file order, as the result file stores them (the result
+  // writer streams a direction one lobe and one sum at a time,
+  // sim/result_stream.h): counts [theta][phi], and one sum [theta][phi][channel]
+  // split into values and residuals (split(), below). Into the given
+  // buffers, resized.
+  void lobe_counts(int l, std::vector<std::uint64_t>& out) const;
+  void lobe_sums(int l, BinSum which, std::vector<double>& value,
+                 std::vector<std::int64_t>& residual) const;
   ExactLedger ledger() const { return {photons, exited, absorbed, truncated, lost}; }
 
   static std::vector<double> to_double(const std::vector<Word>& v);
@@ -80,6 +81,16 @@ struct ExactTally {
   // one.
   static void split(const std::vector<Word>& v, std::vector<double>& value,
                     std::vector<std::int64_t>& residual);
+  // One word: what split() does to each. Inline: the result writer splits
+  // every cell of a tally with it.
+  static void split(Word e, double& value, std::int64_t& residual) {
+    if (e >> 53 == 0) {  // nearly every bin: exact as a double
+      value = static_cast<double>(static_cast<std::uint64_t>(e)) / kScale;
+      residual = 0;
+    } else {
+      split_large(e, value, residual);
+    }
+  }
   static std::ptrdiff_t join(const std::vector<double>& value,
                              const std::vector<std::int64_t>& residual, std::vector<Word>& out);
   // Two uint64 per word, (high, low): how format 1 files stored them (and
@@ -89,6 +100,9 @@ struct ExactTally {
   static void to_double(const std::vector<Word>& v, std::vector<double>& out);
   static void to_pairs(const std::vector<Word>& v, std::vector<std::uint64_t>& out);
   static std::vector<Word> from_pairs(const std::vector<std::uint64_t>& v);
+
+ private:
+  static void split_large(Word e, double& value, std::int64_t& residual);  // e >= 2^53
 };
 
 }  // namespace fiberlab::sim

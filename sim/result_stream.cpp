@@ -105,27 +105,40 @@ void ResultWriter::write(std::size_t k, const ExactTally& t) {
   const std::size_t per_lobe = static_cast<std::size_t>(t.shape.n_theta) * t.shape.n_phi;
   std::vector<std::size_t> work(static_cast<std::size_t>(t.shape.lobes), 0);
   for (std::size_t b = 0; b < t.count.size(); ++b) work[b / per_lobe] += t.count[b] != 0;
-  write_direction(k, t.shape, t.ledger(), [&](int l, ExactLobe& lobe) { t.lobe(l, lobe); }, work);
+  write_direction(k, t.shape, t.ledger(),
+                  {[&](int l, std::vector<std::uint64_t>& c) { t.lobe_counts(l, c); },
+                   [&](int l, BinSum which, std::vector<double>& v, std::vector<std::int64_t>& r) {
+                     t.lobe_sums(l, which, v, r);
+                   }},
+                  work);
 }
 
 void ResultWriter::write(std::size_t k, const Tally& t) {
   write_direction(k, t.shape(), t.exact_ledger(),
-                  [&](int l, ExactLobe& lobe) { t.exact_lobe(l, lobe); },
+                  {[&](int l, std::vector<std::uint64_t>& c) { t.lobe_counts(l, c); },
+                   [&](int l, BinSum which, std::vector<double>& v, std::vector<std::int64_t>& r) {
+                     t.lobe_sums(l, which, v, r);
+                   }},
                   t.touched_bins_per_lobe());
 }
 
 namespace {
 
-// Lobe indices, heaviest first (ties in lobe order): with the lobes handed
-// out to threads one at a time, the last ones to start are the lightest, so
-// threads finish close together (longest processing time first). Measured on
-// case c (4 M photons, 2 threads): the last lobe, p >= 7, was also the
-// densest, and one thread waited 13 ms for it.
-std::vector<int> heaviest_first(const std::vector<std::size_t>& work) {
+// The parts of the lobes to convert and deflate, (lobe, part) with part 0
+// S1, 1 S2, 2 the counts: the sums of the heaviest lobes first (ties in lobe
+// order), then the counts, the lightest. With the parts handed out to
+// threads one at a time, the last ones to start are the lightest, so threads
+// finish close together (longest processing time first). Measured on case c
+// (4 M photons, 2 threads): the last lobe, p >= 7, was also the densest, and
+// one thread waited 13 ms for it when a lobe was one piece of work.
+std::vector<std::pair<int, int>> heaviest_first(const std::vector<std::size_t>& work) {
   std::vector<int> order(work.size());
   for (std::size_t l = 0; l < order.size(); ++l) order[l] = static_cast<int>(l);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return work[a] > work[b]; });
-  return order;
+  std::vector<std::pair<int, int>> parts;
+  for (int l : order) parts.insert(parts.end(), {{l, 0}, {l, 1}});
+  for (int l : order) parts.push_back({l, 2});
+  return parts;
 }
 
 }  // namespace
@@ -135,7 +148,7 @@ std::vector<int> heaviest_first(const std::vector<std::size_t>& work) {
 // h5::File's chunking), then every chunk handed to HDF5 on this thread (HDF5
 // is serial, and its error settings are per thread).
 void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
-                                   const ExactLedger& ledger, const LobeSource& lobe_of,
+                                   const ExactLedger& ledger, const BinSource& bins,
                                    const std::vector<std::size_t>& lobe_work) {
   if (!(shape == shape_) || k >= photons_.size() ||
       lobe_work.size() != static_cast<std::size_t>(shape_.lobes))
@@ -151,13 +164,13 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
   std::exception_ptr failure;  // the first; the lobes after it are skipped
   std::atomic<bool> failed{false};
-  const std::vector<int> order = heaviest_first(lobe_work);
+  const std::vector<std::pair<int, int>> parts = heaviest_first(lobe_work);
 #pragma omp parallel for num_threads(threads) schedule(dynamic)
-  for (int i = 0; i < shape_.lobes; ++i) {
-    const int l = order[i];
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const auto [l, part] = parts[i];
     if (failed) continue;
     try {
-      prepare_lobe(l, plans, lobe_of, scratch_[omp_get_thread_num()], prepared_[l]);
+      prepare_part(l, part, plans, bins, scratch_[omp_get_thread_num()], prepared_[l]);
     } catch (...) {
 #pragma omp critical(result_writer_failure)
       if (!failure) failure = std::current_exception();
@@ -180,23 +193,22 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
 }
 
-// Lobe l's five rows (the sums and squared sums as float64 and residuals,
-// the counts), on one thread with its scratch.
-void ResultWriter::prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of,
-                                LobeScratch& s, std::array<h5::File::PreparedRow, 5>& out) {
-  lobe_of(l, s.lobe);
+void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins,
+                                Scratch& s, std::array<h5::File::PreparedRow, 5>& out) {
   const auto deflater = [&](const h5::File::RowPlan& plan) -> Deflater& {
     const int level = plan.direct ? plan.level : 1;  // (unused when not direct)
     if (!s.deflater || s.deflater->level() != level) s.deflater.emplace(level);
     return *s.deflater;
   };
-  ExactTally::split(s.lobe.weight_sum, s.doubles, s.residuals);
-  h5::File::prepare_row(plans[0], s.doubles, deflater(plans[0]), out[0]);
-  h5::File::prepare_row(plans[2], s.residuals, deflater(plans[2]), out[2]);
-  ExactTally::split(s.lobe.weight_sq_sum, s.doubles, s.residuals);
-  h5::File::prepare_row(plans[1], s.doubles, deflater(plans[1]), out[1]);
-  h5::File::prepare_row(plans[3], s.residuals, deflater(plans[3]), out[3]);
-  h5::File::prepare_row(plans[4], s.lobe.count, deflater(plans[4]), out[4]);
+  if (part == 2) {
+    bins.counts(l, s.count);
+    h5::File::prepare_row(plans[4], s.count, deflater(plans[4]), out[4]);
+    return;
+  }
+  // S1: rows 0 (values) and 2 (residuals); S2: rows 1 and 3.
+  bins.sums(l, part == 0 ? BinSum::S1 : BinSum::S2, s.value, s.residual);
+  h5::File::prepare_row(plans[part], s.value, deflater(plans[part]), out[part]);
+  h5::File::prepare_row(plans[2 + part], s.residual, deflater(plans[2 + part]), out[2 + part]);
 }
 
 void ResultWriter::commit() {

@@ -46,30 +46,39 @@ class ResultWriter {
   void commit();  // writes /tally/photons, closes, renames into place
 
  private:
-  using LobeSource = std::function<void(int lobe, ExactLobe& out)>;
+  // A direction's bins, a lobe and a sum at a time (ExactTally and Tally
+  // both give them: lobe_counts, lobe_sums).
+  struct BinSource {
+    std::function<void(int lobe, std::vector<std::uint64_t>& count)> counts;
+    std::function<void(int lobe, BinSum which, std::vector<double>& value,
+                       std::vector<std::int64_t>& residual)>
+        sums;
+  };
   // The bin datasets written a lobe (a row) at a time: S1 and S2 as float64,
   // then their residuals, then the counts.
   using LobePlans = std::array<h5::File::RowPlan, 5>;
   // One writing thread's buffers, kept across lobes and directions: fresh
   // memory costs a page fault per 4 KiB, which on these machines costs more
   // than the conversions.
-  struct LobeScratch {
-    ExactLobe lobe;
-    std::vector<double> doubles;
-    std::vector<std::int64_t> residuals;
+  struct Scratch {
+    std::vector<std::uint64_t> count;
+    std::vector<double> value;
+    std::vector<std::int64_t> residual;
     std::optional<Deflater> deflater;
   };
   // lobe_work[l]: lobe l's relative cost (the lobes are taken heaviest first).
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
-                       const LobeSource& lobe_of, const std::vector<std::size_t>& lobe_work);
-  void prepare_lobe(int l, const LobePlans& plans, const LobeSource& lobe_of, LobeScratch& s,
+                       const BinSource& bins, const std::vector<std::size_t>& lobe_work);
+  // Part `part` of lobe l (0: S1, 1: S2, 2: the counts) converted and
+  // deflated into its rows of out, on one thread with its scratch.
+  void prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins, Scratch& s,
                     std::array<h5::File::PreparedRow, 5>& out);
 
   AtomicOutput out_;
   std::optional<h5::File> file_;
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
-  std::vector<LobeScratch> scratch_;   // [thread]
+  std::vector<Scratch> scratch_;   // [thread]
   std::vector<std::array<h5::File::PreparedRow, 5>> prepared_;  // [lobe][dataset], until written
   int threads_ = 1;
 };

@@ -82,7 +82,7 @@ ExactTally Tally::exact() const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
   for (int l = 0; l < lobes_; ++l)
     copy_lobe(l, e.count.data() + l * per_lobe, e.weight_sum.data() + l * per_lobe * C,
-              e.weight_sq_sum.data() + l * per_lobe * C, false);
+              e.weight_sq_sum.data() + l * per_lobe * C);
   ExactLedger ledger = exact_ledger();
   e.photons = ledger.photons;
   e.exited = std::move(ledger.exited);
@@ -92,30 +92,46 @@ ExactTally Tally::exact() const {
   return e;
 }
 
-void Tally::exact_lobe(int l, ExactLobe& out) const {
+void Tally::lobe_counts(int l, std::vector<std::uint64_t>& out) const {
+  const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;
+  const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
+  out.resize(per_lobe);  // every element is written: a reused buffer is not cleared first
+  for (std::size_t i = 0; i < per_lobe; ++i)
+    out[i] = touched_[(first + i) / kPageBins]
+                 ? static_cast<std::uint64_t>(cells()[(first + i) * block()])
+                 : 0;
+}
+
+// Straight from the cells into the file's values and residuals: no copy of
+// the lobe as 128-bit words (fresh memory costs a page fault per 4 KiB here).
+void Tally::lobe_sums(int l, BinSum which, std::vector<double>& value,
+                      std::vector<std::int64_t>& residual) const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
-  // Every element is written (untouched bins as zeros): a reused buffer is not cleared first.
-  out.count.resize(per_lobe);
-  out.weight_sum.resize(per_lobe * C);
-  out.weight_sq_sum.resize(per_lobe * C);
-  copy_lobe(l, out.count.data(), out.weight_sum.data(), out.weight_sq_sum.data(), true);
+  const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
+  const std::size_t offset = which == BinSum::S1 ? 1 : 1 + C;  // in a bin's block
+  value.resize(per_lobe * C);
+  residual.resize(per_lobe * C);
+  for (std::size_t i = 0; i < per_lobe; ++i) {
+    double* v = value.data() + i * C;
+    std::int64_t* r = residual.data() + i * C;
+    if (!touched_[(first + i) / kPageBins]) {
+      std::fill(v, v + C, 0.0);
+      std::fill(r, r + C, std::int64_t{0});
+      continue;
+    }
+    const Fixed* sums = cells() + (first + i) * block() + offset;
+    for (std::size_t c = 0; c < C; ++c)
+      ExactTally::split(static_cast<ExactTally::Word>(sums[c]), v[c], r[c]);
+  }
 }
 
 // Lobe l's touched bins into the arrays ([theta][phi], [theta][phi][channel]);
-// the untouched ones are zero: left as they are (zeroed arrays), or written.
-void Tally::copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2,
-                      bool write_untouched) const {
+// the untouched ones are zero, left as they are (the arrays start zeroed).
+void Tally::copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_, C = channels_;
   const std::size_t first = static_cast<std::size_t>(l) * per_lobe;
   for (std::size_t i = 0; i < per_lobe; ++i) {
-    if (!touched_[(first + i) / kPageBins]) {
-      if (write_untouched) {
-        count[i] = 0;
-        std::fill(s1 + i * C, s1 + (i + 1) * C, ExactTally::Word{0});
-        std::fill(s2 + i * C, s2 + (i + 1) * C, ExactTally::Word{0});
-      }
-      continue;
-    }
+    if (!touched_[(first + i) / kPageBins]) continue;
     const Fixed* cell = cells() + (first + i) * block();
     count[i] = static_cast<std::uint64_t>(cell[0]);
     for (std::size_t c = 0; c < C; ++c) {

@@ -93,8 +93,11 @@ class Tally {
   TallyShape shape() const { return {lobes_, n_theta_, n_phi_, channels_}; }
   ExactTally exact() const;
   // The same, a part at a time, read in place (what the result writer
-  // streams): lobe l's bins, and the photons and ledger.
-  void exact_lobe(int l, ExactLobe& out) const;
+  // streams): lobe l's counts and sums as ExactTally's lobe_counts and
+  // lobe_sums give them, and the photons and ledger.
+  void lobe_counts(int l, std::vector<std::uint64_t>& out) const;
+  void lobe_sums(int l, BinSum which, std::vector<double>& value,
+                 std::vector<std::int64_t>& residual) const;
   ExactLedger exact_ledger() const;
   // Per lobe, how many of its bins lie on pages the tally wrote: what
   // exporting and compressing the lobe costs, roughly (the result writer
@@ -127,8 +130,7 @@ class Tally {
   // that scoring a photon touches one or two cache lines, not three arrays.
   std::size_t block() const { return 2 * static_cast<std::size_t>(channels_) + 1; }
   std::vector<double> column(int offset) const;  // S1 (offset 1) or S2 (1 + C)
-  void copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2,
-                 bool write_untouched) const;
+  void copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const;
 
   int lobes_, n_theta_, n_phi_, channels_;
   std::uint64_t photons_ = 0;
