@@ -10,11 +10,6 @@
 
 namespace fiberlab::sim {
 
-ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
-    : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
-      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
-      kept_(sigma_a_.size()) {}
-
 namespace {
 
 using Batch = xsimd::batch<double>;
@@ -23,13 +18,41 @@ using Index = xsimd::batch<std::int64_t>;
 // A bin index (a whole number below 2^52) as an integer (sim/lanes.h).
 Index to_index(const Batch& x) { return xsimd::bitwise_cast<Index>(life::to_bits(x)); }
 
+// How far from a whole number (in bins) the closed-form position x n of a
+// value must be for the settle step below to be skipped (see settled_bin).
+constexpr double kSettleMargin = 0x1.0p-20;
+
+// Whether every edge's own closed-form position, computed as block_bins
+// computes a value's, lies within half the margin of its index. The
+// positions are monotone in the value (each operation rounds monotonically),
+// so then a value whose position is at least the margin away from every
+// whole number lies strictly between the edges of its closed-form bin, and
+// the settle step would not move it.
+bool edges_at_closed_form(const std::vector<double>& edges, double offset, double period) {
+  const int n = static_cast<int>(edges.size()) - 1;
+  for (int i = 0; i <= n; ++i)
+    if (!(std::abs((edges[i] + offset) / period * n - i) <= kSettleMargin / 2)) return false;
+  return true;
+}
+
 // BinGrid::theta_bin / phi_bin (common/bin_grid.cpp, the definition) for a
 // vector of values: the closed-form index, clamped, then settled on the
 // grid's own edges, so the result is the scalar one exactly (a test compares
-// them at and next to every edge). A NaN fraction gives bin 0 (max(NaN, 0)
-// is 0); such photons did not exit and their bins are never read.
-Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges) {
-  Batch i = xsimd::min(xsimd::max(xsimd::floor(fraction * Batch(n)), Batch(0.0)), Batch(n - 1));
+// them at and next to every edge, and at random values). When the edges are
+// at their closed-form positions (`closed_form`, edges_at_closed_form) and
+// every lane's position is at least kSettleMargin inside its bin, the index
+// is already settled: nearly every vector, which then needs no gather of
+// edges. A NaN fraction gives bin 0 (max(NaN, 0) is 0); such photons did not
+// exit and their bins are never read.
+Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges,
+                  bool closed_form) {
+  const Batch position = fraction * Batch(n);
+  Batch i = xsimd::min(xsimd::max(xsimd::floor(position), Batch(0.0)), Batch(n - 1));
+  if (closed_form) {
+    const Batch inside = position - i;  // exact (Sterbenz) where it matters: 0 <= i <= position
+    if (xsimd::all((inside >= Batch(kSettleMargin)) & (inside <= Batch(1.0 - kSettleMargin))))
+      return to_index(i);
+  }
   const Index k = to_index(i);
   const Batch lo = Batch::gather(edges.data(), k), hi = Batch::gather(edges.data(), k + Index(1));
   const auto down = (i > Batch(0.0)) & (v < lo);
@@ -52,6 +75,15 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
 
 }  // namespace
 
+ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
+    : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
+      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
+      kept_(sigma_a_.size()),
+      // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
+      theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
+                         edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
+      phi_closed_form_(edges_at_closed_form(grid.phi_edges, kPi, kTwoPi)) {}
+
 void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, std::int64_t* phi_bin) const {
   constexpr int W = static_cast<int>(Batch::size);
   const int n_theta = grid_.n_theta(), n_phi = grid_.n_phi();
@@ -60,10 +92,12 @@ void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, s
     const Batch theta = Batch::load_aligned(f.theta + i);
     const Batch theta_fraction = uniform ? (theta + Batch(kPi / 2)) / Batch(kPi)
                                          : Batch(0.5) * (xsimd::sin(theta) + Batch(1.0));
-    settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges).store_aligned(theta_bin + i);
+    settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges, theta_closed_form_)
+        .store_aligned(theta_bin + i);
     Batch::batch_bool_type in_range;
     const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
-    settled_bin(phi, (phi + Batch(kPi)) / Batch(kTwoPi), n_phi, grid_.phi_edges).store_aligned(phi_bin + i);
+    settled_bin(phi, (phi + Batch(kPi)) / Batch(kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
+        .store_aligned(phi_bin + i);
     // Lanes out of the vector wrap's range take the scalar one. Photons that
     // did not exit (truncated) have no direction (NaN): their bins are never
     // read, and a NaN must not reach phi_bin's conversion to int.

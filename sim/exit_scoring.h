@@ -29,6 +29,9 @@ class ExitScorer {
   std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
+  // The grid's edges are where block_bins' closed form puts them (to within
+  // a margin), so that most vectors of bins need no settling on the edges.
+  bool theta_closed_form_, phi_closed_form_;
 };
 
 }  // namespace fiberlab::sim
