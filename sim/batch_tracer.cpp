@@ -135,15 +135,23 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   pack_store(s.weight, lanes, f.weight + n);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
-  alignas(64) double code[W], segments[W];
-  pack_store(s.code, lanes, code);
+  // Fates as fate_of (sim/tracer.h) gives them, from the code's mask bits.
+  const std::uint64_t exited =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
+  const std::uint64_t truncated =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kTruncated))), lanes);
+  const std::uint64_t lost = ~(exited | truncated);
+  alignas(64) double segments[W];
   pack_store(s.segments, lanes, segments);
   for (int j = 0; j < k; ++j) {
-    const PhotonFate fate = fate_of(static_cast<int>(code[j]));
     f.segments[n + j] = static_cast<int>(segments[j]);
-    f.exited[n + j] = fate == PhotonFate::Exited;
-    f.lost[n + j] = fate == PhotonFate::Lost;
-    if (fate != PhotonFate::Exited) f.dx[n + j] = f.dy[n + j] = f.dz[n + j] = 0.0;  // no exit direction
+    f.exited[n + j] = (exited >> j) & 1;
+    f.lost[n + j] = (lost >> j) & 1;
+  }
+  // No exit direction for a photon that did not exit.
+  for (std::uint64_t rest = ~exited & ((std::uint64_t{1} << k) - 1); rest != 0; rest &= rest - 1) {
+    const int j = n + std::countr_zero(rest);
+    f.dx[j] = f.dy[j] = f.dz[j] = 0.0;
   }
   if constexpr (HasExitHook<Model>) {
     alignas(64) std::uint64_t w[4][W];

@@ -33,6 +33,21 @@ inline std::uint64_t lane_bits(const MaskOf<Batch>& m) {
   return bits;
 }
 
+// The bits of `bits` at the lanes `lanes` selects, lowest first: what
+// pack_store does to a vector, done to a mask's lane bits (so that a
+// finished lane's flags need no trip through memory). BMI2's pext where
+// there is one.
+inline std::uint64_t pack_bits(std::uint64_t bits, std::uint64_t lanes) {
+#if defined(__BMI2__)
+  return _pext_u64(bits, lanes);
+#else
+  std::uint64_t out = 0;
+  for (int j = 0; lanes != 0; lanes &= lanes - 1, ++j)
+    out |= ((bits >> std::countr_zero(lanes)) & 1) << j;
+  return out;
+#endif
+}
+
 #if !defined(__AVX512F__) && defined(__AVX2__)
 namespace packing_detail {
 // For each mask of 4 lanes, the permutation of 32-bit elements that moves

@@ -3,6 +3,8 @@
 // leaving what lies past the vector's room untouched.
 #include <gtest/gtest.h>
 
+#include <bit>
+
 #include <cstdint>
 #include <vector>
 
@@ -71,6 +73,21 @@ TEST(LanePacking, APairPacksAsOneVectorOfTwiceTheLanes) {
       EXPECT_EQ(out[j++], v[k]) << "mask " << bits << " lane " << k;
     }
     for (int i = W2; i < W2 + 2; ++i) EXPECT_EQ(out[i], kSentinel) << "mask " << bits;
+  }
+}
+
+// pack_bits packs a mask's lane bits as pack_store packs lanes: bit j of the
+// result is the bit of the j-th selected lane, lowest first (oracle: that
+// definition, one lane at a time), for every selection of 16 lanes.
+TEST(LanePacking, PackBitsKeepsTheSelectedLanesBitsInOrder) {
+  std::uint64_t bits = 0x9e3779b97f4a7c15u;  // a fixed pattern, rotated per selection
+  for (std::uint64_t lanes = 0; lanes < (std::uint64_t{1} << 16); ++lanes) {
+    bits = std::rotl(bits, 5);
+    std::uint64_t expected = 0;
+    int j = 0;
+    for (int k = 0; k < 16; ++k)
+      if ((lanes >> k) & 1) expected |= ((bits >> k) & 1) << j++;
+    ASSERT_EQ(pack_bits(bits, lanes), expected) << "lanes " << lanes << " bits " << bits;
   }
 }
 
