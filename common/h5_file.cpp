@@ -9,6 +9,8 @@
 #include <bit>
 #include <cerrno>
 #include <cstring>
+#include <mutex>
+#include <thread>
 
 #include <cmath>
 
@@ -266,15 +268,43 @@ Handle::~Handle() {
   if (id_ >= 0 && closer_) closer_(id_);
 }
 
+namespace {
+
+// prepare_hdf5's thread, joined once: by the first quiet_hdf5_errors, or at
+// exit (a static destroyed before the HDF5 C++ library's exit-time H5close,
+// which was registered before main).
+struct Hdf5Start {
+  std::thread thread;
+  std::once_flag joined;
+  void wait() {
+    std::call_once(joined, [this] {
+      if (thread.joinable()) thread.join();
+    });
+  }
+  ~Hdf5Start() { wait(); }
+};
+
+Hdf5Start& hdf5_start() {
+  static Hdf5Start start;
+  return start;
+}
+
+}  // namespace
+
 void prepare_hdf5() {
   // Before any other HDF5 call: no C library cleanup at exit; every file
   // fiberlab writes is closed explicitly, on success or failure (see
   // drop_contents). (The HDF5 C++ library still calls H5close at exit.)
-  H5dont_atexit();
-  quiet_hdf5_errors();
+  hdf5_start().thread = std::thread([] {
+    H5dont_atexit();
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  });
 }
 
-void quiet_hdf5_errors() { H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr); }
+void quiet_hdf5_errors() {
+  hdf5_start().wait();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
 
 namespace {
 bool abandoned_files = false;

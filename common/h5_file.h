@@ -160,10 +160,14 @@ class File {
 // Called first in main(): turns the HDF5 C library's atexit cleanup off
 // (fiberlab closes every file it writes explicitly; a write that failed drops
 // the file's contents first so that its ids close, see drop_contents in the
-// .cpp) and silences HDF5's error printing.
+// .cpp) and silences HDF5's error printing. On a thread of its own: this is
+// the library's initialisation, about 2 ms, which then overlaps the parsing
+// of the command line and the config (nothing else calls HDF5 before
+// quiet_hdf5_errors, which waits for it: every File starts there).
 void prepare_hdf5();
 
 // Silences HDF5's automatic error stack printing; fiberlab reports its own.
+// Waits for prepare_hdf5's thread first.
 void quiet_hdf5_errors();
 
 // True once a file being written was abandoned after a failed write (e.g. a
