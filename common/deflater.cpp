@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstring>
 #include <new>
+#include <optional>
 #include <utility>
 
 #include "common/error.h"
@@ -53,6 +54,12 @@ void Deflater::deflate(const unsigned char* data, std::size_t bytes, std::size_t
       libdeflate_zlib_compress(z_, in, padded, compressed_.data(), compressed_.size());
   if (size == 0) throw Error("internal error: libdeflate could not compress a chunk");
   out.assign(compressed_.begin(), compressed_.begin() + static_cast<std::ptrdiff_t>(size));
+}
+
+Deflater& thread_deflater(int level) {
+  thread_local std::optional<Deflater> z;
+  if (!z || z->level() != level) z.emplace(level);
+  return *z;
 }
 
 }  // namespace fiberlab

@@ -34,4 +34,9 @@ class Deflater {
   std::vector<unsigned char> compressed_;  // the output, at the bound's size
 };
 
+// This thread's Deflater at `level`, made on first use and kept (remade
+// when another level is asked for): a compressor's tables are a few hundred
+// KB of fresh memory, so every writer on a thread shares one.
+Deflater& thread_deflater(int level);
+
 }  // namespace fiberlab

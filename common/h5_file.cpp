@@ -129,6 +129,21 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
   return dcpl;
 }
 
+// Whether a dataset's creation list makes it one chunk, deflated at level 2
+// and nothing else (dataset_creation for a dataset of 4096 to 65536 cells).
+bool whole_chunk_deflated(hid_t dcpl, const Dims& dims) {
+  if (H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_nfilters(dcpl) != 1) return false;
+  unsigned flags = 0, cd[4] = {0, 0, 0, 0};
+  std::size_t n_cd = 4;
+  if (H5Pget_filter2(dcpl, 0, &flags, &n_cd, cd, 0, nullptr, nullptr) != H5Z_FILTER_DEFLATE ||
+      n_cd < 1 || cd[0] != 2)
+    return false;
+  Dims chunk(dims.size());
+  return H5Pget_chunk(dcpl, static_cast<int>(dims.size()), chunk.data()) ==
+             static_cast<int>(dims.size()) &&
+         chunk == dims;
+}
+
 template <typename T>
 void write_dataset(hid_t file, const std::string& path, const std::string& name,
                    const Dims& dims, const std::vector<T>& data, hid_t mem_type, hid_t file_type) {
@@ -144,8 +159,22 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
                                   dcpl.id(), H5P_DEFAULT),
                        H5Dclose, "cannot create " + name, path);
   errno = 0;
-  check_write(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
-              "cannot write " + name, path);
+  if (whole_chunk_deflated(dcpl.id(), dims) && sizeof(T) == 8 &&
+      std::endian::native == std::endian::little) {
+    // One chunk, deflated here by libdeflate (common/deflater.h) and handed
+    // over as it is stored: HDF5's own zlib filter took about 1 ms for the
+    // 16,200 solid angles of a 90 x 180 grid, libdeflate a tenth of that.
+    // (The file types are the little-endian forms of T.)
+    std::vector<unsigned char> chunk;
+    const std::size_t bytes = data.size() * sizeof(T);
+    thread_deflater(2).deflate(reinterpret_cast<const unsigned char*>(data.data()), bytes, bytes, chunk);
+    const Dims origin(dims.size(), 0);
+    check_write(H5Dwrite_chunk(set.id(), H5P_DEFAULT, 0, origin.data(), chunk.size(), chunk.data()),
+                file, "cannot write " + name, path);
+  } else {
+    check_write(H5Dwrite(set.id(), mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data.data()), file,
+                "cannot write " + name, path);
+  }
   // Written to disk now, while a failure can still drop the file's contents
   // (the close of `set` would flush it with no way to report a failure).
   check_write(H5Dflush(set.id()), file, "cannot write " + name, path);

@@ -195,10 +195,8 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
 
 void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins,
                                 Scratch& s, std::array<h5::File::PreparedRow, 5>& out) {
-  const auto deflater = [&](const h5::File::RowPlan& plan) -> Deflater& {
-    const int level = plan.direct ? plan.level : 1;  // (unused when not direct)
-    if (!s.deflater || s.deflater->level() != level) s.deflater.emplace(level);
-    return *s.deflater;
+  const auto deflater = [](const h5::File::RowPlan& plan) -> Deflater& {
+    return thread_deflater(plan.direct ? plan.level : 1);  // (unused when not direct)
   };
   if (part == 2) {
     bins.counts(l, s.count);

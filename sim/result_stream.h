@@ -59,12 +59,11 @@ class ResultWriter {
   using LobePlans = std::array<h5::File::RowPlan, 5>;
   // One writing thread's buffers, kept across lobes and directions: fresh
   // memory costs a page fault per 4 KiB, which on these machines costs more
-  // than the conversions.
+  // than the conversions. (Its compressor is the thread's, thread_deflater.)
   struct Scratch {
     std::vector<std::uint64_t> count;
     std::vector<double> value;
     std::vector<std::int64_t> residual;
-    std::optional<Deflater> deflater;
   };
   // lobe_work[l]: lobe l's relative cost (the lobes are taken heaviest first).
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
