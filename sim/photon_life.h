@@ -131,7 +131,8 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
 // last allowed segment is truncated (SPEC section 5), and so is one running
 // exactly along the axis (guided for ever).
 template <class T, class Light>
-void travel(const LifeConfig& c, PhotonState<T, Light>& s, const MaskOf<T>& live) {
+[[gnu::always_inline]] inline void travel(const LifeConfig& c, PhotonState<T, Light>& s,
+                                          const MaskOf<T>& live) {
   const MaskOf<T> at_limit = live & (s.code == T(kTravel)) & (s.segments >= T(c.max_segments));
   s.code = select(at_limit, T(kTruncated), s.code);
   const MaskOf<T> go = live & (s.code == T(kTravel));
