@@ -129,19 +129,24 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
   return dcpl;
 }
 
-// Whether a dataset's creation list makes it one chunk, deflated at level 2
-// and nothing else (dataset_creation for a dataset of 4096 to 65536 cells).
-bool whole_chunk_deflated(hid_t dcpl, const Dims& dims) {
-  if (H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_nfilters(dcpl) != 1) return false;
+// The deflate level of a chunked layout whose only filter is deflate (what
+// dataset_creation makes of a dataset of 4096 cells or more), or -1: then
+// fiberlab can deflate its chunks itself and hand them over as stored.
+int only_deflate_level(hid_t dcpl) {
+  if (H5Pget_layout(dcpl) != H5D_CHUNKED || H5Pget_nfilters(dcpl) != 1) return -1;
   unsigned flags = 0, cd[4] = {0, 0, 0, 0};
   std::size_t n_cd = 4;
   if (H5Pget_filter2(dcpl, 0, &flags, &n_cd, cd, 0, nullptr, nullptr) != H5Z_FILTER_DEFLATE ||
-      n_cd < 1 || cd[0] != 2)
-    return false;
-  Dims chunk(dims.size());
-  return H5Pget_chunk(dcpl, static_cast<int>(dims.size()), chunk.data()) ==
-             static_cast<int>(dims.size()) &&
-         chunk == dims;
+      n_cd < 1)
+    return -1;
+  return static_cast<int>(cd[0]);
+}
+
+// The chunk dimensions of a chunked layout of rank `rank` (empty if not).
+Dims chunk_dims(hid_t dcpl, std::size_t rank) {
+  Dims chunk(rank);
+  if (H5Pget_chunk(dcpl, static_cast<int>(rank), chunk.data()) != static_cast<int>(rank)) return {};
+  return chunk;
 }
 
 template <typename T>
@@ -159,7 +164,8 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
                                   dcpl.id(), H5P_DEFAULT),
                        H5Dclose, "cannot create " + name, path);
   errno = 0;
-  if (whole_chunk_deflated(dcpl.id(), dims) && sizeof(T) == 8 &&
+  const int level = only_deflate_level(dcpl.id());
+  if (level >= 0 && chunk_dims(dcpl.id(), dims.size()) == dims && sizeof(T) == 8 &&
       std::endian::native == std::endian::little) {
     // One chunk, deflated here by libdeflate (common/deflater.h) and handed
     // over as it is stored: HDF5's own zlib filter took about 1 ms for the
@@ -167,7 +173,8 @@ void write_dataset(hid_t file, const std::string& path, const std::string& name,
     // (The file types are the little-endian forms of T.)
     std::vector<unsigned char> chunk;
     const std::size_t bytes = data.size() * sizeof(T);
-    thread_deflater(2).deflate(reinterpret_cast<const unsigned char*>(data.data()), bytes, bytes, chunk);
+    thread_deflater(level).deflate(reinterpret_cast<const unsigned char*>(data.data()), bytes, bytes,
+                                   chunk);
     const Dims origin(dims.size(), 0);
     check_write(H5Dwrite_chunk(set.id(), H5P_DEFAULT, 0, origin.data(), chunk.size(), chunk.data()),
                 file, "cannot write " + name, path);
@@ -557,19 +564,15 @@ File::RowPlan File::plan_rows(const std::string& name) {
   if constexpr (std::endian::native != std::endian::little) return plan;  // file types are LE
   // Direct: chunk dims (1, 1, rows_per_chunk, whole trailing dims), deflate the only filter.
   Handle dcpl = checked(H5Dget_create_plist(plan.set.id()), H5Pclose, "creation list of " + name, path_);
-  if (H5Pget_layout(dcpl.id()) != H5D_CHUNKED || H5Pget_nfilters(dcpl.id()) != 1) return plan;
-  unsigned flags = 0, cd[4] = {0, 0, 0, 0};
-  std::size_t n_cd = 4;
-  if (H5Pget_filter2(dcpl.id(), 0, &flags, &n_cd, cd, 0, nullptr, nullptr) != H5Z_FILTER_DEFLATE ||
-      n_cd < 1)
-    return plan;
+  const int level = only_deflate_level(dcpl.id());
+  if (level < 0) return plan;
   Handle space = checked(H5Dget_space(plan.set.id()), H5Sclose, "dataspace of " + name, path_);
   const int rank = H5Sget_simple_extent_ndims(space.id());
   if (rank < 3) return plan;
-  Dims dims(rank), chunk(rank);
+  Dims dims(rank);
   H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
-  if (H5Pget_chunk(dcpl.id(), rank, chunk.data()) != rank || chunk[0] != 1 || chunk[1] != 1)
-    return plan;
+  const Dims chunk = chunk_dims(dcpl.id(), dims.size());
+  if (chunk.empty() || chunk[0] != 1 || chunk[1] != 1) return plan;
   std::size_t cells = 1;
   for (int d = 3; d < rank; ++d) {
     if (chunk[d] != dims[d]) return plan;
@@ -578,7 +581,7 @@ File::RowPlan File::plan_rows(const std::string& name) {
   plan.rows = dims[2];
   plan.rows_per_chunk = chunk[2];
   plan.row_bytes = cells * sizeof(double);  // float64 and (u)int64 alike
-  plan.level = static_cast<int>(cd[0]);
+  plan.level = level;
   plan.direct = true;
   return plan;
 }

@@ -26,6 +26,16 @@ void write_file_identity(h5::File& f, const std::string& format, const std::stri
   f.set_attr("/", "created_utc", created_utc);
 }
 
+std::int64_t read_format_version(const h5::File& f, const std::string& path) {
+  if (!f.has_attr("/", "format_version"))
+    throw Error(fmt::format("{}: root attribute format_version is missing", path));
+  const std::int64_t v = f.attr_int("/", "format_version");
+  if (v < 1 || v > kFormatVersion)
+    throw Error(fmt::format("{}: format_version = {} is not supported (this fiberlab reads 1 to {})",
+                            path, v, kFormatVersion));
+  return v;
+}
+
 bool is_hdf5_file(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error(fmt::format("{}: cannot open", path));

@@ -20,6 +20,9 @@ std::string utc_timestamp();
 // The root attributes every fiberlab file carries: format (the file type,
 // e.g. "fiber-histogram"), format_version, software_version, created_utc.
 void write_file_identity(h5::File& f, const std::string& format, const std::string& created_utc);
+// The file's format_version, 1 to kFormatVersion; throws fiberlab::Error
+// naming `path` when it is missing or another.
+std::int64_t read_format_version(const h5::File& f, const std::string& path);
 
 // Whether `path` starts with the HDF5 signature. Throws fiberlab::Error when
 // it cannot be read.

@@ -100,23 +100,22 @@ std::vector<double> ExactTally::to_double(const std::vector<Word>& v) {
   return out;
 }
 
-void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out) {
-  out.resize(v.size());
-  // Below 2^64 (nearly every bin) the 64-bit conversion gives the same
-  // correctly rounded double as the 128-bit one, without its library call.
-  for (std::size_t i = 0; i < v.size(); ++i)
-    out[i] = (v[i] >> 64 == 0 ? static_cast<double>(static_cast<std::uint64_t>(v[i]))
-                              : static_cast<double>(v[i])) / kScale;
-}
 
 namespace {
 
 // The float64 nearest E (ties to even), as an integer: E itself below 2^53.
+// Below 2^64 (nearly every bin) the 64-bit conversion gives the same
+// correctly rounded double as the 128-bit one, without its library call.
 double nearest_double(ExactTally::Word e) {
   return e >> 64 == 0 ? static_cast<double>(static_cast<std::uint64_t>(e)) : static_cast<double>(e);
 }
 
 }  // namespace
+
+void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out) {
+  out.resize(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = nearest_double(v[i]) / kScale;
+}
 
 void ExactTally::split(const std::vector<Word>& v, std::vector<double>& value,
                        std::vector<std::int64_t>& residual) {

@@ -18,6 +18,15 @@ using Index = xsimd::batch<std::int64_t>;
 // A bin index (a whole number below 2^52) as an integer (sim/lanes.h).
 Index to_index(const Batch& x) { return xsimd::bitwise_cast<Index>(life::to_bits(x)); }
 
+// The closed-form fraction of a uniformly binned value: (v + offset) /
+// period, in [0, 1) inside the grid. One formula for the values' bins and for
+// the check of the edges below (edges_at_closed_form relies on it being the
+// same operations).
+template <class T>
+T uniform_fraction(const T& v, double offset, double period) {
+  return (v + T(offset)) / T(period);
+}
+
 // How far from a whole number (in bins) the closed-form position x n of a
 // value must be for the settle step below to be skipped (see settled_bin).
 constexpr double kSettleMargin = 0x1.0p-20;
@@ -31,7 +40,8 @@ constexpr double kSettleMargin = 0x1.0p-20;
 bool edges_at_closed_form(const std::vector<double>& edges, double offset, double period) {
   const int n = static_cast<int>(edges.size()) - 1;
   for (int i = 0; i <= n; ++i)
-    if (!(std::abs((edges[i] + offset) / period * n - i) <= kSettleMargin / 2)) return false;
+    if (!(std::abs(uniform_fraction(edges[i], offset, period) * n - i) <= kSettleMargin / 2))
+      return false;
   return true;
 }
 
@@ -90,13 +100,13 @@ void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, s
   const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
   for (int i = 0; i < f.n; i += W) {
     const Batch theta = Batch::load_aligned(f.theta + i);
-    const Batch theta_fraction = uniform ? (theta + Batch(kPi / 2)) / Batch(kPi)
+    const Batch theta_fraction = uniform ? uniform_fraction(theta, kPi / 2, kPi)
                                          : Batch(0.5) * (xsimd::sin(theta) + Batch(1.0));
     settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges, theta_closed_form_)
         .store_aligned(theta_bin + i);
     Batch::batch_bool_type in_range;
     const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
-    settled_bin(phi, (phi + Batch(kPi)) / Batch(kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
+    settled_bin(phi, uniform_fraction(phi, kPi, kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
         .store_aligned(phi_bin + i);
     // Lanes out of the vector wrap's range take the scalar one. Photons that
     // did not exit (truncated) have no direction (NaN): their bins are never

@@ -44,12 +44,7 @@ class Reader {
   void identity() const {
     if (!f_.has_attr("/", "format") || f_.attr_string("/", "format") != "fiber-histogram")
       fail("not a fiberlab result file (root attribute format must be \"fiber-histogram\")");
-    if (!f_.has_attr("/", "format_version"))
-      fail("root attribute format_version is missing");
-    const std::int64_t v = f_.attr_int("/", "format_version");
-    if (v < 1 || v > kFormatVersion)
-      fail(fmt::format("format_version = {} is not supported (this fiberlab reads 1 to {})", v,
-                       kFormatVersion));
+    read_format_version(f_, path_);
     for (const char* name : {"software_version", "created_utc", "config_yaml"})
       if (!f_.has_attr("/", name)) fail(fmt::format("root attribute {} is missing", name));
   }

@@ -105,21 +105,11 @@ void ResultWriter::write(std::size_t k, const ExactTally& t) {
   const std::size_t per_lobe = static_cast<std::size_t>(t.shape.n_theta) * t.shape.n_phi;
   std::vector<std::size_t> work(static_cast<std::size_t>(t.shape.lobes), 0);
   for (std::size_t b = 0; b < t.count.size(); ++b) work[b / per_lobe] += t.count[b] != 0;
-  write_direction(k, t.shape, t.ledger(),
-                  {[&](int l, std::vector<std::uint64_t>& c) { t.lobe_counts(l, c); },
-                   [&](int l, BinSum which, std::vector<double>& v, std::vector<std::int64_t>& r) {
-                     t.lobe_sums(l, which, v, r);
-                   }},
-                  work);
+  write_direction(k, t.shape, t.ledger(), bins_of(t), work);
 }
 
 void ResultWriter::write(std::size_t k, const Tally& t) {
-  write_direction(k, t.shape(), t.exact_ledger(),
-                  {[&](int l, std::vector<std::uint64_t>& c) { t.lobe_counts(l, c); },
-                   [&](int l, BinSum which, std::vector<double>& v, std::vector<std::int64_t>& r) {
-                     t.lobe_sums(l, which, v, r);
-                   }},
-                  t.touched_bins_per_lobe());
+  write_direction(k, t.shape(), t.exact_ledger(), bins_of(t), t.touched_bins_per_lobe());
 }
 
 namespace {
@@ -229,12 +219,7 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-histogram")
     throw Error(fmt::format("{}: not a fiberlab result file (root attribute format is not "
                             "\"fiber-histogram\")", path));
-  if (!f.has_attr("/", "format_version"))
-    throw Error(fmt::format("{}: root attribute format_version is missing", path));
-  version_ = f.attr_int("/", "format_version");
-  if (version_ < 1 || version_ > kFormatVersion)
-    throw Error(fmt::format("{}: format_version = {} is not supported (this fiberlab reads 1 to {})",
-                            path, version_, kFormatVersion));
+  version_ = read_format_version(f, path);
   ResultFile& h = header_;
   h.config_yaml = f.attr_string("/", "config_yaml");
   h.settings = parse_settings_yaml(h.config_yaml, path + ":/config_yaml");

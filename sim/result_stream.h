@@ -54,6 +54,14 @@ class ResultWriter {
                        std::vector<std::int64_t>& residual)>
         sums;
   };
+  // The BinSource of an ExactTally or a Tally (read in place).
+  template <class Tallied>
+  static BinSource bins_of(const Tallied& t) {
+    return {[&t](int l, std::vector<std::uint64_t>& c) { t.lobe_counts(l, c); },
+            [&t](int l, BinSum which, std::vector<double>& v, std::vector<std::int64_t>& r) {
+              t.lobe_sums(l, which, v, r);
+            }};
+  }
   // The bin datasets written a lobe (a row) at a time: S1 and S2 as float64,
   // then their residuals, then the counts.
   using LobePlans = std::array<h5::File::RowPlan, 5>;
