@@ -553,28 +553,30 @@ void File::write_slab(const std::string& name, hsize_t i, const std::vector<doub
   slab_io<double>(handle_.id(), path_, name, {i}, nullptr, &data, H5T_NATIVE_DOUBLE);
 }
 
-File::RowPlan File::plan_rows(const std::string& name) {
-  RowPlan plan;
+namespace {
+
+// The type a dataset's file type is read and written as.
+File::Type stored_type(hid_t type) {
+  return H5Tget_class(type) == H5T_FLOAT     ? File::Type::Float64
+         : H5Tget_sign(type) == H5T_SGN_2 ? File::Type::Int64
+                                           : File::Type::UInt64;
+}
+
+// A plan from a dataset's type, dims and creation list. Direct: chunk dims
+// (1, 1, rows_per_chunk, whole trailing dims), deflate the only filter.
+File::RowPlan plan_from_layout(const std::string& name, File::Type type, const Dims& dims,
+                               hid_t dcpl) {
+  File::RowPlan plan;
   plan.name = name;
-  plan.set = checked(H5Dopen2(handle_.id(), name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path_);
-  Handle type = checked(H5Dget_type(plan.set.id()), H5Tclose, "type of " + name, path_);
-  plan.type = H5Tget_class(type.id()) == H5T_FLOAT      ? Type::Float64
-              : H5Tget_sign(type.id()) == H5T_SGN_2 ? Type::Int64
-                                                    : Type::UInt64;
+  plan.type = type;
   if constexpr (std::endian::native != std::endian::little) return plan;  // file types are LE
-  // Direct: chunk dims (1, 1, rows_per_chunk, whole trailing dims), deflate the only filter.
-  Handle dcpl = checked(H5Dget_create_plist(plan.set.id()), H5Pclose, "creation list of " + name, path_);
-  const int level = only_deflate_level(dcpl.id());
-  if (level < 0) return plan;
-  Handle space = checked(H5Dget_space(plan.set.id()), H5Sclose, "dataspace of " + name, path_);
-  const int rank = H5Sget_simple_extent_ndims(space.id());
-  if (rank < 3) return plan;
-  Dims dims(rank);
-  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
-  const Dims chunk = chunk_dims(dcpl.id(), dims.size());
+  const int level = only_deflate_level(dcpl);
+  const std::size_t rank = dims.size();
+  if (level < 0 || rank < 3) return plan;
+  const Dims chunk = chunk_dims(dcpl, rank);
   if (chunk.empty() || chunk[0] != 1 || chunk[1] != 1) return plan;
   std::size_t cells = 1;
-  for (int d = 3; d < rank; ++d) {
+  for (std::size_t d = 3; d < rank; ++d) {
     if (chunk[d] != dims[d]) return plan;
     cells *= dims[d];
   }
@@ -584,6 +586,35 @@ File::RowPlan File::plan_rows(const std::string& name) {
   plan.level = level;
   plan.direct = true;
   return plan;
+}
+
+}  // namespace
+
+File::RowPlan File::plan_rows(const std::string& name) {
+  Handle set = checked(H5Dopen2(handle_.id(), name.c_str(), H5P_DEFAULT), H5Dclose, "missing " + name, path_);
+  Handle type = checked(H5Dget_type(set.id()), H5Tclose, "type of " + name, path_);
+  Handle dcpl = checked(H5Dget_create_plist(set.id()), H5Pclose, "creation list of " + name, path_);
+  Handle space = checked(H5Dget_space(set.id()), H5Sclose, "dataspace of " + name, path_);
+  Dims dims(std::max(0, H5Sget_simple_extent_ndims(space.id())));
+  H5Sget_simple_extent_dims(space.id(), dims.data(), nullptr);
+  RowPlan plan = plan_from_layout(name, stored_type(type.id()), dims, dcpl.id());
+  plan.set = std::move(set);
+  return plan;
+}
+
+File::RowPlan File::plan_new_rows(const std::string& name, const Dims& dims, Type type) {
+  Handle dcpl = dataset_creation(dims, true, name);
+  return plan_from_layout(name, type, dims, dcpl.id());
+}
+
+void File::attach(RowPlan& plan) {
+  if (plan.set.id() >= 0) return;
+  RowPlan opened = plan_rows(plan.name);
+  if (opened.type != plan.type || opened.direct != plan.direct || opened.rows != plan.rows ||
+      opened.rows_per_chunk != plan.rows_per_chunk || opened.row_bytes != plan.row_bytes ||
+      opened.level != plan.level)
+    throw Error(fmt::format("{}: internal error: {} was not created as planned", path_, plan.name));
+  plan.set = std::move(opened.set);
 }
 
 namespace {

@@ -110,6 +110,11 @@ class File {
     std::vector<std::int64_t> signed_words;
   };
   RowPlan plan_rows(const std::string& name);
+  // The plan of a dataset create_dataset(name, dims, type) will make, before
+  // any file exists (so that rows can be prepared while the file is created),
+  // and its dataset opened into it once created (checked against the plan).
+  static RowPlan plan_new_rows(const std::string& name, const Dims& dims, Type type);
+  void attach(RowPlan& plan);
   // Throws fiberlab::Error if the values do not fill a row of the plan's
   // type, or if z's level is not the dataset's.
   static void prepare_row(const RowPlan& plan, const std::vector<double>& values, Deflater& z,

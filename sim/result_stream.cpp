@@ -64,6 +64,12 @@ h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
   return dims;
 }
 
+h5::File::Type type_of(const DatasetShape& d) {
+  return d.stored == Stored::Float64    ? h5::File::Type::Float64
+         : d.stored == Stored::Residual ? h5::File::Type::Int64
+                                        : h5::File::Type::UInt64;
+}
+
 TallyShape shape_of(const ResultFile& r) {
   return {r.lobes, r.grid.n_theta(), r.grid.n_phi(), r.channels};
 }
@@ -72,26 +78,40 @@ TallyShape shape_of(const ResultFile& r) {
 
 ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
                            const DirectionSeeds& direction_seeds)
-    : out_(path), photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
+    : out_(path), header_(header), direction_seeds_(direction_seeds),
+      photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
+  // The header is all create_file needs.
+  for (std::vector<double>* v : {&header_.weight_sum, &header_.weight_sq_sum, &header_.exited,
+                                 &header_.absorbed, &header_.truncated, &header_.lost})
+    *v = {};
+  header_.count = {};
+}
+
+h5::File::RowPlan ResultWriter::planned(const std::string& name) const {
+  for (const DatasetShape& d : kTallyDatasets)
+    if (name == d.name) return h5::File::plan_new_rows(name, dims_of(d, photons_.size(), shape_), type_of(d));
+  throw Error("internal error: no dataset " + name);
+}
+
+h5::File& ResultWriter::file() {
+  if (!file_) create_file();
+  return *file_;
+}
+
+void ResultWriter::create_file() {
   file_.emplace(h5::File::create(out_.temp_path(), out_.target()));
   h5::File& f = *file_;
-  write_result_header(f, header);
+  write_result_header(f, header_);
   f.create_group("/tally");
   f.create_group("/ledger");
   f.create_group("/exact");
   const hsize_t K = photons_.size();
-  auto create = [&](const DatasetShape& d) {
-    f.create_dataset(d.name, dims_of(d, K, shape_),
-                     d.stored == Stored::Float64    ? h5::File::Type::Float64
-                     : d.stored == Stored::Residual ? h5::File::Type::Int64
-                                                    : h5::File::Type::UInt64);
-  };
-  for (const DatasetShape& d : kTallyDatasets) create(d);
-  for (const DatasetShape& d : kLostDatasets) create(d);
-  if (!direction_seeds.empty()) {
+  for (const DatasetShape& d : kTallyDatasets) f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
+  for (const DatasetShape& d : kLostDatasets) f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
+  if (!direction_seeds_.empty()) {
     std::vector<std::uint64_t> rows;
-    for (std::size_t k = 0; k < direction_seeds.size(); ++k)
-      for (std::uint64_t s : direction_seeds[k]) {
+    for (std::size_t k = 0; k < direction_seeds_.size(); ++k)
+      for (std::uint64_t s : direction_seeds_[k]) {
         rows.push_back(k);
         rows.push_back(s);
       }
@@ -143,31 +163,55 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   if (!(shape == shape_) || k >= photons_.size() ||
       lobe_work.size() != static_cast<std::size_t>(shape_.lobes))
     throw Error("internal error: writing a tally of the wrong shape or direction");
-  h5::File& f = *file_;
   photons_[k] = ledger.photons;
-  const LobePlans plans{f.plan_rows("/tally/weight_sum"), f.plan_rows("/tally/weight_sq_sum"),
-                        f.plan_rows("/exact/weight_sum_residual"),
-                        f.plan_rows("/exact/weight_sq_sum_residual"),
-                        f.plan_rows("/tally/count")};
+  // Before the file exists (its first direction), the plans come from the
+  // layout the datasets will have, and the file is created on this thread
+  // (HDF5's) while the other threads convert and deflate the first parts.
+  const bool create = !file_;
+  LobePlans plans = create ? LobePlans{planned("/tally/weight_sum"), planned("/tally/weight_sq_sum"),
+                                       planned("/exact/weight_sum_residual"),
+                                       planned("/exact/weight_sq_sum_residual"),
+                                       planned("/tally/count")}
+                           : LobePlans{file_->plan_rows("/tally/weight_sum"),
+                                       file_->plan_rows("/tally/weight_sq_sum"),
+                                       file_->plan_rows("/exact/weight_sum_residual"),
+                                       file_->plan_rows("/exact/weight_sq_sum_residual"),
+                                       file_->plan_rows("/tally/count")};
   prepared_.resize(static_cast<std::size_t>(shape_.lobes));
   const int threads = std::clamp(threads_, 1, shape_.lobes);
   if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
-  std::exception_ptr failure;  // the first; the lobes after it are skipped
+  std::exception_ptr failure;  // the first; the parts after it are skipped
   std::atomic<bool> failed{false};
-  const std::vector<std::pair<int, int>> parts = heaviest_first(lobe_work);
-#pragma omp parallel for num_threads(threads) schedule(dynamic)
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    const auto [l, part] = parts[i];
-    if (failed) continue;
-    try {
-      prepare_part(l, part, plans, bins, scratch_[omp_get_thread_num()], prepared_[l]);
-    } catch (...) {
+  const auto record_failure = [&] {
 #pragma omp critical(result_writer_failure)
-      if (!failure) failure = std::current_exception();
-      failed = true;
+    if (!failure) failure = std::current_exception();
+    failed = true;
+  };
+  const std::vector<std::pair<int, int>> parts = heaviest_first(lobe_work);
+#pragma omp parallel num_threads(threads)
+  {
+    if (create && omp_get_thread_num() == 0) {
+      try {
+        create_file();
+      } catch (...) {
+        record_failure();
+      }
+    }
+#pragma omp for schedule(dynamic) nowait
+    for (std::size_t i = 0; i < parts.size(); ++i) {
+      const auto [l, part] = parts[i];
+      if (failed) continue;
+      try {
+        prepare_part(l, part, plans, bins, scratch_[omp_get_thread_num()], prepared_[l]);
+      } catch (...) {
+        record_failure();
+      }
     }
   }
   if (failure) std::rethrow_exception(failure);
+  h5::File& f = *file_;
+  if (create)
+    for (h5::File::RowPlan& plan : plans) f.attach(plan);
   for (int l = 0; l < shape_.lobes; ++l)
     for (std::size_t r = 0; r < plans.size(); ++r)
       f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
@@ -200,7 +244,7 @@ void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const B
 }
 
 void ResultWriter::commit() {
-  file_->write("/tally/photons", {photons_.size()}, photons_);
+  file().write("/tally/photons", {photons_.size()}, photons_);
   file_->close();
   file_.reset();
   out_.commit();

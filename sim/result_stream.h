@@ -33,14 +33,16 @@ using DirectionSeeds = std::vector<std::vector<std::uint64_t>>;
 
 class ResultWriter {
  public:
-  // `header`: a ResultFile whose tally arrays may be empty (everything else is
-  // written now). The file appears at `path` only on commit().
+  // `header`: a ResultFile whose tally arrays may be empty. The file is
+  // created with the header on the first write() or file() (the first
+  // write() creates it while its threads deflate); it appears at `path`
+  // only on commit().
   ResultWriter(const std::string& path, const ResultFile& header,
                const DirectionSeeds& direction_seeds = {});
   // Each direction once, from exact sums or from a run's tally read in place.
   void write(std::size_t k, const ExactTally& t);
   void write(std::size_t k, const Tally& t);
-  h5::File& file() { return *file_; }              // for extra groups (checkpoints)
+  h5::File& file();  // for extra groups (checkpoints); creates the file if not yet
   // Threads that convert and deflate the bin datasets' lobes (1 unless set).
   void set_compression_threads(int threads) { threads_ = threads; }
   void commit();  // writes /tally/photons, closes, renames into place
@@ -80,8 +82,14 @@ class ResultWriter {
   // deflated into its rows of out, on one thread with its scratch.
   void prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins, Scratch& s,
                     std::array<h5::File::PreparedRow, 5>& out);
+  // The temporary file with the header and every dataset (none written).
+  void create_file();
+  // The row plan of bin dataset `name` as create_file makes it.
+  h5::File::RowPlan planned(const std::string& name) const;
 
   AtomicOutput out_;
+  ResultFile header_;
+  DirectionSeeds direction_seeds_;
   std::optional<h5::File> file_;
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
