@@ -141,5 +141,36 @@ TEST(H5RowPlan, RefusesRowsThatDoNotFitThePlan) {
   f.close();
 }
 
+// A plan made before the file exists (plan_new_rows) is the plan of the
+// dataset create_dataset then makes, for direct and fallback layouts alike;
+// attach opens the dataset into it, and refuses a dataset laid out otherwise.
+TEST(H5RowPlan, PlanBeforeTheFileIsThePlanOfTheCreatedDataset) {
+  const auto dir = test_support::unique_temp_dir("fiberlab_test_new_row_plan");
+  File f = File::create((dir / "new.h5").string());
+  const std::vector<std::pair<Dims, File::Type>> cases{
+      {{1, 8, 90, 180, 3}, File::Type::Float64}, {{2, 8, 90, 180, 3}, File::Type::Int64},
+      {{1, 8, 90, 180}, File::Type::UInt64},     {{1, 8, 30, 60}, File::Type::UInt64},
+      {{1, 8, 64, 64}, File::Type::UInt64},      {{2, 2, 2, 100000}, File::Type::Float64}};
+  for (std::size_t c = 0; c < cases.size(); ++c) {
+    const std::string name = "/d" + std::to_string(c);
+    File::RowPlan planned = File::plan_new_rows(name, cases[c].first, cases[c].second);
+    f.create_dataset(name, cases[c].first, cases[c].second);
+    const File::RowPlan opened = f.plan_rows(name);
+    EXPECT_EQ(planned.type, opened.type) << name;
+    EXPECT_EQ(planned.direct, opened.direct) << name;
+    EXPECT_EQ(planned.rows, opened.rows) << name;
+    EXPECT_EQ(planned.rows_per_chunk, opened.rows_per_chunk) << name;
+    EXPECT_EQ(planned.row_bytes, opened.row_bytes) << name;
+    EXPECT_EQ(planned.level, opened.level) << name;
+    EXPECT_NO_THROW(f.attach(planned)) << name;
+    EXPECT_GE(planned.set.id(), 0) << name;
+  }
+  // A dataset of another shape than planned (its rows split differently).
+  File::RowPlan wrong = File::plan_new_rows("/other", {1, 8, 90, 180, 3}, File::Type::Float64);
+  f.create_dataset("/other", {1, 8, 120, 180, 3}, File::Type::Float64);
+  EXPECT_THROW(f.attach(wrong), Error);
+  f.close();
+}
+
 }  // namespace
 }  // namespace fiberlab::h5
