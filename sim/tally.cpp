@@ -54,12 +54,14 @@ void Tally::score_lost(const double* lost, const double* kept) {
   }
 }
 
-void Tally::add(const Tally& o) {
+void Tally::add(const Tally& o, int threads) {
   if (!(o.shape() == shape())) throw Error("internal error: adding a tally of another shape");
   photons_ += o.photons_;
   Fixed* to = cells();
   const Fixed* from = o.cells();
-  for (std::size_t p = 0; p < touched_.size(); ++p) {
+  const auto pages = static_cast<std::ptrdiff_t>(touched_.size());
+#pragma omp parallel for num_threads(std::max(1, threads)) schedule(static) if (threads > 1)
+  for (std::ptrdiff_t p = 0; p < pages; ++p) {
     if (!o.touched_[p]) continue;
     touched_[p] = 1;
     for (std::size_t i = page_begin(p); i < page_end(p); ++i) to[i] += from[i];

@@ -85,7 +85,8 @@ class Tally {
   // Every launched photon must have been scored (exited, truncated, lost): what
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
-  void add(const Tally& other);  // exact: integer sums
+  // Exact: integer sums; on `threads` threads (a page each at a time).
+  void add(const Tally& other, int threads = 1);
   // Nothing scored: no photon launched, no cell touched, no ledger entry.
   bool is_zero() const;
   // The same sums as exact integers in file order (checkpoints, MPI, merge),
