@@ -9,7 +9,9 @@
 #   - the config's own run (its `photons`): the median wall time of N runs and
 #     photons / (wall x threads);
 #   - the slope from 4 M to 16 M photons: 12 M photons over the difference of
-#     the two medians, per thread: the tracing rate without the fixed part.
+#     the two medians, per thread: the tracing rate without the fixed part;
+# and, before and after, bench_sim's one-thread rate on case c as a check of
+# the machine's speed at the time (machine_check below).
 # Issue 10's targets (3.8 M/s per core for case b, 11 for case c) were set on
 # machines with AVX-512; the script says which vector instructions this
 # machine has, since rates on AVX2-only machines are about half.
@@ -71,10 +73,26 @@ config_photons() {
   awk '$1 == "photons:" {print $2}' "$root/bench/configs/case_$1.yaml"
 }
 
+# The machine's own speed at the time (these VMs' hosts slow them by up to a
+# fifth for minutes at a time): bench_sim's one-thread tracing rate of case
+# c, before and after the runs, when bench_sim is built. On a quiet AVX-512
+# machine of the sessions' kind it reads about 17 M photons/s
+# (docs/PERFORMANCE.md); markedly less means the times below are slow too.
+machine_check() {
+  local bench="$build/bench/bench_sim"
+  [ -x "$bench" ] || return 0
+  local rate
+  rate=$("$bench" --benchmark_filter='^trace/c_rough' --benchmark_min_time=1 2>/dev/null |
+    grep -o 'photons_per_s=[0-9.]*M' | head -1 | tr -dc '0-9.')
+  [ -n "$rate" ] && echo "machine check ($1): bench_sim case c, one thread: $rate M photons/s"
+  return 0
+}
+
 simd="AVX2 or less"
 grep -qw avx512f /proc/cpuinfo && simd="AVX-512"
 echo "machine: $(nproc) cores, $simd; $threads threads, medians of $runs runs"
 echo "issue 10's targets (AVX-512 machines): case b 3.8, case c 11 M photons/s per core"
+machine_check before
 for c in "${cases[@]}"; do
   n=$(config_photons "$c")
   t=$(median_wall "$c" "")
@@ -87,3 +105,4 @@ for c in "${cases[@]}"; do
     else printf "slope undefined (4 M %.3f s, 16 M %.3f s)\n", t4, t16
   }'
 done
+machine_check after
