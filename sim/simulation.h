@@ -92,8 +92,8 @@ class Simulation {
   // Traces the photons of every run the feed hands out (sim/photon_feed.h)
   // of incident configuration k into `tally` (with the batched tracer where
   // it runs the roughness model, the reference tracer for the microfacet
-  // models). `traced`, when given, grows by `per_photon` as each photon is
-  // scored (progress).
+  // models). `traced`, when given, grows by `per_photon` for each photon of
+  // a run as the run is taken (progress: every run taken is traced in full).
   void trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tally,
                      TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,
                      std::uint64_t per_photon = 1) const;
