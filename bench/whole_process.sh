@@ -10,8 +10,9 @@
 #     photons / (wall x threads);
 #   - the slope from 4 M to 16 M photons: 12 M photons over the difference of
 #     the two medians, per thread: the tracing rate without the fixed part;
-# and, before and after, bench_sim's one-thread rate on case c as a check of
-# the machine's speed at the time (machine_check below).
+# and, before and after, bench_sim's one-thread rate on case c, a copy per
+# thread at once, as a check of the machine's speed at the time
+# (machine_check below).
 # Issue 10's targets (3.8 M/s per core for case b, 11 for case c) were set on
 # machines with AVX-512; the script says which vector instructions this
 # machine has, since rates on AVX2-only machines are about half.
@@ -74,18 +75,28 @@ config_photons() {
 }
 
 # The machine's own speed at the time (these VMs' hosts slow them by up to a
-# fifth for minutes at a time): bench_sim's one-thread tracing rate of case
-# c, before and after the runs, when bench_sim is built. On a quiet AVX-512
-# machine of the sessions' kind it reads about 17 M photons/s
-# (docs/PERFORMANCE.md); markedly less means the times below are slow too.
+# fifth for minutes at a time, sometimes one core and not the other):
+# bench_sim's one-thread tracing rate of case c, one copy per thread run at
+# once (pinned to cores 0, 1, ... where taskset exists), before and after
+# the runs, when bench_sim is built. On a quiet AVX-512 machine of the
+# sessions' kind each reads about 17 M photons/s (docs/PERFORMANCE.md);
+# markedly less means the times below are slow too.
 machine_check() {
-  local bench="$build/bench/bench_sim"
+  local bench="$build/bench/bench_sim" i rates=()
   [ -x "$bench" ] || return 0
-  local rate
-  rate=$("$bench" --benchmark_filter='^trace/c_rough' --benchmark_min_time=1 2>/dev/null |
-    grep -o 'photons_per_s=[0-9.]*M' | head -1 | tr -dc '0-9.')
-  [ -n "$rate" ] && echo "machine check ($1): bench_sim case c, one thread: $rate M photons/s"
-  return 0
+  local copies=$threads
+  [ "$copies" -gt "$(nproc)" ] && copies=$(nproc)
+  for ((i = 0; i < copies; ++i)); do
+    local pin=()
+    command -v taskset >/dev/null && pin=(taskset -c "$i")
+    "${pin[@]}" "$bench" --benchmark_filter='^trace/c_rough' --benchmark_min_time=1 \
+      >"$work/check_$i" 2>/dev/null &
+  done
+  wait
+  for ((i = 0; i < copies; ++i)); do
+    rates+=("$(grep -o 'photons_per_s=[0-9.]*M' "$work/check_$i" | head -1 | tr -dc '0-9.')")
+  done
+  echo "machine check ($1): bench_sim case c, $copies copies at once, M photons/s each: ${rates[*]}"
 }
 
 simd="AVX2 or less"
