@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <iterator>
 
 #include "common/error.h"
 #include "common/result_layout.h"
@@ -64,6 +65,12 @@ h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
   return dims;
 }
 
+// The bin datasets a lobe is written to, in LobePlans' order (S1 and S2 as
+// float64, their residuals, the counts).
+constexpr const char* kLobeRows[] = {"/tally/weight_sum", "/tally/weight_sq_sum",
+                                     "/exact/weight_sum_residual",
+                                     "/exact/weight_sq_sum_residual", "/tally/count"};
+
 h5::File::Type type_of(const DatasetShape& d) {
   return d.stored == Stored::Float64    ? h5::File::Type::Float64
          : d.stored == Stored::Residual ? h5::File::Type::Int64
@@ -89,7 +96,8 @@ ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
 
 h5::File::RowPlan ResultWriter::planned(const std::string& name) const {
   for (const DatasetShape& d : kTallyDatasets)
-    if (name == d.name) return h5::File::plan_new_rows(name, dims_of(d, photons_.size(), shape_), type_of(d));
+    if (name == d.name)
+      return h5::File::plan_new_rows(name, dims_of(d, photons_.size(), shape_), type_of(d));
   throw Error("internal error: no dataset " + name);
 }
 
@@ -106,8 +114,10 @@ void ResultWriter::create_file() {
   f.create_group("/ledger");
   f.create_group("/exact");
   const hsize_t K = photons_.size();
-  for (const DatasetShape& d : kTallyDatasets) f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
-  for (const DatasetShape& d : kLostDatasets) f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
+  for (const DatasetShape& d : kTallyDatasets)
+    f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
+  for (const DatasetShape& d : kLostDatasets)
+    f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
   if (!direction_seeds_.empty()) {
     std::vector<std::uint64_t> rows;
     for (std::size_t k = 0; k < direction_seeds_.size(); ++k)
@@ -168,15 +178,10 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   // layout the datasets will have, and the file is created on this thread
   // (HDF5's) while the other threads convert and deflate the first parts.
   const bool create = !file_;
-  LobePlans plans = create ? LobePlans{planned("/tally/weight_sum"), planned("/tally/weight_sq_sum"),
-                                       planned("/exact/weight_sum_residual"),
-                                       planned("/exact/weight_sq_sum_residual"),
-                                       planned("/tally/count")}
-                           : LobePlans{file_->plan_rows("/tally/weight_sum"),
-                                       file_->plan_rows("/tally/weight_sq_sum"),
-                                       file_->plan_rows("/exact/weight_sum_residual"),
-                                       file_->plan_rows("/exact/weight_sq_sum_residual"),
-                                       file_->plan_rows("/tally/count")};
+  LobePlans plans;
+  static_assert(std::size(kLobeRows) == std::tuple_size_v<LobePlans>);
+  for (std::size_t r = 0; r < plans.size(); ++r)
+    plans[r] = create ? planned(kLobeRows[r]) : file_->plan_rows(kLobeRows[r]);
   prepared_.resize(static_cast<std::size_t>(shape_.lobes));
   const int threads = std::clamp(threads_, 1, shape_.lobes);
   if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
