@@ -86,13 +86,7 @@ TallyShape shape_of(const ResultFile& r) {
 ResultWriter::ResultWriter(const std::string& path, const ResultFile& header,
                            const DirectionSeeds& direction_seeds)
     : out_(path), header_(header), direction_seeds_(direction_seeds),
-      photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {
-  // The header is all create_file needs.
-  for (std::vector<double>* v : {&header_.weight_sum, &header_.weight_sq_sum, &header_.exited,
-                                 &header_.absorbed, &header_.truncated, &header_.lost})
-    *v = {};
-  header_.count = {};
-}
+      photons_(header.theta_i.size(), 0), shape_(shape_of(header)) {}
 
 h5::File::RowPlan ResultWriter::planned(const std::string& name) const {
   for (const DatasetShape& d : kTallyDatasets)

@@ -33,10 +33,11 @@ using DirectionSeeds = std::vector<std::vector<std::uint64_t>>;
 
 class ResultWriter {
  public:
-  // `header`: a ResultFile whose tally arrays may be empty. The file is
-  // created with the header on the first write() or file() (the first
-  // write() creates it while its threads deflate); it appears at `path`
-  // only on commit().
+  // `header`: a ResultFile of which only the header is written (kept until
+  // the file is created; every caller passes one with empty tally arrays,
+  // e.g. result_header). The file is created on the first write() or file()
+  // (the first write() creates it while its threads deflate); it appears at
+  // `path` only on commit().
   ResultWriter(const std::string& path, const ResultFile& header,
                const DirectionSeeds& direction_seeds = {});
   // Each direction once, from exact sums or from a run's tally read in place.
