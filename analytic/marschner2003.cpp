@@ -383,8 +383,8 @@ namespace {
 // when a step is below 1e-13 rad: Newton's next step would be ~1e-26 /
 // |phi'| (quadratic convergence), while phi near 2 pi carries a rounding
 // error of ~1e-15, so a tighter stop only makes the iterate wander inside
-// the rounding (the version before asked for 1e-15 and ran its 100 steps at
-// most crossings: half of predict's time).
+// the rounding (a stop at 1e-15 runs the 100-step cap at most crossings:
+// half of predict's time).
 // `guess` is used where it lies inside (a, b); else linear interpolation.
 template <class PhiOf, class SlopeOf>
 double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, double a, double b, double fa,

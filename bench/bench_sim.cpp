@@ -1,10 +1,10 @@
-// Photons per second per core for the three cases of issues 2 and 10 (90 x 180
+// Photons per second per core for the reference cases (90 x 180
 // bins, 8 lobes; the same cases as bench/configs/case_{a,b,c}.yaml, which time
 // the whole process):
 //  (a) smooth circle, sigma_a 0;
 //  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
 //  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg;
-//  (d) steep tilt: circle, beta 5 deg, tilt 20 deg, sigma_a 0, theta_i 30 deg (issue 8: light
+//  (d) steep tilt: circle, beta 5 deg, tilt 20 deg, sigma_a 0, theta_i 30 deg (light
 //      guided along the fiber runs to max_segments).
 // One thread, so the rate is per core. Counters: photons/s, interface events
 // and candidate normals per photon. `trace` is the batched SIMD tracer that

@@ -1,5 +1,5 @@
 #!/bin/bash
-# Whole-process speed of `fiberlab run` (issue 10's measure): start-up,
+# Whole-process speed of `fiberlab run`: start-up,
 # tallies, tracing, adding up and writing the HDF5 file, in photons per
 # second per core, for the bench/configs cases.
 #
@@ -13,7 +13,7 @@
 # and, before and after, bench_sim's one-thread rate on case c, a copy per
 # thread at once, as a check of the machine's speed at the time
 # (machine_check below).
-# Issue 10's targets (3.8 M/s per core for case b, 11 for case c) were set on
+# The design targets (3.8 M/s per core for case b, 11 for case c) hold on
 # machines with AVX-512; the script says which vector instructions this
 # machine has, since rates on AVX2-only machines are about half.
 # Wall times come from bash's EPOCHREALTIME (microseconds, read without
@@ -79,7 +79,7 @@ config_photons() {
 # bench_sim's one-thread tracing rate of case c, one copy per thread run at
 # once (pinned to cores 0, 1, ... where taskset exists), before and after
 # the runs, when bench_sim is built. On a quiet AVX-512 machine of the
-# sessions' kind each reads about 17 M photons/s (docs/PERFORMANCE.md);
+# kind docs/PERFORMANCE.md describes each reads about 17 M photons/s;
 # markedly less means the times below are slow too.
 machine_check() {
   local bench="$build/bench/bench_sim" i rates=()
@@ -102,7 +102,7 @@ machine_check() {
 simd="AVX2 or less"
 grep -qw avx512f /proc/cpuinfo && simd="AVX-512"
 echo "machine: $(nproc) cores, $simd; $threads threads, medians of $runs runs"
-echo "issue 10's targets (AVX-512 machines): case b 3.8, case c 11 M photons/s per core"
+echo "design targets (AVX-512 machines): case b 3.8, case c 11 M photons/s per core"
 machine_check before
 for c in "${cases[@]}"; do
   n=$(config_photons "$c")

@@ -21,7 +21,7 @@ std::string degrees(const std::vector<double>& radians) {
 }
 
 void info(const std::string& path) {
-  if (compare::is_prediction_file(path)) {  // issue 7: info reads predictions too
+  if (compare::is_prediction_file(path)) {  // info reads predictions too
     fmt::print("{}", compare::describe_prediction(compare::read_prediction(path)));
     return;
   }

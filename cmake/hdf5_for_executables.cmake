@@ -6,8 +6,8 @@
 #   FIBERLAB_STATIC_HDF5 is OFF: the shared library (HDF5::HDF5).
 # Why: Debian's shared libhdf5 needs about 27 more shared libraries (libcurl
 # and its TLS and Kerberos chain, for a remote-file driver fiberlab never
-# uses). Loading them was about 11 ms of every run's start-up (README
-# "Performance"). The archive only brings what fiberlab calls.
+# uses). Loading them costs about 11 ms of every run's start-up. The archive
+# only brings what fiberlab calls.
 option(FIBERLAB_STATIC_HDF5 "Link executables with HDF5's static archive when it is installed" ON)
 
 add_library(fiberlab_hdf5 INTERFACE)

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Calibrate the physical-to-model longitudinal widths (issue 7).
+"""Calibrate the physical-to-model longitudinal widths.
 
 The simulator's `gaussian` roughness tilts every microfacet normal by a
 Gaussian of standard deviation beta (SPEC s3). What width should d'Eon 2011's

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 12 part 3: how far Huang et al. 2022 (`--model huang2022`) is from the
+# How far Huang et al. 2022 (`--model huang2022`) is from the
 # simulated microfacet fiber it describes: the simulator's `roughness:
 # {model: ggx, alpha: A, masking: smith_g1}` (the paper's own ground truth:
 # weight times G1, paths ending on the wrong side lost). Two fibers (a

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The sanitizer job (issue 8): a second build in ./build-asan with
+# The sanitizer job: a second build in ./build-asan with
 # AddressSanitizer and UndefinedBehaviorSanitizer (float-cast-overflow
 # included), running the test subset labelled "sanitize" (tests/sim and
 # tests/robustness: the simulator, the settings, the command line and the

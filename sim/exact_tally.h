@@ -43,7 +43,7 @@ struct ExactTally {
   std::vector<Word> weight_sum, weight_sq_sum;  // [lobe][theta][phi][channel]
   std::vector<Word> exited;                     // [lobe][channel]
   std::vector<Word> absorbed, truncated;        // [channel]
-  std::vector<Word> lost;                       // [channel]: removed by masking (issue 12)
+  std::vector<Word> lost;                       // [channel]: removed by masking
 
   // Exact sum; throws fiberlab::Error when a count would overflow 64 bits.
   ExactTally& operator+=(const ExactTally& other);

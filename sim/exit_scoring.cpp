@@ -146,7 +146,7 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
       tally.score_truncated(weight);
     }
   }
-  // Masking's removals (issue 12), each absorbed along the path up to it,
+  // Masking's removals, each absorbed along the path up to it,
   // summed per photon (a photon's removals are consecutive in f.losses).
   double* kept = kept_.data();
   for (std::size_t j = 0; j < f.losses.size();) {

@@ -22,7 +22,7 @@ struct FinishedPhotons {
   int segments[kCapacity];
   bool exited[kCapacity];
   bool lost[kCapacity];  // killed by masking (its weight is in `losses`)
-  // Weight removed by masking from the block's photons (issue 12; empty
+  // Weight removed by masking from the block's photons (empty
   // without masking): photon slot, weight, path length at the removal.
   struct Loss {
     int slot;

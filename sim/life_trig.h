@@ -18,10 +18,10 @@
 // coefficients rounded to double, the polynomials differ from sin and cos by
 // at most 0.06 and 0.012 units of 2^-53 (relative) on |x| <= pi/4, far below
 // the rounding of the evaluation (about 2^-53), so the result is as accurate
-// as the library's, not an approximation of it. (Until the tenth session the
-// Taylor series to x^17 and x^18: five more operations per pair.) The
-// scalar and vector forms perform the same operations and give the same
-// bits (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp).
+// as the library's, not an approximation of it (with five operations per
+// pair fewer than the Taylor series to x^17 and x^18). The scalar and
+// vector forms perform the same operations and give the same bits
+// (photon-by-photon equivalence, tests/sim/test_batch_tracer.cpp).
 // tests/sim/test_life_trig.cpp compares both with std::sin / std::cos.
 #include <utility>
 

@@ -1,6 +1,6 @@
 #pragma once
 // Microfacet normal distributions for the simulator's `roughness: {model:
-// beckmann | ggx, alpha: A}` (issue 12; not yet wired into the tracers):
+// beckmann | ggx, alpha: A}` (sim/microfacet_roughness.h uses them):
 // the distribution D of microfacet normals about a mean (possibly tilted)
 // normal n, Smith's masking G1, and exact sampling of the distribution of
 // visible normals (VNDF)

@@ -1,6 +1,6 @@
 #pragma once
 // The microfacet roughness models `beckmann` and `ggx` at an interface event
-// (issue 12; SPEC section 3's roughness models, extended):
+// (SPEC section 3's roughness models, extended):
 //
 // - The mean normal of the event is the tilted normal n_f facing the photon.
 //   In the rare case that the tilt makes n_f face away (d.n_f >= 0) no

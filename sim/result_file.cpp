@@ -32,7 +32,7 @@ void write_parameters(h5::File& f, const Settings& s) {
   f.set_attr("/roughness", "model", to_string(s.roughness.model));
   f.set_attr("/roughness", "beta_long", s.roughness.beta_long);
   f.set_attr("/roughness", "beta_azim", s.roughness.beta_azim);
-  if (s.roughness.microfacet()) {  // beckmann / ggx (issue 12)
+  if (s.roughness.microfacet()) {  // beckmann / ggx
     f.set_attr("/roughness", "alpha", std::vector<double>{s.roughness.alpha_long, s.roughness.alpha_azim});
     f.set_attr("/roughness", "masking", to_string(s.roughness.masking));
   }

@@ -164,7 +164,7 @@ ResultFile read_result(const std::string& path) {
   rd.check_sums("/ledger/absorbed", r.absorbed);
   r.truncated = f.read_doubles("/ledger/truncated", {d.K, d.C}, "K x C, " + sizes);
   rd.check_sums("/ledger/truncated", r.truncated);
-  // /ledger/lost (masking, issue 12): files written before it have none, and lost nothing.
+  // /ledger/lost (masking): files written before it have none, and lost nothing.
   if (f.exists("/ledger/lost")) {
     r.lost = f.read_doubles("/ledger/lost", {d.K, d.C}, "K x C, " + sizes);
     rd.check_sums("/ledger/lost", r.lost);

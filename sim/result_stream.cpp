@@ -47,7 +47,7 @@ constexpr DatasetShape kTallyDatasets[] = {
 constexpr DatasetShape kFormat1BinSums[] = {{"/exact/weight_sum", Stored::Pairs, 5},
                                             {"/exact/weight_sq_sum", Stored::Pairs, 5}};
 
-// The ledger's `lost` (issue 12: weight removed by masking). Files written
+// The ledger's `lost` (weight removed by masking). Files written
 // before it existed have neither dataset: their lost is 0.
 constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", Stored::Float64, 2},
                                           {"/exact/lost", Stored::Pairs, 2}};
@@ -142,9 +142,9 @@ namespace {
 // S1, 1 S2, 2 the counts: the sums of the heaviest lobes first (ties in lobe
 // order), then the counts, the lightest. With the parts handed out to
 // threads one at a time, the last ones to start are the lightest, so threads
-// finish close together (longest processing time first). Measured on case c
-// (4 M photons, 2 threads): the last lobe, p >= 7, was also the densest, and
-// one thread waited 13 ms for it when a lobe was one piece of work.
+// finish close together (longest processing time first). On case c (4 M
+// photons, 2 threads) the last lobe, p >= 7, is also the densest: as one
+// piece of work it keeps one thread busy 13 ms after the other is done.
 std::vector<std::pair<int, int>> heaviest_first(const std::vector<std::size_t>& work) {
   std::vector<int> order(work.size());
   for (std::size_t l = 0; l < order.size(); ++l) order[l] = static_cast<int>(l);

@@ -1,7 +1,7 @@
 #pragma once
-// Roughness models `beckmann` and `ggx` (issue 12; sim/microfacet_roughness.h)
-// as a roughness model of the photon life (sim/roughness_model.h). Scalar
-// only for now: its visible-normal sampler is written for one photon, so
+// Roughness models `beckmann` and `ggx` (sim/microfacet_roughness.h) as a
+// roughness model of the photon life (sim/roughness_model.h). Scalar only:
+// its visible-normal sampler is written for one photon, so
 // Simulation traces these models with the reference Tracer (kScalarOnly);
 // making MicrofacetRoughness generic over T would run it batched unchanged.
 #include "sim/microfacet_normal.h"

@@ -12,7 +12,7 @@
 namespace fiberlab::sim {
 
 // Beckmann and GGX: microfacet distributions of normals about the tilted
-// normal, sampled as visible normals (sim/microfacet_roughness.h; issue 12).
+// normal, sampled as visible normals (sim/microfacet_roughness.h).
 enum class RoughnessModel { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
 // `roughness.masking` of the microfacet models: `smith_g1` multiplies the
 // photon's weight by Smith's G1 of each scattered direction and kills paths

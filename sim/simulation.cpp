@@ -111,8 +111,8 @@ std::uint64_t Simulation::Runner::photons_done() const {
 // of the tracer for the round, which takes the runs as its pool has room
 // (sim/photon_feed.h), so the pool drains once per thread and round (the
 // drain, where a few light-guided photons hold a vector for up to
-// max_segments steps, was most of a chunk's vector iterations when each
-// chunk was a call). Which thread or rank traces a photon changes no bit of
+// max_segments steps, would be most of a chunk's vector iterations if each
+// chunk were a call). Which thread or rank traces a photon changes no bit of
 // the sums. A lone process stops early on a signal, after a prefix of the
 // round's chunks (every run taken is traced in full); returns the end of
 // what was traced.
@@ -319,7 +319,7 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      // The microfacet models (issue 12) run on the reference tracer for now.
+      // The microfacet models run on the reference tracer (sim/roughness_microfacet.h).
       use_batch_tracer_(!settings_.roughness.microfacet()),  // scalar and Stokes light
       incidences_(settings_.incidences()) {}
 

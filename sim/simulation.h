@@ -58,10 +58,10 @@ enum class RunOutcome { Finished, Interrupted };
 class Simulation {
  public:
   // Photons handed to a thread at a time (the unit of a round's prefix when
-  // a signal stops it). When each chunk was a call of the batched tracer,
-  // which waits for the slowest (light-guided) photon of each call, 256-photon
-  // chunks ran at half the speed; now runs of chunks are fed to one call per
-  // thread and round. Progress is counted per photon.
+  // a signal stops it). The batched tracer waits for the slowest
+  // (light-guided) photon of each call, so runs of chunks are fed to one call
+  // per thread and round rather than a call per chunk (256-photon chunks, a
+  // call each, run at half the speed). Progress is counted per photon.
   static constexpr std::uint64_t kChunk = 4096;
   // A thread takes up to kMaxRunChunks consecutive chunks at a time (a
   // signal waits for the runs a thread has taken: 64 Ki photons, a few

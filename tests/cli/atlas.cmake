@@ -1,4 +1,4 @@
-# Issue 12 part 4: `fiberlab atlas` on a tiny sweep (seconds): table, report,
+# `fiberlab atlas` on a tiny sweep (seconds): table, report,
 # a recovered parameter, one-line config errors, Ctrl-C.
 add_test(NAME atlas_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})

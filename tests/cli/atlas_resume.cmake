@@ -1,4 +1,4 @@
-# `fiberlab atlas` checkpoints and --resume (issue 12 part 4): SIGINT, SIGKILL
+# `fiberlab atlas` checkpoints and --resume: SIGINT, SIGKILL
 # and SIGTERM, refusals, damaged checkpoints, and resumed results
 # bit-identical to an uninterrupted run (tests/cli/atlas_same_results.py).
 add_test(NAME atlas_resume_cli

@@ -12,7 +12,7 @@
 # 4. The resume (CONFIG given, from another folder) says "resuming: k of 4"
 #    and writes datasets bit-identical to the reference's (all but the wall
 #    times), the same report tables, and removes the checkpoint.
-# 5. SIGKILL (a killed session: no handler runs) after a checkpoint: the
+# 5. SIGKILL (a killed process: no handler runs) after a checkpoint: the
 #    resume without CONFIG gives the reference's results too, and no
 #    temporary file is left. SIGTERM once OUT is written, during the
 #    report: the resume restores all 4 fibers and runs none.

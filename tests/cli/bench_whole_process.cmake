@@ -1,4 +1,4 @@
-# Issue 10: bench/whole_process.sh runs and reports photons/s per core (case
+# bench/whole_process.sh runs and reports photons/s per core (case
 # a, one run each: about 1.5 s), and refuses a bad flag with exit 2.
 add_test(NAME bench_whole_process
          COMMAND bash ${PROJECT_SOURCE_DIR}/bench/whole_process.sh --build ${PROJECT_BINARY_DIR}

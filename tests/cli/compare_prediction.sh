@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 7: honest comparisons through the real program.
+# Honest comparisons through the real program.
 # 1. A smooth *absorbing* circle against `--model exact` with no --set is
 #    accepted (the exact model uses the chord by default); a wrong index, or
 #    the published attenuation, is rejected (exit 1).

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 2, test 11: a result file is readable by Debian's Python with h5py and
+# A result file is readable by Debian's Python with h5py and
 # no project code, and holds every SPEC section 9 name.
 set -euo pipefail
 fiberlab=$1 source_dir=$2

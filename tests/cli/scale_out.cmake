@@ -1,4 +1,4 @@
-# Issue 9: MPI ranks, SIGINT/SIGTERM + resume, split-sweep merge and the
+# MPI ranks, SIGINT/SIGTERM + resume, split-sweep merge and the
 # target-error stop, each compared bit for bit with one uninterrupted process.
 foreach(case mpi signal merge target)
   add_test(NAME scale_out_${case}

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Issue 9: runs split over MPI ranks, interrupted and resumed, split by
+"""Runs split over MPI ranks, interrupted and resumed, split by
 incident direction and merged, or stopped at a target error, give the same
 bits as one uninterrupted process. Compares runs against runs (never against
 stored numbers): every /tally and /ledger array, and the exact sums.

@@ -1,4 +1,4 @@
-// Issue 8: nothing a file, a flag or a signal can do crashes fiberlab,
+// Nothing a file, a flag or a signal can do crashes fiberlab,
 // corrupts a result or loses work silently. Every hostile input below is
 // crafted in the test (h5py through /usr/bin/python3, or the shell) from a
 // good result; each must give exit status 2, one line naming the problem,

@@ -93,7 +93,7 @@ TEST(BatchTracer, FarTailNormalsMatchReference) {
 }
 
 // Steep tilt: light-guided photons meet the tilted normal from behind at
-// most events (issue 8's slow case), so the far-tail sampler runs often.
+// most events (case d, the slow one), so the far-tail sampler runs often.
 TEST(BatchTracer, SteepTiltMatchesReference) {
   Settings s = testing::smooth_circle(30.0, 1);
   testing::make_rough(s, 5.0, 20.0);

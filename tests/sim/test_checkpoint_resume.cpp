@@ -1,4 +1,4 @@
-// Issue 9: a run stopped after some whole chunks, saved to a checkpoint file,
+// A run stopped after some whole chunks, saved to a checkpoint file,
 // read back and continued gives the same bits as the run done in one go; the
 // exact sums survive files and MPI's word format; the target-error measure
 // agrees with the result file's lobe estimator (SPEC section 6).

@@ -1,4 +1,4 @@
-// The command line's handling of bad input (issue 2, test 10): a one-line
+// The command line's handling of bad input: a one-line
 // error naming the field and the allowed range, a non-zero exit, and no
 // output file. Runs the real `fiberlab` program.
 #include <gtest/gtest.h>

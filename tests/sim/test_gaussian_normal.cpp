@@ -101,7 +101,7 @@ TEST(GaussianNormal, SameDistributionInTheFarTail) {
                    40000);
 }
 
-// Issue 8's case: beta 0.5 deg with the normal 3 deg away (eps / beta = 6):
+// A steep case: beta 0.5 deg with the normal 3 deg away (eps / beta = 6):
 // plain rejection (probability ~1e-9 a candidate) hit any cap; the tail
 // sampler must find every normal in a few dozen candidates.
 TEST(GaussianNormal, FarTailNeverReachesTheCap) {

@@ -1,4 +1,4 @@
-// A fiber with microfacet roughness (issue 12: `roughness: {model: beckmann |
+// A fiber with microfacet roughness (`roughness: {model: beckmann |
 // ggx, alpha: A, masking: none | smith_g1}`) traced whole:
 // - alpha -> 0 is the smooth fiber: phi histograms per lobe against the exact
 //   smooth cylinder (SPEC s7, analytic/smooth_cylinder), and on a tilted

@@ -1,4 +1,4 @@
-// The ledger's `lost` (issue 12) through the files: the exact sums a run
+// The ledger's `lost` through the files: the exact sums a run
 // writes (as `fiberlab run` and checkpoints do), the validating reader's
 // balance exited + absorbed + truncated + lost = N, files written before
 // `lost` existed (read as 0), a tampered `lost` (refused), and the exact sums'

@@ -1,4 +1,4 @@
-// `masking: smith_g1` (issue 12) against its definition at one interface: a
+// `masking: smith_g1` against its definition at one interface: a
 // photon entering a circular fiber through its axis (h = 0) meets the
 // surface at the entry point, and the weight masking removes at that first
 // event is the first entry of PhotonOutcome::losses (at path length 0; a

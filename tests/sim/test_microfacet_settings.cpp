@@ -1,4 +1,4 @@
-// The microfacet roughness block (issue 12): `roughness: {model: beckmann |
+// The microfacet roughness block: `roughness: {model: beckmann |
 // ggx, alpha: A | [longitudinal, azimuthal], masking: none | smith_g1}`, its
 // round trip through to_yaml and its one-line errors.
 //

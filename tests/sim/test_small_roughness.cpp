@@ -29,7 +29,7 @@ TEST(SmallRoughness, BetaZeroIsTheSmoothModelBitForBit) {
   EXPECT_EQ(b.truncated[0], 0.0);
 }
 
-// Issue 8: tilt 3 deg, theta_i 60 deg, beta 0.5 deg. Near the fiber's edge
+// Tilt 3 deg, theta_i 60 deg, beta 0.5 deg. Near the fiber's edge
 // (|h| > 0.9959, 0.41% of the photons) the tilted normal faces away from the
 // incoming photon by up to 2.6 deg = 5.2 beta; plain rejection truncated
 // 1.2% of the photons (internal events included) and put R 28 standard

@@ -1,4 +1,4 @@
-// Issue 2, test 3: a smooth absorbing circle's phi histogram, lobe by lobe,
+// A smooth absorbing circle's phi histogram, lobe by lobe,
 // against the exact smooth-cylinder bin probabilities of SPEC section 7
 // (chord-length absorption), which analytic/smooth_cylinder computes by
 // integrating A(p, h) over h, with no simulator code.
