@@ -264,7 +264,7 @@ Chiang2016::Chiang2016(Chiang2016Params params) : params_(std::move(params)) {
   if (!(p.beta_m >= 0.0 && p.beta_m <= 1.0)) bad(fmt::format("beta_m = {} must be in [0, 1]", p.beta_m));
   if (!(p.beta_n >= 0.0 && p.beta_n <= 1.0)) bad(fmt::format("beta_n = {} must be in [0, 1]", p.beta_n));
   if (!(std::abs(p.alpha) < kPi / 4))
-    bad(fmt::format("alpha = {} deg must be in (-45, 45) degrees", rad_to_deg(p.alpha)));
+    bad(fmt::format("alpha = {:g} deg must be in (-45, 45) degrees", rad_to_deg(p.alpha)));
   if (p.lobes < 1 || p.lobes > 4)
     bad(fmt::format("lobes = {} must be 1..4 (every order p >= 3 is one residual lobe)", p.lobes));
   if (p.sigma_a.empty()) bad("sigma_a needs at least one channel");

@@ -334,7 +334,7 @@ Huang2022::Huang2022(Huang2022Params params) : params_(std::move(params)) {
   if (!(p.eta > 1.0) || !std::isfinite(p.eta)) bad(fmt::format("eta = {} must be > 1", p.eta));
   if (!(p.roughness >= 0.0 && p.roughness <= 1.0))
     bad(fmt::format("roughness = {} must be in [0, 1]", p.roughness));
-  if (!(std::abs(p.tilt) < kPi / 4)) bad(fmt::format("tilt = {} deg must be in (-45, 45)", rad_to_deg(p.tilt)));
+  if (!(std::abs(p.tilt) < kPi / 4)) bad(fmt::format("tilt = {:g} deg must be in (-45, 45)", rad_to_deg(p.tilt)));
   if (!(p.eccentricity > 0.0 && p.eccentricity <= 1.0))
     bad(fmt::format("eccentricity = {} must be in (0, 1]", p.eccentricity));
   if (p.lobes < 1 || p.lobes > 4)

@@ -6,6 +6,7 @@
 // one is not, 2 on bad input. The statistics: compare/comparison.h; the rule:
 // compare/verdict.h; the prediction format: compare/prediction_file.h.
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <chrono>
 #include <cmath>
@@ -156,9 +157,11 @@ void add_compare_command(CLI::App& app) {
       "compare", "Validate a model against a result's histograms (exit 0 accepted, 1 rejected, 2 bad input)");
   cmd->add_option("result", o->result, "Result file (.h5)")->required();
   cmd->add_option("--model", o->model,
-                  "exact | deon2011 | marschner2003, optionally NAME:KEY=VALUE:... (per-model --set)");
+                  fmt::format("{}, optionally NAME:KEY=VALUE:... (per-model --set)",
+                              fmt::join(analytic::model_names(), " | ")));
   cmd->add_option("--prediction", o->prediction,
-                  "Judge a prediction file instead of a built-in model (format: README, \"Prediction files\")");
+                  "Judge a prediction file instead of a built-in model (format fiber-prediction: "
+                  "docs/FILE_FORMAT.md)");
   cmd->add_option("--set", o->settings,
                   "Model parameter KEY=VALUE (angles in degrees; repeatable; `fiberlab models` lists the keys)");
   cmd->add_option("--fit", o->fit,

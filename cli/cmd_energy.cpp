@@ -7,6 +7,7 @@
 // models are evaluated unless --run is given (then the simulation runs here,
 // in memory, with the config's photons or --photons).
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <omp.h>
 
@@ -17,6 +18,7 @@
 #include <memory>
 #include <sstream>
 
+#include "analytic/model_registry.h"
 #include "cli/commands.h"
 #include "common/error.h"
 #include "common/result_layout.h"
@@ -35,7 +37,7 @@ namespace fiberlab::cli {
 namespace {
 
 struct EnergyOptions {
-  std::string input, models = "deon2011,marschner2003,marschner2003:longitudinal=two_theta_h";
+  std::string input, models;  // empty: every registered model (energy_models_help)
   std::vector<std::string> settings;
   std::string beta_sweep, theta_i, report;
   bool run = false;
@@ -123,6 +125,24 @@ std::vector<std::string> split_commas(const std::string& s) {
   return out;
 }
 
+// The models `energy` evaluates when --models is not given: every registered
+// model, each at its default quadrature (huang2022's costs seconds per
+// theta_i: see energy_models_help).
+std::string energy_models_help() {
+  return fmt::format(
+      "Comma-separated model specs NAME[:KEY=VALUE...] (default: every model, {}; a model that does not "
+      "apply to the fiber, such as a circular-only one on an ellipse, is listed and skipped; huang2022 "
+      "takes seconds per theta_i at its default quadrature_points, so a long sweep may want "
+      "huang2022:quadrature_points=262144 or leaving it out)",
+      fmt::join(analytic::model_names(), ", "));
+}
+
+// Does model `name`'s table have the key of KEY=VALUE?
+bool has_key(const std::string& name, const std::string& key_value) {
+  const std::string key = key_value.substr(0, key_value.find('='));
+  return analytic::find_param(analytic::model_info(name).params, key) != nullptr;
+}
+
 std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
   using compare::json_number;
   auto arr = [](const std::vector<double>& v) {
@@ -203,28 +223,56 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
       if (theta_i.empty() || theta_i.back() != inc.theta_i) theta_i.push_back(inc.theta_i);
   bool white = true;
   for (double s : settings.fiber.sigma_a) white = white && s == 0.0;
+  const bool every_model = o.models.empty();
+  const std::vector<std::string> model_specs = every_model ? analytic::model_names() : split_commas(o.models);
+  // --set KEY=VALUE goes to every model whose table has KEY; a key no model has is an error.
+  for (const std::string& kv : o.settings) {
+    bool used = false;
+    for (const std::string& m : model_specs) used = used || has_key(compare::parse_model_spec(m).name, kv);
+    if (!used)
+      throw Error(fmt::format("--set {}: no model of --models {} has this key (`fiberlab models` lists them)", kv,
+                              every_model ? "(every model)" : o.models));
+  }
   if (!o.report.empty()) compare::make_report_dir(o.report);
 
   std::vector<compare::EnergyCurve> curves;
   if (simulated) curves.push_back(compare::simulation_energy(result));
   std::vector<double> betas;
   if (!o.beta_sweep.empty()) betas = parse_degrees("--beta-sweep", o.beta_sweep, kBetaRange);
-  for (const std::string& m : split_commas(o.models)) {
+  std::vector<std::string> skipped;
+  for (const std::string& m : model_specs) {
     const compare::ModelSpec spec = compare::parse_model_spec(m);
-    const analytic::ModelParams base = compare::params_for(settings, spec, o.settings);
-    auto add = [&](const analytic::ModelParams& p, const std::string& label, double beta) {
-      const auto model = compare::make_model(spec.name, p);
-      compare::EnergyCurve e = compare::model_energy(*model, label, theta_i, o.n_theta, o.n_phi);
+    std::vector<std::string> sets;
+    for (const std::string& kv : o.settings)
+      if (has_key(spec.name, kv)) sets.push_back(kv);
+    analytic::ModelParams base;
+    std::unique_ptr<analytic::Model> model;
+    try {
+      base = compare::params_for(settings, spec, sets);
+      model = compare::make_model(spec.name, base);
+    } catch (const Error& e) {
+      if (!every_model) throw;
+      skipped.push_back(fmt::format("{}: not applicable: {}", spec.name, e.what()));
+      continue;
+    }
+    auto add = [&](const analytic::Model& m, const std::string& label, double beta) {
+      compare::EnergyCurve e = compare::model_energy(m, label, theta_i, o.n_theta, o.n_phi);
       e.beta_long = beta;
       curves.push_back(std::move(e));
     };
-    if (betas.empty()) add(base, spec.label, -1.0);
+    // --beta-sweep varies the models that have a beta_long; the others are evaluated once.
+    if (betas.empty() || !has_key(spec.name, "beta_long")) {
+      add(*model, spec.label, -1.0);
+      continue;
+    }
     for (double b : betas) {
       analytic::ModelParams p = base;
       p.beta_long = {b};
-      add(p, fmt::format("{} beta_long={:g}", spec.label, rad_to_deg(b)), b);
+      add(*compare::make_model(spec.name, p), fmt::format("{} beta_long={:g}", spec.label, rad_to_deg(b)), b);
     }
   }
+  if (curves.empty()) throw Error(fmt::format("energy {}: no model applies to this fiber ({})", o.input,
+                                              fmt::join(skipped, "; ")));
   const int C = curves.empty() ? 0 : curves.front().channels;
   if (o.channel < 0 || o.channel >= C)
     throw Error(fmt::format("--channel {} out of range ({} channels)", o.channel, C));
@@ -233,6 +281,7 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
   fmt::print("{}: {}{}\n", o.input, from_result ? "result file" : "config",
              simulated ? (from_result ? "" : " (simulated here, --run)")
                        : " (simulation not run: models only; pass --run or a result file)");
+  for (const std::string& line : skipped) fmt::print("{}\n", line);
   fmt::print("fiber: eta {:g}, sigma_a[{}] = {:g}{}; channel {} shown\n", settings.fiber.eta, c,
              settings.fiber.sigma_a.at(std::min<std::size_t>(c, settings.fiber.sigma_a.size() - 1)),
              white ? " (white: the furnace test applies, total should be 1)" : " (absorbing: no furnace test)",
@@ -311,12 +360,12 @@ void add_energy_command(CLI::App& app) {
   CLI::App* cmd = app.add_subcommand(
       "energy", "Energy per lobe and in total over theta_i: simulation ledger vs models (white furnace)");
   cmd->add_option("input", o->input, "Result file (.h5) or YAML config (models only unless --run)")->required();
-  cmd->add_option("--models", o->models,
-                  "Comma-separated model specs NAME[:KEY=VALUE...] (default: deon2011, marschner2003, "
-                  "marschner2003:longitudinal=two_theta_h)");
-  cmd->add_option("--set", o->settings, "Model parameter KEY=VALUE for every model (degrees); repeatable");
+  cmd->add_option("--models", o->models, energy_models_help());
+  cmd->add_option("--set", o->settings,
+                  "Model parameter KEY=VALUE for every model that has KEY (degrees); repeatable");
   cmd->add_option("--beta-sweep", o->beta_sweep,
-                  "Evaluate each model at these beta_long (degrees, every lobe), as in d'Eon 2011 Fig. 3");
+                  "Evaluate each model that has beta_long at these beta_long (degrees, every lobe), as in "
+                  "d'Eon 2011 Fig. 3");
   cmd->add_option("--theta-i", o->theta_i, "Config only: model theta_i, degrees A,B,C or FROM:TO:STEP");
   cmd->add_flag("--run", o->run, "Config only: run the simulation too (in memory)");
   CLI::Option* photons = cmd->add_option("--photons", o->photons, "With --run: photons per incident direction");

@@ -14,7 +14,7 @@ void add_models_command(CLI::App& app) {
   auto markdown = std::make_shared<bool>(false);
   CLI::App* cmd = app.add_subcommand(
       "models", "List the analytic models and each one's --set keys (meaning, unit, default, range)");
-  cmd->add_flag("--markdown", *markdown, "Markdown tables (the README's section)");
+  cmd->add_flag("--markdown", *markdown, "Markdown tables (docs/MODELS.md)");
   cmd->callback([markdown] { fmt::print("{}", analytic::models_listing(*markdown)); });
 }
 

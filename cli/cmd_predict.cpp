@@ -2,6 +2,7 @@
 // an analytic model's bin probabilities for the histogram a simulation with
 // this configuration produces (SPEC section 7), in the same layout.
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 #include <hdf5.h>
 
 #include <cmath>
@@ -92,7 +93,8 @@ void add_predict_command(CLI::App& app) {
       "predict", "Bin probabilities of an analytic model for a config or a result's config");
   cmd->add_option("input", o->input, "Config (.yaml) or result (.h5)")->required();
   cmd->add_option("--model", o->model,
-                  "exact | deon2011 | marschner2003 (optionally NAME:KEY=VALUE:...); keys: `fiberlab models`")
+                  fmt::format("{} (optionally NAME:KEY=VALUE:...); keys: `fiberlab models`",
+                              fmt::join(analytic::model_names(), " | ")))
       ->required();
   cmd->add_option("--set", o->settings,
                   "KEY=VALUE parameter of the model (repeatable; angles in degrees; `fiberlab models` lists "

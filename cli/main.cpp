@@ -15,8 +15,9 @@
 int main(int argc, char** argv) {
   fiberlab::tune_allocator();
   fiberlab::h5::prepare_hdf5();
-  CLI::App app{"fiberlab " FIBERLAB_VERSION
-               ": Monte Carlo ground truth for light scattering by single fibers"};
+  // Named, so that usage lines say `fiberlab`, not the path it was started by.
+  CLI::App app{"fiberlab " FIBERLAB_VERSION ": Monte Carlo ground truth for light scattering by single fibers",
+               "fiberlab"};
   app.set_version_flag("--version", std::string(FIBERLAB_VERSION));
   app.require_subcommand(1);
   fiberlab::cli::add_run_command(app);

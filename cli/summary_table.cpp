@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/estimate_text.h"
 #include "common/units.h"
 
 namespace fiberlab::cli {
@@ -32,7 +33,7 @@ void print_summary(std::FILE* out, const sim::ResultFile& r) {
       fmt::print(out, "  {:<10}", lobe_name(l, r.lobes));
       for (int c = 0; c < r.channels; ++c) {
         const sim::Estimate e = sim::lobe_energy(r, k, l, c);
-        fmt::print(out, " {:>24}", fmt::format("{:.6f} +- {:.6f}", e.mean, e.std_error));
+        fmt::print(out, " {:>24}", estimate_text(e.mean, e.std_error));
       }
       fmt::print(out, "\n");
     }

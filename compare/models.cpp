@@ -85,9 +85,13 @@ std::string model_header(const ModelSpec& spec, const analytic::ModelParams& par
 
 std::string params_json(const std::string& model_name, const analytic::ModelParams& params) {
   std::string s;
-  for (const analytic::ParamSpec& spec : analytic::model_info(model_name).params)
+  for (const analytic::ParamSpec& spec : analytic::model_info(model_name).params) {
+    // "choice" and "integer" say what kind of value it is, not a unit: a reader
+    // prints "absorption = published", not "published choice".
+    const bool has_unit = spec.unit != "choice" && spec.unit != "integer";
     s += fmt::format("{}{}: {{\"value\": {}, \"unit\": {}}}", s.empty() ? "" : ", ", json_string(spec.key),
-                     json_string(spec.show(params)), json_string(spec.unit));
+                     json_string(spec.show(params)), json_string(has_unit ? spec.unit : ""));
+  }
   return "{" + s + "}";
 }
 

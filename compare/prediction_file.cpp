@@ -20,7 +20,8 @@ constexpr double kAngleTolerance = 1e-9;  // radians: edges and directions writt
 
 void require(const h5::File& f, const std::string& name) {
   if (!f.exists(name))
-    throw Error(fmt::format("{}: prediction file without {} (see README, \"Prediction files\")", f.path(), name));
+    throw Error(fmt::format("{}: prediction file without {} (see docs/FILE_FORMAT.md, fiber-prediction)", f.path(),
+                            name));
 }
 
 bool same_angle(double a, double b) {

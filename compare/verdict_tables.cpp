@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "common/estimate_text.h"
 #include "common/units.h"
 #include "compare/report.h"
 
@@ -35,7 +36,7 @@ std::string verdict_table(const Verdict& v, int lobes) {
         "{:7.2f} {:>7} {:>5} {:>2} {:>21} {:10.6f} {:7.1f} {:10.3f} {:5d} {:8.3f} {:8.3f} {:6.3f} {:8.3f} "
         "{:8.3f} {:8.3f}  {}\n",
         rad_to_deg(r.theta_i), phi_text(r.phi_i), lobe_name(r.lobe, lobes), r.channel,
-        fmt::format("{:.6f} +- {:.6f}", r.sim_energy, r.sim_error), r.model_energy, r.energy_z,
+        estimate_text(r.sim_energy, r.sim_error), r.model_energy, r.energy_z,
         r.bins.per_dof(), r.bins.dof, r.theta_marginal.per_dof(), r.phi_marginal.per_dof(), r.l1,
         rad_to_deg(r.centroid_sim), rad_to_deg(r.centroid_model), rad_to_deg(r.measured_shift),
         verdict_word(v, i));
@@ -97,10 +98,10 @@ std::string verdict_markdown(const Verdict& v, int lobes) {
       "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (std::size_t i = 0; i < v.rows.size(); ++i) {
     const auto& r = v.rows[i];
-    md += fmt::format("| {:.2f} | {} | {} | {} | {:.5f} +- {:.5f} | {:.5f} | {:.3f} ({}) | {:.3f} | {:.3f} | "
+    md += fmt::format("| {:.2f} | {} | {} | {} | {} | {:.5f} | {:.3f} ({}) | {:.3f} | {:.3f} | "
                       "{:.3f} | {:.2f} / {:.2f} | {:.2f} | {} |\n",
                       rad_to_deg(r.theta_i), phi_text(r.phi_i), lobe_name(r.lobe, lobes), r.channel,
-                      r.sim_energy, r.sim_error, r.model_energy, r.bins.per_dof(), r.bins.dof,
+                      estimate_text(r.sim_energy, r.sim_error, 5), r.model_energy, r.bins.per_dof(), r.bins.dof,
                       r.theta_marginal.per_dof(), r.phi_marginal.per_dof(), r.l1, rad_to_deg(r.centroid_sim),
                       rad_to_deg(r.centroid_model), rad_to_deg(r.measured_shift),
                       !r.judged ? "not judged" : (v.accepted[i] ? "ok" : "rejected"));

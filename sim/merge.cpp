@@ -51,8 +51,8 @@ struct Direction {
 
 std::string describe(const Direction& d) {
   return std::isnan(d.phi_i)
-             ? fmt::format("theta_i = {} deg, phi_i uniform", rad_to_deg(d.theta_i))
-             : fmt::format("theta_i = {} deg, phi_i = {} deg", rad_to_deg(d.theta_i),
+             ? fmt::format("theta_i = {:.10g} deg, phi_i uniform", rad_to_deg(d.theta_i))
+             : fmt::format("theta_i = {:.10g} deg, phi_i = {:.10g} deg", rad_to_deg(d.theta_i),
                            rad_to_deg(d.phi_i));
 }
 
