@@ -130,10 +130,10 @@ std::vector<std::string> split_commas(const std::string& s) {
 // theta_i: see energy_models_help).
 std::string energy_models_help() {
   return fmt::format(
-      "Comma-separated model specs NAME[:KEY=VALUE...] (default: every model, {}; a model that does not "
-      "apply to the fiber, such as a circular-only one on an ellipse, is listed and skipped; huang2022 "
-      "takes seconds per theta_i at its default quadrature_points, so a long sweep may want "
-      "huang2022:quadrature_points=262144 or leaving it out)",
+      "Comma-separated model specs NAME[:KEY=VALUE...] (default: every registered model: {}; a "
+      "model that does not apply to the fiber, such as a circular-only one on an ellipse, is listed and "
+      "skipped; huang2022 takes seconds per theta_i at its default quadrature_points, so a long sweep "
+      "may want huang2022:quadrature_points=262144 or leaving it out)",
       fmt::join(analytic::model_names(), ", "));
 }
 

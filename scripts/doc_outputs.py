@@ -166,7 +166,9 @@ def check_measured(path, text, problems):
 
 # Words that tell how the project was built rather than what it is: docs and
 # comments state what is true now (development history lives in git).
-HISTORY = re.compile(r"\b(sessions?|rounds? of work|the version before|previous build|issues? \d+)\b", re.I)
+HISTORY = re.compile(r"\b((first|second|third|\w+teenth|\w+tieth|fourth|fifth|sixth|seventh|eighth|ninth|tenth|"
+                     r"eleventh|twelfth|\d+(st|nd|rd|th)|this|previous|last|next) sessions?|session by session|"
+                     r"rounds? of work|the version before|previous build|issues? \d+)\b", re.I)
 HISTORY_ALLOWED = ('scope="session"',)  # pytest's fixture scope
 SOURCE_SUFFIXES = (".md", ".cpp", ".h", ".inc", ".py", ".sh", ".cmake", ".txt", ".yaml", ".ipynb")
 
