@@ -79,8 +79,6 @@ sim::ProgressCallback progress_printer(bool quiet) {
   };
 }
 
-const char* signal_name(int sig) { return sig == 2 ? "SIGINT" : sig == 15 ? "SIGTERM" : "a signal"; }
-
 // Every rank's setup (config or checkpoint, flags, output path): a failure on
 // any rank stops all, rank 0 saying why.
 struct Job {
