@@ -13,6 +13,7 @@ import re
 import shutil
 import subprocess
 import sys
+import sysconfig
 
 from setuptools import Extension, setup
 from setuptools.command.build_ext import build_ext
@@ -38,14 +39,21 @@ class CMakeBuild(build_ext):
         build_dir = os.path.abspath(os.environ.get("FIBERLAB_BUILD_DIR", os.path.join(HERE, "build")))
         built = self._built_extension(build_dir)
         if built is None or not os.environ.get("FIBERLAB_REUSE_BUILD"):
-            subprocess.check_call(["cmake", "-S", HERE, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release",
-                                   "-DPython_EXECUTABLE=" + sys.executable])
+            configure = ["cmake", "-S", HERE, "-B", build_dir, "-DCMAKE_BUILD_TYPE=Release"]
+            # A new build is made for this interpreter; an existing one keeps its
+            # own (a venv's python has the same extension suffix as the Python
+            # it was made from, which is all that must match: checked below).
+            if not os.path.exists(os.path.join(build_dir, "CMakeCache.txt")):
+                configure.append("-DPython_EXECUTABLE=" + sys.executable)
+            subprocess.check_call(configure)
             jobs = os.environ.get("CMAKE_BUILD_PARALLEL_LEVEL", str(os.cpu_count() or 1))
             subprocess.check_call(["cmake", "--build", build_dir, "--target", "_fiberlab", "-j", jobs])
             built = self._built_extension(build_dir)
         if built is None:
-            raise RuntimeError("CMake built no _fiberlab extension in %s/python/fiberlab (pybind11-dev and "
-                               "python3-dev missing? see scripts/setup.sh)" % build_dir)
+            raise RuntimeError("no _fiberlab%s in %s/python/fiberlab: pybind11-dev or python3-dev missing "
+                               "(scripts/setup.sh), or that build is for another Python (set "
+                               "FIBERLAB_BUILD_DIR to a new folder)"
+                               % (sysconfig.get_config_var("EXT_SUFFIX"), build_dir))
         target = self.get_ext_fullpath(ext.name)
         os.makedirs(os.path.dirname(target), exist_ok=True)
         shutil.copyfile(built, target)
@@ -53,7 +61,7 @@ class CMakeBuild(build_ext):
     @staticmethod
     def _built_extension(build_dir):
         folder = os.path.join(build_dir, "python", "fiberlab")
-        suffix = __import__("sysconfig").get_config_var("EXT_SUFFIX")
+        suffix = sysconfig.get_config_var("EXT_SUFFIX")
         path = os.path.join(folder, "_fiberlab" + suffix)
         return path if os.path.exists(path) else None
 

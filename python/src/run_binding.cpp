@@ -64,6 +64,7 @@ class ProgressRelay {
 // the main one), SIGINT still raises KeyboardInterrupt and other signals a
 // fiberlab.Error: the run was cut short and has no result.
 [[noreturn]] void raise_interrupted(int sig) {
+  if (sig == 0) throw Error("run interrupted; nothing was kept");
   std::raise(sig);
   if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   if (sig == SIGINT) {
@@ -84,7 +85,8 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
   if (threads <= 0) threads = std::min(omp_get_max_threads(), sim::kMaxThreads);
   ProgressRelay relay(std::move(progress));
   std::shared_ptr<sim::ResultFile> result;
-  int interrupted_by = 0;
+  bool interrupted = false;
+  int received = 0;  // a signal that came during the call, even after the last photon
   {
     py::gil_scoped_release release;
     const sim::Simulation simulation(settings);
@@ -93,17 +95,20 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
     sim::RunControl control;
     control.threads = threads;
     control.progress = relay.callback();
-    sim::RunOutcome outcome;
     {
       ScopedInterruptPolling polling;
-      outcome = simulation.run(state, control);
-      interrupted_by = outcome == sim::RunOutcome::Interrupted ? polling.received_signal() : 0;
+      interrupted = simulation.run(state, control) == sim::RunOutcome::Interrupted;
+      received = polling.received_signal();
     }
-    if (!interrupted_by)
+    if (!interrupted)
       result = std::make_shared<sim::ResultFile>(
           sim::make_result(simulation.settings(), simulation.grid(), state.tallies));
   }
-  if (interrupted_by) raise_interrupted(interrupted_by);
+  if (interrupted) raise_interrupted(received);
+  if (received != 0) {  // the run was complete: Python's handler decides, as after any call
+    std::raise(received);
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }
   relay.rethrow();
   return result;
 }

@@ -87,3 +87,20 @@ def test_bad_fit_keys_are_refused(blur_result, keys, word):
 def test_fit_refuses_a_non_result(blur_fit):
     with pytest.raises(fiberlab.Error, match="Result"):
         fiberlab.fit(blur_fit, "deon2011", ["beta_long"])
+
+
+def test_progress_gets_the_commands_lines_and_an_exception_in_it_stops_the_fit(blur_result):
+    """An exception in progress (as a KeyboardInterrupt from Ctrl-C, which is
+    checked at the same point of every iteration) ends the fit with it."""
+    lines = []
+    fiberlab.fit(blur_result, "deon2011", ["beta_long"], beta_long=9, progress=lines.append, **SWITCHES)
+    assert lines and all(isinstance(line, str) for line in lines)
+
+    class Stop(Exception):
+        pass
+
+    def stop(line):
+        raise Stop(line)
+
+    with pytest.raises(Stop):
+        fiberlab.fit(blur_result, "deon2011", ["beta_long"], beta_long=9, progress=stop, **SWITCHES)
