@@ -74,6 +74,7 @@ def test_sigint_stops_a_run_within_two_seconds_with_keyboard_interrupt(tmp_path)
         # No handler of fiberlab is left: the mask is the one before import.
         say("caught", caught() == CAUGHT_AT_START)
         try:
+            say("sleeping")
             time.sleep(60)
         except KeyboardInterrupt:
             say("KeyboardInterrupt again")
@@ -85,6 +86,7 @@ def test_sigint_stops_a_run_within_two_seconds_with_keyboard_interrupt(tmp_path)
     wait_for(child, "KeyboardInterrupt")
     assert time.monotonic() - sent < 2.0
     assert wait_for(child, "caught")[-1] == "caught True"
+    wait_for(child, "sleeping")
     child.send_signal(signal.SIGINT)
     wait_for(child, "KeyboardInterrupt again")
     assert child.wait(timeout=30) == 0
@@ -96,8 +98,8 @@ def test_sigint_after_save_and_load_is_a_keyboard_interrupt_not_exit_130(tmp_pat
         r = fiberlab.run(BIG, photons=2000, seed=1, progress=False)
         r.save("r.h5")
         fiberlab.load("r.h5")
-        say("saved", caught() == CAUGHT_AT_START)
         try:
+            say("saved", caught() == CAUGHT_AT_START)
             time.sleep(60)
         except KeyboardInterrupt:
             say("KeyboardInterrupt")
