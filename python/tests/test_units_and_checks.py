@@ -166,3 +166,14 @@ def test_to_xarray_has_named_dimensions_degrees_and_units(smooth_result):
     p = exact_prediction(smooth_result).to_xarray()
     assert p["probability"].dims == ds["mean"].dims
     np.testing.assert_array_equal(p["theta_r"].values, ds["theta_r"].values)
+
+
+def test_the_extension_itself_refuses_nul_bytes(smooth_result, tmp_path):
+    """The compiled layer checks too (a caller of fiberlab._fiberlab)."""
+    from fiberlab import _fiberlab
+    path = str(tmp_path / "r.h5")
+    smooth_result.save(path)
+    for call in (lambda: _fiberlab.read_result(path + "\0x"), lambda: _fiberlab.load_settings(path + "\0x"),
+                 lambda: smooth_result._file.save(path + "\0x")):
+        with pytest.raises(fiberlab.Error, match="NUL"):
+            call()
