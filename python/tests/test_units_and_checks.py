@@ -10,15 +10,26 @@ import fiberlab
 from conftest import SMOOTH_ABSORBING, exact_prediction
 
 
+# A rough, tilted fiber: every model's angles (widths, tilt shifts) are well
+# away from their floors, so a unit slip (radians read as degrees) shows.
+ROUGH_TILTED = {"fiber": {"eta": 1.55, "sigma_a": 0.4, "scale_tilt": 3},
+                "roughness": {"model": "ggx", "alpha": [0.2, 0.2]},
+                "source": {"theta_i": [30], "phi_i": 0}, "tally": {"n_theta": 18, "n_phi": 24, "lobes": 3}}
+
+
 @pytest.mark.parametrize("model", fiberlab.model_names())
-def test_predict_with_a_predictions_own_params_reproduces_it(smooth_result, model):
+@pytest.mark.parametrize("fiber", ["smooth", "rough"])
+def test_predict_with_a_predictions_own_params_reproduces_it(smooth_result, model, fiber):
     """Prediction.params are in predict()'s units (degrees, ints), so feeding
     them back gives the same prediction: for every model."""
-    p = fiberlab.predict(smooth_result, model)
-    q = fiberlab.predict(smooth_result, model, **p.params)
-    assert q.params == p.params
-    # Degrees -> radians -> degrees may move an angle by an ulp.
-    np.testing.assert_allclose(q.probability, p.probability, rtol=1e-12, atol=1e-300)
+    source = smooth_result if fiber == "smooth" else ROUGH_TILTED
+    p = fiberlab.predict(source, model)
+    q = fiberlab.predict(source, model, **p.params)
+    assert q.params == pytest.approx(p.params, rel=1e-12)
+    # Degrees -> radians -> degrees may move an angle by an ulp, which moves
+    # a bin's quadrature by ~1e-18 (of a total probability 1); a unit slip
+    # moves the lobes by percents.
+    np.testing.assert_allclose(q.probability, p.probability, rtol=1e-9, atol=1e-15)
     for key, value in p.params.items():
         assert not isinstance(value, float) or math.isfinite(value), key
 
@@ -34,6 +45,10 @@ def test_angles_are_degrees_and_integers_are_ints(smooth_result):
     np.testing.assert_allclose(d.theta_edges, r.theta_edges)
     # Prediction and Result compute the same solid angles from degrees.
     np.testing.assert_allclose(d.solid_angle, r.solid_angle, rtol=1e-12)
+    # The tilt shifts of SPEC s7 (R -2a, TT +a, TRT +4a) of a 3 deg scale tilt, in degrees.
+    rough = fiberlab.predict(ROUGH_TILTED, "deon2011")
+    np.testing.assert_allclose(rough.params["alpha"][:3], [-6, 3, 12], rtol=1e-12)
+    np.testing.assert_allclose(rough.alpha[:3], [-6, 3, 12], rtol=1e-12)
 
 
 def test_counts_accept_integral_floats_as_configs_do():
