@@ -207,7 +207,7 @@ def run(config, photons=None, seed=None, threads=None, progress=True):
     False, or a callable(done, total). Returns a Result (not written to
     disk: save() it).
 
-    Ctrl-C (SIGINT) stops the run within a fraction of a second and raises
+    Ctrl-C (SIGINT) stops the run within about a second and raises
     KeyboardInterrupt; nothing is kept.
     """
     settings = to_settings(config)
