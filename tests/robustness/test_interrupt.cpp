@@ -157,6 +157,14 @@ TEST(Interrupt, GuardInAHostProgramInstallsNothing) {
   EXPECT_EQ(WEXITSTATUS(status), 0);
 }
 
+// Whether process `pid` has a handler for `sig` (/proc/PID/status, SigCgt).
+bool catches(pid_t pid, int sig) {
+  std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+  for (std::string line; std::getline(status, line);)
+    if (line.rfind("SigCgt:", 0) == 0) return (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1;
+  return false;
+}
+
 // `fiberlab run` stopped by SIGHUP (a closed terminal) saves its checkpoint
 // and exits with 128 + SIGHUP, as for SIGTERM and SIGINT; no output, no
 // temporary file.
@@ -173,7 +181,11 @@ TEST(Interrupt, RunCheckpointsOnHangUp) {
           static_cast<char*>(nullptr));
     _exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  // Signal once the run has its handler (a slow start, e.g. under a
+  // sanitizer, must not meet SIGHUP's default action instead).
+  for (int i = 0; i < 3000 && !catches(pid, SIGHUP); ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  std::this_thread::sleep_for(std::chrono::milliseconds(300));
   kill(pid, SIGHUP);
   int status = 0;
   ASSERT_EQ(waitpid(pid, &status, 0), pid);
