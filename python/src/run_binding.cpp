@@ -88,21 +88,22 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
   bool interrupted = false;
   int received = 0;  // a signal that came during the call, even after the last photon
   {
+    // Everything without the GIL is inside the scope: a signal while the
+    // tracers are set up or the result is assembled is not left to a Python
+    // handler that cannot run before the call returns.
     py::gil_scoped_release release;
+    ScopedInterruptPolling polling;
     const sim::Simulation simulation(settings);
     sim::check_memory_budget(simulation.settings(), threads);
     sim::RunProgress state = simulation.start();
     sim::RunControl control;
     control.threads = threads;
     control.progress = relay.callback();
-    {
-      ScopedInterruptPolling polling;
-      interrupted = simulation.run(state, control) == sim::RunOutcome::Interrupted;
-      received = polling.received_signal();
-    }
+    interrupted = simulation.run(state, control) == sim::RunOutcome::Interrupted;
     if (!interrupted)
       result = std::make_shared<sim::ResultFile>(
           sim::make_result(simulation.settings(), simulation.grid(), state.tallies));
+    received = polling.received_signal();
   }
   if (interrupted) raise_interrupted(received);
   if (received != 0) {  // the run was complete: Python's handler decides, as after any call
