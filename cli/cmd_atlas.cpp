@@ -55,8 +55,6 @@ void check_report_dir(const std::string& dir) {
     throw Error(fmt::format("--report {}: its parent folder {} does not exist", dir, parent.string()));
 }
 
-const char* signal_name(int sig) { return sig == 2 ? "SIGINT" : sig == 15 ? "SIGTERM" : "a signal"; }
-
 // What one invocation runs: a new atlas, or the rest of a checkpoint's.
 struct AtlasJob {
   compare::AtlasRunSetup setup;

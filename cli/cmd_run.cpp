@@ -79,8 +79,6 @@ sim::ProgressCallback progress_printer(bool quiet) {
   };
 }
 
-const char* signal_name(int sig) { return sig == 2 ? "SIGINT" : sig == 15 ? "SIGTERM" : "a signal"; }
-
 // Every rank's setup (config or checkpoint, flags, output path): a failure on
 // any rank stops all, rank 0 saying why.
 struct Job {
@@ -243,7 +241,7 @@ void add_run_command(CLI::App& app) {
                   fmt::format("OpenMP threads per process, 1 to {} (default: all cores)", sim::kMaxThreads));
   cmd->add_option("--checkpoint-every", o->checkpoint_every,
                   "Seconds between checkpoints OUT.checkpoint.h5 (default 300; one is also "
-                  "written on SIGINT/SIGTERM)");
+                  "written on SIGINT/SIGTERM/SIGHUP)");
   cmd->add_option("--resume", o->resume, "Finish the run saved in this checkpoint");
   cmd->add_option("--target-error", o->target_error,
                   "Stop each incident direction once every lobe energy's relative standard "

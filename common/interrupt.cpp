@@ -33,6 +33,19 @@ volatile std::sig_atomic_t g_signal = 0;          // the first signal received
 volatile std::sig_atomic_t g_polling = 0;         // install_interrupt_handlers() was called
 std::atomic<int> g_guards_alive{0};
 std::once_flag g_installed;
+std::atomic<bool> g_host_owns_signals{false};     // leave_signals_to_host() was called
+
+// The signals that stop fiberlab: interrupt, terminate, and a hang-up (a
+// closed terminal or ssh session), which the command treats as SIGTERM.
+constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
+constexpr int kSignalCount = sizeof(kSignals) / sizeof(kSignals[0]);
+
+// ScopedInterruptPolling: how many scopes are alive, and the dispositions
+// the first one replaced (put back by the last).
+std::mutex g_scope_mutex;
+int g_scopes = 0;
+struct sigaction g_previous[kSignalCount];
+bool g_replaced[kSignalCount] = {};
 
 static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
 
@@ -52,18 +65,28 @@ extern "C" void on_interrupt(int sig) {
   _exit(128 + sig);
 }
 
+// In a host program: record the first signal, nothing else (the host's own
+// handler gets it once the scope has put it back).
+extern "C" void on_interrupt_in_host(int sig) {
+  if (g_signal == 0) g_signal = sig;
+}
+
+bool ignored(const struct sigaction& sa) {
+  return !(sa.sa_flags & SA_SIGINFO) && sa.sa_handler == SIG_IGN;
+}
+
 void install_handlers_once() {
   std::call_once(g_installed, [] {
     struct sigaction sa {};
     sa.sa_handler = on_interrupt;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESTART;
-    for (int sig : {SIGINT, SIGTERM}) {
+    for (int sig : kSignals) {
       struct sigaction old {};
       sigaction(sig, nullptr, &old);
       // A signal ignored by the parent (e.g. a background job of a
       // non-interactive shell) stays ignored, as the shell intended.
-      if (old.sa_handler == SIG_IGN) continue;
+      if (ignored(old)) continue;
       sigaction(sig, &sa, nullptr);
     }
   });
@@ -80,10 +103,47 @@ bool interrupt_requested() { return g_signal != 0; }
 
 int interrupt_signal() { return static_cast<int>(g_signal); }
 
+const char* signal_name(int sig) {
+  switch (sig) {
+    case SIGINT: return "SIGINT";
+    case SIGTERM: return "SIGTERM";
+    case SIGHUP: return "SIGHUP";
+    default: return "a signal";
+  }
+}
+
+void leave_signals_to_host() { g_host_owns_signals = true; }
+
+ScopedInterruptPolling::ScopedInterruptPolling() {
+  std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (g_scopes++ > 0) return;
+  g_signal = 0;
+  struct sigaction sa {};
+  sa.sa_handler = on_interrupt_in_host;
+  sigemptyset(&sa.sa_mask);
+  sa.sa_flags = SA_RESTART;
+  for (int i = 0; i < kSignalCount; ++i) {
+    sigaction(kSignals[i], nullptr, &g_previous[i]);
+    // An ignored signal stays ignored, as whoever ignored it intended.
+    g_replaced[i] = !ignored(g_previous[i]);
+    if (g_replaced[i]) sigaction(kSignals[i], &sa, nullptr);
+  }
+}
+
+ScopedInterruptPolling::~ScopedInterruptPolling() {
+  std::lock_guard<std::mutex> lock(g_scope_mutex);
+  if (--g_scopes > 0) return;
+  for (int i = 0; i < kSignalCount; ++i)
+    if (g_replaced[i]) sigaction(kSignals[i], &g_previous[i], nullptr);
+  g_signal = 0;  // received_signal() was read before; the next scope starts clear
+}
+
+int ScopedInterruptPolling::received_signal() const { return static_cast<int>(g_signal); }
+
 TempFileGuard::TempFileGuard(std::string path) {
   if (path.size() + 1 > kPathBytes)
     throw Error(fmt::format("{}: temporary file path is longer than {} bytes", path, kPathBytes - 1));
-  install_handlers_once();
+  if (!g_host_owns_signals) install_handlers_once();
   std::lock_guard<std::mutex> lock(g_slots_mutex);
   for (int i = 0; i < kSlots; ++i) {
     if (g_slot_used[i].load()) continue;

@@ -31,7 +31,7 @@ CONFIG = {
 def main(out_dir):
     result = fiberlab.run(CONFIG, photons=200_000, seed=1)
     print(result)
-    for k, theta_i in enumerate(np.degrees(result.theta_i)):
+    for k, theta_i in enumerate(result.theta_i):  # degrees
         energies = ", ".join("%s %.4f +- %.4f" % (name, result.energy.mean[k, l, 0], result.energy.std_err[k, l, 0])
                              for l, name in enumerate(result.lobe_names))
         print("theta_i %4.0f deg, channel %s: %s" % (theta_i, result.channel_names[0], energies))
@@ -43,37 +43,37 @@ def main(out_dir):
     comparison = fiberlab.compare(result, prediction)
     table = comparison.table
     columns = ["theta_i_deg", "lobe_name", "channel", "sim_energy", "model_energy", "chi2_per_dof", "dof",
-               "accepted"]
+               "verdict"]
     print(table[columns].to_string() if hasattr(table, "to_string") else table)
     print(comparison)
 
     # theta_r marginal (log y, model as steps) and phi marginal per lobe, channel 0, first theta_i.
     k, c = 0, 0
     m = result.marginals
-    width_t, width_p = np.degrees(np.diff(result.theta_edges)), np.degrees(np.diff(result.phi_edges))
-    model_theta = prediction.probability.sum(axis=3)  # (K, L, n_theta, C)
-    model_phi = prediction.probability.sum(axis=2)    # (K, L, n_phi, C)
-    centres_t = np.degrees(0.5 * (result.theta_edges[1:] + result.theta_edges[:-1]))
-    centres_p = np.degrees(0.5 * (result.phi_edges[1:] + result.phi_edges[:-1]))
+    width_t, width_p = np.diff(result.theta_edges), np.diff(result.phi_edges)  # degrees
+    model_theta = prediction.marginals.theta  # (K, L, n_theta, C)
+    model_phi = prediction.marginals.phi      # (K, L, n_phi, C)
+    centres_t = 0.5 * (result.theta_edges[1:] + result.theta_edges[:-1])
+    centres_p = 0.5 * (result.phi_edges[1:] + result.phi_edges[:-1])
     fig, axes = plt.subplots(2, len(result.lobe_names), figsize=(14, 6), dpi=80)
     for l, name in enumerate(result.lobe_names):
         ax = axes[0, l]
         ax.errorbar(centres_t, m.theta[k, l, :, c] / width_t, m.theta_std_err[k, l, :, c] / width_t,
                     fmt=".", ms=3, label="simulation")
-        ax.stairs(model_theta[k, l, :, c] / width_t, np.degrees(result.theta_edges), label="deon2011")
+        ax.stairs(model_theta[k, l, :, c] / width_t, result.theta_edges, label="deon2011")
         ax.set_yscale("log")
         ax.set_ylim(bottom=1e-6 * max(model_theta[k, l, :, c].max() / width_t.min(), 1e-300))
         ax.set_title("%s: theta_r marginal" % name)
         ax.set_xlabel("theta_r (deg)")
         ax = axes[1, l]
         ax.errorbar(centres_p, m.phi[k, l, :, c] / width_p, m.phi_std_err[k, l, :, c] / width_p, fmt=".", ms=3)
-        ax.stairs(model_phi[k, l, :, c] / width_p, np.degrees(result.phi_edges))
+        ax.stairs(model_phi[k, l, :, c] / width_p, result.phi_edges)
         ax.set_title("%s: phi marginal" % name)
         ax.set_xlabel("phi (deg)")
     axes[0, 0].set_ylabel("probability per degree")
     axes[1, 0].set_ylabel("probability per degree")
     axes[0, 0].legend(fontsize=8)
-    fig.suptitle("theta_i = %.0f deg, channel %s" % (np.degrees(result.theta_i[k]), result.channel_names[c]))
+    fig.suptitle("theta_i = %.0f deg, channel %s" % (result.theta_i[k], result.channel_names[c]))
     fig.tight_layout()
     path = os.path.join(out_dir, "quickstart_marginals.png")
     fig.savefig(path)

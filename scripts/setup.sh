@@ -10,6 +10,8 @@ packages=(
   googletest libgtest-dev libbenchmark-dev libboost-dev libboost-math-dev
   python3 python3-dev python3-h5py python3-numpy python3-matplotlib
   pybind11-dev python3-pybind11 python3-pytest python3-pandas
+  python3-xarray python3-nbclient python3-nbformat python3-ipykernel
+  python3-setuptools python3-pip python3-venv
   libopenmpi-dev openmpi-bin
 )
 missing=()

@@ -9,22 +9,25 @@ compare the two, and read or write fiberlab's HDF5 files.
     pred = fiberlab.predict(result, "exact")
     cmp = fiberlab.compare(result, pred)
     cmp.accepted, cmp.table            # verdict, one row per (theta_i, phi_i, lobe, channel)
+    fit = fiberlab.fit(result, "deon2011", ["beta_long"])
 
 Every array is in the result file's index order (K incident directions, L
-lobes, n_theta, n_phi, C channels); angles in radians (keyword parameters of
-predict in degrees, as `fiberlab predict --set`). The numbers come from the
+lobes, n_theta, n_phi, C channels); every angle a user passes or reads is in
+degrees (as `fiberlab predict --set` and configs). The numbers come from the
 C++ library (the same code as the `fiberlab` command); this package only
-arranges them. Errors in configs, files or parameters raise fiberlab.Error
-(a ValueError) with the command line's one-line message.
+arranges them. Bad arguments, configs, files or parameters raise
+fiberlab.Error (a ValueError) with a one-line message. The user guide is
+docs/PYTHON.md.
 """
 from ._fiberlab import Error, software_version
 from .comparison import Comparison, compare
+from .fit import Fit, fit
 from .prediction import Prediction, predict
 from .result import LobeEnergy, Marginals, Result, load, run
 
 __version__ = software_version
-__all__ = ["Error", "Result", "LobeEnergy", "Marginals", "Prediction", "Comparison",
-           "run", "load", "predict", "compare", "model_names", "__version__"]
+__all__ = ["Error", "Result", "LobeEnergy", "Marginals", "Prediction", "Comparison", "Fit",
+           "run", "load", "predict", "compare", "fit", "model_names", "__version__"]
 
 
 def model_names():

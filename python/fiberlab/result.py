@@ -3,15 +3,17 @@
 The estimators are those of SPEC section 6, computed by the C++ library
 (sim::bin_estimate, sim::lobe_energy): P_b = S1_b / N, its standard error
 sqrt((S2_b/N - P_b^2)/(N - 1)), and the density P_b / Omega_b per steradian.
+Angles are in degrees (the files store radians; docs/FILE_FORMAT.md).
 """
 import dataclasses
 import functools
-import os
 
 import numpy as np
 
 from . import _fiberlab
+from ._checks import count_argument, path_argument
 from ._config import to_settings
+from .labelled import to_xarray
 from .progress import ProgressLine
 
 
@@ -49,7 +51,7 @@ class Result:
     Arrays are NumPy, index order (K, L, n_theta, n_phi, C): K incident
     directions (theta_i, phi_i), L lobes (lobe_names), theta_r bins
     (theta_edges), relative-azimuth bins (phi_edges), C colour channels.
-    Angles in radians.
+    Angles in degrees.
     """
 
     def __init__(self, file):
@@ -78,13 +80,13 @@ class Result:
 
     @functools.cached_property
     def theta_edges(self):
-        """theta_r bin edges (n_theta + 1), radians in [-pi/2, pi/2]."""
-        return self._file.theta_edges
+        """theta_r bin edges (n_theta + 1), degrees in [-90, 90]."""
+        return np.degrees(self._file.theta_edges)
 
     @functools.cached_property
     def phi_edges(self):
-        """Relative azimuth phi_r - phi_i bin edges (n_phi + 1), radians in [-pi, pi]."""
-        return self._file.phi_edges
+        """Relative azimuth phi_r - phi_i bin edges (n_phi + 1), degrees in [-180, 180]."""
+        return np.degrees(self._file.phi_edges)
 
     @functools.cached_property
     def solid_angle(self):
@@ -93,13 +95,13 @@ class Result:
 
     @functools.cached_property
     def theta_i(self):
-        """(K,) incident inclinations, radians."""
-        return self._file.theta_i
+        """(K,) incident inclinations, degrees."""
+        return np.degrees(self._file.theta_i)
 
     @functools.cached_property
     def phi_i(self):
-        """(K,) incident azimuths, radians (NaN for a randomly rotated fiber)."""
-        return self._file.phi_i
+        """(K,) incident azimuths, degrees (NaN for a randomly rotated fiber)."""
+        return np.degrees(self._file.phi_i)
 
     @functools.cached_property
     def photons(self):
@@ -166,9 +168,25 @@ class Result:
         return Marginals(theta, theta_se, phi, phi_se)
 
     # --- files ------------------------------------------------------------------
+    def to_xarray(self):
+        """The estimators as an xarray.Dataset (Debian's python3-xarray):
+        variables mean, std_err, density, density_std_err over dimensions
+        (incidence, lobe, theta_r, phi, channel), coordinates theta_i, phi_i,
+        theta_r, phi (bin centres, degrees, with their edges as attributes),
+        lobe and channel names; the lobe energies as energy, energy_std_err."""
+        e = self.energy
+        return to_xarray(self, {"mean": (self.mean, "1", "probability of the bin, P = S1/N"),
+                                "std_err": (self.std_err, "1", "standard error of mean"),
+                                "density": (self.density, "sr^-1", "probability per steradian, P / Omega"),
+                                "density_std_err": (self.density_std_err, "sr^-1", "standard error of density")},
+                         {"energy": (e.mean, "1", "fraction of the launched weight in the lobe"),
+                          "energy_std_err": (e.std_err, "1", "standard error of energy")},
+                         {"photons": (self.photons, "1", "photons launched per incident direction")},
+                         "fiberlab simulation result")
+
     def save(self, path):
         """Writes the result file (SPEC s9; written to a temporary name, then renamed)."""
-        self._file.save(os.fspath(path))
+        self._file.save(path_argument("path", path))
 
     def __repr__(self):
         K, L, T, P, C = self.weight_sum.shape
@@ -177,31 +195,32 @@ class Result:
                                       ", ".join(str(int(n)) for n in np.unique(self.photons))))
 
 
-def _check_count(name, value, minimum):
-    if value is None:
-        return None
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
-        raise _fiberlab.Error("%s = %r is not an integer" % (name, value))
-    if value < minimum or value >= 2 ** 64:
-        raise _fiberlab.Error("%s = %d is out of range (must be an integer >= %d)" % (name, value, minimum))
-    return int(value)
+MAX_THREADS = 1024  # sim/memory_budget.h kMaxThreads, the cap of `fiberlab run --threads`
 
 
 def run(config, photons=None, seed=None, threads=None, progress=True):
     """Simulates a config: a YAML path, or a dict with the YAML's keys
     (degrees, as in the file; see configs/README.md). photons, seed override
-    the config's; threads defaults to every core (the tallies do not depend
-    on it). progress: True (a line on stderr after a second), False, or a
-    callable(done, total). Returns a Result (not written to disk: save() it).
+    the config's (integers; an integral float such as 1e6 is accepted, as
+    in configs); threads (1 to 1024) defaults to every core (the tallies do
+    not depend on it). progress: True (a line on stderr after a second),
+    False, or a callable(done, total). Returns a Result (not written to
+    disk: save() it).
+
+    Ctrl-C (SIGINT) stops the run within about a second and raises
+    KeyboardInterrupt; nothing is kept.
     """
     settings = to_settings(config)
-    photons = _check_count("photons", photons, 1)
-    seed = _check_count("seed", seed, 0)
-    threads = _check_count("threads", threads, 1) or 0
+    photons = count_argument("photons", photons, 1)
+    seed = count_argument("seed", seed, 0)
+    threads = count_argument("threads", threads, 1, MAX_THREADS) or 0
     if progress is True:
         progress = ProgressLine()
-    elif progress is False:
+    elif progress is False or progress is None:
         progress = None
+    elif not callable(progress):
+        raise _fiberlab.Error("progress must be True, False or a callable(done, total), not %s"
+                              % type(progress).__name__)
     return Result(_fiberlab.run(settings, photons, seed, threads, progress))
 
 
@@ -221,7 +240,7 @@ def load(path):
     """Reads a result file (format "fiber-histogram") as a Result, or a
     prediction file of `fiberlab predict` ("fiber-prediction") as a
     Prediction (docs/FILE_FORMAT.md)."""
-    path = os.fspath(path)
+    path = path_argument("path", path)
     if _file_format(path) == "fiber-prediction":
         from .prediction import load_prediction
         return load_prediction(path)

@@ -8,7 +8,13 @@
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
+#include "analytic/model.h"
+#include "compare/comparison.h"
+#include "compare/verdict.h"
+
 #include <cstddef>
+#include <optional>
+#include <string>
 #include <vector>
 
 namespace fiberlab::python {
@@ -23,9 +29,20 @@ py::array_t<T> to_array(const std::vector<T>& data, const std::vector<py::ssize_
   return a;
 }
 
+// A model's parameters as predict(**params) takes them (prediction_binding.cpp).
+py::dict params_dict(const std::string& model_name, const analytic::ModelParams& params);
+
+// The checks of `fiberlab compare`'s flags and the options they make; a
+// verdict as {"rows": [...], "judged", "rejected", "all_accepted",
+// "criterion"} (comparison_binding.cpp).
+compare::Options comparison_options(std::optional<double> max_chi2, double min_effective, double model_error,
+                                    double min_energy);
+py::dict verdict_dict(const compare::Verdict& v, int lobes);
+
 void bind_result(py::module_& m);      // result_binding.cpp: ResultFile, Settings, estimators, I/O
 void bind_run(py::module_& m);         // run_binding.cpp: the simulation
 void bind_prediction(py::module_& m);  // prediction_binding.cpp: analytic models' bin probabilities
-void bind_comparison(py::module_& m);  // comparison_binding.cpp: compare/'s statistics
+void bind_comparison(py::module_& m);  // comparison_binding.cpp: compare/'s statistics and verdict
+void bind_fit(py::module_& m);         // fit_binding.cpp: compare/fit.h, the fit of `fiberlab compare --fit`
 
 }  // namespace fiberlab::python

@@ -1,6 +1,6 @@
 // fiberlab.compare from Python: compare::compare() on a result and any bin
-// probabilities of the same shape (a model's or a researcher's own), and the
-// acceptance rule of `fiberlab compare`.
+// probabilities of the same shape (a model's or a researcher's own), judged
+// by compare::judge, the verdict of `fiberlab compare`.
 #include <pybind11/stl.h>
 
 #include <cmath>
@@ -18,14 +18,11 @@ namespace fiberlab::python {
 
 namespace {
 
-// The acceptance rule of `fiberlab compare` (compare/verdict.h).
-double acceptance_threshold(std::optional<double> max_chi2, int dof) {
-  return compare::acceptance_threshold(max_chi2 ? *max_chi2 : 0.0, dof);
-}
-
-// Rows keyed as in `fiberlab compare --report`'s metrics.json (angles in degrees).
-py::dict row(const compare::LobeComparison& r, int lobes, std::optional<double> max_chi2) {
-  const double limit = acceptance_threshold(max_chi2, r.bins.dof);
+// Row i of a verdict, keyed as in `fiberlab compare --report`'s metrics.json
+// (angles in degrees), with the verdict the CLI prints: "accepted",
+// "rejected" or "not judged" (accepted is true for judged, accepted lobes only).
+py::dict row(const compare::Verdict& v, std::size_t i, int lobes) {
+  const compare::LobeComparison& r = v.rows[i];
   py::dict d;
   d["k"] = r.k;
   d["theta_i_deg"] = rad_to_deg(r.theta_i);
@@ -56,14 +53,14 @@ py::dict row(const compare::LobeComparison& r, int lobes, std::optional<double> 
   d["alpha_model_deg"] = rad_to_deg(r.alpha_model);
   d["measured_shift_deg"] = rad_to_deg(r.measured_shift);
   d["judged"] = r.judged;
-  d["threshold"] = limit;
-  d["accepted"] = !r.judged || r.bins.per_dof() <= limit;
+  d["threshold"] = v.threshold[i];
+  d["accepted"] = r.judged && v.accepted[i];
+  d["verdict"] = !r.judged ? "not judged" : (v.accepted[i] ? "accepted" : "rejected");
   return d;
 }
 
-py::list compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c_style | py::array::forcecast> p,
-                      const std::vector<double>& alpha, std::optional<double> max_chi2, double min_effective,
-                      double model_error, double min_energy) {
+std::vector<std::vector<double>> bins_of(const sim::ResultFile& r,
+                                         py::array_t<double, py::array::c_style | py::array::forcecast> p) {
   const std::vector<py::ssize_t> want{static_cast<py::ssize_t>(r.configs()), r.lobes, r.grid.n_theta(),
                                       r.grid.n_phi(), r.channels};
   const std::vector<py::ssize_t> got(p.shape(), p.shape() + p.ndim());
@@ -76,35 +73,67 @@ py::list compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c
     throw Error("prediction probability has shape " + text(got) + ", the result's histogram " + text(want) +
                 " (K, lobes, n_theta, n_phi, channels)");
   }
-  if (max_chi2 && !(*max_chi2 > 0.0)) throw Error("max_chi2 must be > 0");
-  if (!(min_effective > 0.0)) throw Error("min_effective must be > 0");
   const double* data = p.data();
   for (py::ssize_t i = 0; i < p.size(); ++i)
     if (!std::isfinite(data[i])) throw Error("prediction probability holds a NaN or infinite value");
   std::vector<std::vector<double>> bins(r.configs());
   for (std::size_t k = 0; k < r.configs(); ++k)
     bins[k].assign(data + k * r.bin_cells(), data + (k + 1) * r.bin_cells());
+  return bins;
+}
+
+py::dict compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c_style | py::array::forcecast> p,
+                      const std::vector<double>& alpha, std::optional<double> max_chi2, double min_effective,
+                      double model_error, double min_energy) {
+  const std::vector<std::vector<double>> bins = bins_of(r, p);
+  const compare::Options o = comparison_options(max_chi2, min_effective, model_error, min_energy);
+  compare::Verdict v;
+  {
+    py::gil_scoped_release release;
+    v = compare::judge(compare::compare(r, bins, alpha.empty() ? std::vector<double>{0.0} : alpha, o),
+                       max_chi2 ? *max_chi2 : 0.0);
+  }
+  return verdict_dict(v, r.lobes);
+}
+
+}  // namespace
+
+// The checks of `fiberlab compare`'s flags (cli/cmd_compare.cpp), with
+// Python's keyword names.
+compare::Options comparison_options(std::optional<double> max_chi2, double min_effective, double model_error,
+                                    double min_energy) {
+  if (max_chi2 && !(*max_chi2 > 0.0 && std::isfinite(*max_chi2)))
+    throw Error("max_chi2 = " + std::to_string(*max_chi2) + ": must be a finite number > 0 (or None: 1 + 5 sqrt(2/dof))");
+  if (!(min_effective > 0.0 && std::isfinite(min_effective)))
+    throw Error("min_effective must be a finite number > 0");
+  if (!(model_error >= 0.0 && std::isfinite(model_error)))
+    throw Error("model_error must be a finite number >= 0 (a relative error)");
+  if (!(min_energy >= 0.0 && min_energy < 1.0))
+    throw Error("min_energy must be a number in [0, 1) (a fraction of the launched weight)");
   compare::Options o;
   o.min_effective = min_effective;
   o.model_rel_error = model_error;
   o.min_lobe_energy = min_energy;
-  std::vector<compare::LobeComparison> rows;
-  {
-    py::gil_scoped_release release;
-    rows = compare::compare(r, bins, alpha.empty() ? std::vector<double>{0.0} : alpha, o);
-  }
-  py::list out;
-  for (const auto& x : rows) out.append(row(x, r.lobes, max_chi2));
-  return out;
+  return o;
 }
 
-}  // namespace
+py::dict verdict_dict(const compare::Verdict& v, int lobes) {
+  py::list rows;
+  for (std::size_t i = 0; i < v.rows.size(); ++i) rows.append(row(v, i, lobes));
+  py::dict d;
+  d["rows"] = rows;
+  d["judged"] = v.judged;
+  d["rejected"] = v.rejected;
+  d["all_accepted"] = v.all_accepted;
+  d["criterion"] = v.criterion;
+  return d;
+}
 
 void bind_comparison(py::module_& m) {
   m.def("compare", &compare_bins, py::arg("result"), py::arg("probability"), py::arg("alpha"),
         py::arg("max_chi2") = py::none(), py::arg("min_effective") = 30.0, py::arg("model_error") = 1e-4,
         py::arg("min_energy") = 1e-4,
-        "One row per (k, lobe, channel): compare::compare's statistics and the verdict");
+        "compare::compare's statistics per (k, lobe, channel) and compare::judge's verdict");
   m.def("model_names", &analytic::model_names);
 }
 

@@ -55,6 +55,13 @@ py::object yaml_to_python(const YAML::Node& node) {
   }
 }
 
+// A path from Python: text with a NUL byte would be read by the C library
+// only up to the NUL (another file), so it is refused.
+std::string checked_path(const std::string& path) {
+  if (path.find('\0') != std::string::npos) throw Error("path contains a NUL byte");
+  return path;
+}
+
 // P = S1/N, its standard error, and P / Omega with its standard error, for
 // every bin (SPEC s6, sim::bin_estimate).
 py::tuple estimators(const Result& r) {
@@ -130,7 +137,8 @@ void bind_result(py::module_& m) {
       .def_property_readonly("melanin", [](const sim::Settings& s) { return s.fiber.eumelanin.has_value(); });
   m.def("parse_settings", &sim::parse_settings_yaml, py::arg("yaml_text"), py::arg("origin"),
         "Parses a YAML config (errors name `origin` and the field)");
-  m.def("load_settings", &sim::load_settings_or_result, py::arg("path"),
+  m.def("load_settings", [](const std::string& path) { return sim::load_settings_or_result(checked_path(path)); },
+        py::arg("path"),
         "The settings of a YAML config or of a result file's config_yaml");
 
   py::class_<Result, std::shared_ptr<Result>>(m, "ResultFile", "A result file's contents (sim/result_file.h)")
@@ -174,13 +182,15 @@ void bind_result(py::module_& m) {
       .def("marginal", &marginal, py::arg("axis"), "(mean, std_err) of the theta or phi marginal, (K, L, n, C)")
       .def("energy", &energy, "lobe energies with errors, absorbed and truncated fractions")
       .def("save", [](const Result& r, const std::string& path) {
+        const std::string target = checked_path(path);
         py::gil_scoped_release release;
-        sim::write_result(r, path);
+        sim::write_result(r, target);
       }, py::arg("path"), "Writes the result file (atomically)");
 
   m.def("read_result", [](const std::string& path) {
+    const std::string source = checked_path(path);
     py::gil_scoped_release release;
-    return std::make_shared<Result>(sim::read_result(path));
+    return std::make_shared<Result>(sim::read_result(source));
   }, py::arg("path"));
   m.def("lobe_names", &lobe_names, py::arg("lobes"), "R, TT, TRT, ..., p>=L-1 (common/file_schema.h)");
   m.def("channel_names", [](const sim::Settings& s) {

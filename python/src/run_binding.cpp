@@ -1,14 +1,27 @@
 // fiberlab.run from Python: sim::Simulation on resolved Settings, with the
 // GIL released while photons are traced and an optional Python progress
-// callable (called from the calling thread, which Simulation::run uses as
-// OpenMP's thread 0, every 250 ms).
+// callable (called about twice a second, sim/simulation.h).
+//
+// Signals (common/interrupt.h): while photons are traced, SIGINT, SIGTERM
+// and SIGHUP only set the flag the simulation polls (a ScopedInterruptPolling
+// replaces Python's handlers for the call and puts them back exactly), so
+// the run stops within a few hundredths of a second; the signal is then
+// re-delivered to Python's own handler (raise() after the restore), which
+// makes a SIGINT a KeyboardInterrupt as anywhere else in Python.
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
+#include <omp.h>
+
+#include <algorithm>
+#include <csignal>
 #include <memory>
 #include <optional>
 
 #include "bindings.h"
+#include "common/error.h"
+#include "common/interrupt.h"
+#include "sim/memory_budget.h"
 #include "sim/result_file.h"
 #include "sim/simulation.h"
 
@@ -44,18 +57,58 @@ class ProgressRelay {
   std::unique_ptr<py::error_already_set> error_;
 };
 
+// After an interrupted run: Python's handler gets the signal it missed (a
+// KeyboardInterrupt for SIGINT; the default action for an unhandled SIGTERM
+// ends the process as it would have). When no Python exception results (a
+// handler that only records the signal, or a call from another thread than
+// the main one), SIGINT still raises KeyboardInterrupt and other signals a
+// fiberlab.Error: the run was cut short and has no result.
+[[noreturn]] void raise_interrupted(int sig) {
+  if (sig == 0) throw Error("run interrupted; nothing was kept");
+  std::raise(sig);
+  if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  if (sig == SIGINT) {
+    PyErr_SetNone(PyExc_KeyboardInterrupt);
+    throw py::error_already_set();
+  }
+  throw Error(std::string("run interrupted by ") + signal_name(sig) + "; nothing was kept");
+}
+
 std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::uint64_t> photons,
                                      std::optional<std::uint64_t> seed, int threads, py::object progress) {
   if (photons) settings.photons = *photons;
   if (seed) settings.seed = *seed;
+  // The CLI's rule (cli/cmd_run.cpp, sim/memory_budget.h): 1 to kMaxThreads, every core by default.
+  if (threads > sim::kMaxThreads)
+    throw Error("threads = " + std::to_string(threads) + ": must be an integer from 1 to " +
+                std::to_string(sim::kMaxThreads) + " (as fiberlab run --threads)");
+  if (threads <= 0) threads = std::min(omp_get_max_threads(), sim::kMaxThreads);
   ProgressRelay relay(std::move(progress));
   std::shared_ptr<sim::ResultFile> result;
+  bool interrupted = false;
+  int received = 0;  // a signal that came during the call, even after the last photon
   {
+    // Everything without the GIL is inside the scope: a signal while the
+    // tracers are set up or the result is assembled is not left to a Python
+    // handler that cannot run before the call returns.
     py::gil_scoped_release release;
+    ScopedInterruptPolling polling;
     const sim::Simulation simulation(settings);
-    const std::vector<sim::Tally> tallies = simulation.run(threads, relay.callback());
-    result = std::make_shared<sim::ResultFile>(
-        sim::make_result(simulation.settings(), simulation.grid(), tallies));
+    sim::check_memory_budget(simulation.settings(), threads);
+    sim::RunProgress state = simulation.start();
+    sim::RunControl control;
+    control.threads = threads;
+    control.progress = relay.callback();
+    interrupted = simulation.run(state, control) == sim::RunOutcome::Interrupted;
+    if (!interrupted)
+      result = std::make_shared<sim::ResultFile>(
+          sim::make_result(simulation.settings(), simulation.grid(), state.tallies));
+    received = polling.received_signal();
+  }
+  if (interrupted) raise_interrupted(received);
+  if (received != 0) {  // the run was complete: Python's handler decides, as after any call
+    std::raise(received);
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
   }
   relay.rethrow();
   return result;

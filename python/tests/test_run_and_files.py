@@ -12,7 +12,7 @@ def test_dict_config_runs_with_the_configs_settings(smooth_result):
     assert r.mean.shape == (2, 4, 45, 72, 2)
     assert r.lobe_names == ["R", "TT", "TRT", "p>=3"]
     assert r.channel_names == ["c0", "c1"]
-    np.testing.assert_allclose(np.degrees(r.theta_i), [0, 40])
+    np.testing.assert_allclose(r.theta_i, [0, 40])  # degrees
     assert list(r.photons) == [200_000, 200_000]
     assert r.config["fiber"]["sigma_a"] == [0.2, 0.5]
     assert r.seeds == [11]
