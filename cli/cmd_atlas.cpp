@@ -114,6 +114,7 @@ void atlas_command(const AtlasOptions& o, const std::string& command) {
   check_output_target(job.output, job.inputs);
   // The checkpoint is rewritten in place when resuming; never over CONFIG.
   check_output_target(job.checkpoint, o.config.empty() ? std::vector<std::string>{} : std::vector{o.config});
+  remove_stale_temporaries(job.checkpoint);  // of an atlas killed while writing it
   check_report_dir(job.report);
   if (!o.quiet) control.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
 

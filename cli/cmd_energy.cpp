@@ -27,6 +27,7 @@
 #include "compare/energy.h"
 #include "compare/models.h"
 #include "compare/report.h"
+#include "compare/report_folder.h"
 #include "sim/memory_budget.h"
 #include "sim/result_file.h"
 #include "sim/settings.h"
@@ -322,34 +323,42 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
     }
   }
   if (!o.report.empty()) {
-    compare::write_text(o.report, "metrics.csv", csv);
-    std::string js;
-    for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, L);
-    compare::write_text(o.report, "metrics.json",
-                        fmt::format("{{\n  \"kind\": \"energy\",\n  \"input\": {},\n  \"simulated\": {},\n"
-                                    "  \"white\": {},\n  \"channel\": {},\n  \"curves\": [{}\n  ]\n}}\n",
-                                    compare::json_string(o.input), simulated ? "true" : "false",
-                                    white ? "true" : "false", c, js));
-    const compare::PlotOutcome plots = compare::make_plots("energy", o.report);
-    std::string md = fmt::format("# Energy: {}\n\n{}. Channel {}. Models integrated over the sphere on a "
-                                 "{} x {} grid (sum of bin probabilities).\n\n",
-                                 o.input,
-                                 simulated ? "Simulated and predicted" : "Models only (the simulation was not run)",
-                                 c, o.n_theta, o.n_phi);
-    md += "| source | theta_i | total | R+TT+TRT |" + std::string(white ? " total - 1 |" : "") +
-          "\n|---|---|---|---|" + (white ? "---|" : "") + "\n";
-    for (const auto& e : curves)
-      for (std::size_t k = 0; k < theta_i.size(); ++k)
-        md += fmt::format("| {} | {:.1f} | {:.5f} | {:.5f} |{}\n", e.label, rad_to_deg(theta_i[k]), e.total(k, c),
-                          e.three_lobe(k, c), white ? fmt::format(" {:+.4f} |", e.total(k, c) - 1.0) : "");
-    md += "\n## Plots\n\n";
-    if (plots.html) md += "All figures on one page: [report.html](report.html).\n\n";
-    if (!plots.ran) md += plots.message + "\n\n";
-    for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
-    md += "Numbers: `metrics.csv` (every channel), `metrics.json`.\n";
-    compare::write_text(o.report, "report.md", md);
-    fmt::print("\nreport: {}/report.md{}{}\n", o.report, plots.html ? fmt::format(", {}/report.html", o.report) : "",
-               plots.ran ? "" : " (" + plots.message + ")");
+    compare::ReportFolder folder(o.report);
+    try {
+      const std::string& dir = folder.staging();
+      compare::write_text(dir, "metrics.csv", csv);
+      std::string js;
+      for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, L);
+      compare::write_text(dir, "metrics.json",
+                          fmt::format("{{\n  \"kind\": \"energy\",\n  \"input\": {},\n  \"simulated\": {},\n"
+                                      "  \"white\": {},\n  \"channel\": {},\n  \"curves\": [{}\n  ]\n}}\n",
+                                      compare::json_string(o.input), simulated ? "true" : "false",
+                                      white ? "true" : "false", c, js));
+      const compare::PlotOutcome plots = compare::make_plots("energy", dir);
+      std::string md = fmt::format("# Energy: {}\n\n{}. Channel {}. Models integrated over the sphere on a "
+                                   "{} x {} grid (sum of bin probabilities).\n\n",
+                                   o.input,
+                                   simulated ? "Simulated and predicted" : "Models only (the simulation was not run)",
+                                   c, o.n_theta, o.n_phi);
+      md += "| source | theta_i | total | R+TT+TRT |" + std::string(white ? " total - 1 |" : "") +
+            "\n|---|---|---|---|" + (white ? "---|" : "") + "\n";
+      for (const auto& e : curves)
+        for (std::size_t k = 0; k < theta_i.size(); ++k)
+          md += fmt::format("| {} | {:.1f} | {:.5f} | {:.5f} |{}\n", e.label, rad_to_deg(theta_i[k]), e.total(k, c),
+                            e.three_lobe(k, c), white ? fmt::format(" {:+.4f} |", e.total(k, c) - 1.0) : "");
+      md += "\n## Plots\n\n";
+      if (plots.html) md += "All figures on one page: [report.html](report.html).\n\n";
+      if (!plots.ran) md += plots.message + "\n\n";
+      for (const std::string& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
+      md += "Numbers: `metrics.csv` (every channel), `metrics.json`.\n";
+      compare::write_text(dir, "report.md", md);
+      folder.commit();
+      fmt::print("\nreport: {}/report.md{}{}\n", o.report,
+                 plots.html ? fmt::format(", {}/report.html", o.report) : "",
+                 plots.ran ? "" : " (" + plots.message + ")");
+    } catch (const std::exception& e) {
+      folder.rethrow(e);
+    }
   }
 }
 

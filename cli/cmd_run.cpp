@@ -192,7 +192,12 @@ void run(const RunOptions& o) {
       std::vector<std::string> inputs;
       for (const std::string& in : {o.config, o.resume})
         if (!in.empty()) inputs.push_back(in);
-      if (group.is_root()) check_output_target(job.settings.output, inputs);
+      if (group.is_root()) {
+        check_output_target(job.settings.output, inputs);
+        // Temporaries of an earlier run killed while writing (SIGKILL): this
+        // run may never write a checkpoint, whose writer would remove them.
+        remove_stale_temporaries(sim::checkpoint_path(job.settings.output));
+      }
       sim::check_memory_budget(job.settings, threads);
     });
     const std::string checkpoint = sim::checkpoint_path(job.settings.output);

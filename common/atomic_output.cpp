@@ -49,8 +49,9 @@ void check_not_an_input(const std::string& target, const struct stat& out,
   }
 }
 
-// .NAME.tmp-PID files of this target whose process is gone.
-void remove_stale_temporaries(const std::string& dir, const std::string& name) {
+// .NAME.tmp-PID files of this target whose process is gone (regular files
+// only: a symbolic link of that name is left, never followed).
+void remove_stale_in(const std::string& dir, const std::string& name) {
   const std::string prefix = "." + name + ".tmp-";
   DIR* d = opendir(dir.c_str());
   if (!d) return;
@@ -64,7 +65,9 @@ void remove_stale_temporaries(const std::string& dir, const std::string& name) {
     const pid_t pid = static_cast<pid_t>(std::stol(digits));
     if (pid == getpid()) continue;
     if (kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive, or not ours to judge
-    unlink((fs::path(dir) / entry).c_str());
+    const std::string stale = (fs::path(dir) / entry).string();
+    struct stat st {};
+    if (lstat(stale.c_str(), &st) == 0 && S_ISREG(st.st_mode)) unlink(stale.c_str());
   }
   closedir(d);
 }
@@ -109,9 +112,14 @@ AtomicOutput::AtomicOutput(std::string target, const std::vector<std::string>& i
   check_output_target(target_, inputs);
   dir_ = folder_of(target_);
   const std::string name = fs::path(target_).filename().string();
-  remove_stale_temporaries(dir_, name);
+  remove_stale_in(dir_, name);
   temp_ = (fs::path(dir_) / fmt::format(".{}.tmp-{}", name, getpid())).string();
   guard_.emplace(temp_);
+}
+
+void remove_stale_temporaries(const std::string& target) {
+  if (target.empty()) return;
+  remove_stale_in(folder_of(target), fs::path(target).filename().string());
 }
 
 AtomicOutput::~AtomicOutput() {

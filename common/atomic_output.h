@@ -39,6 +39,13 @@ class AtomicOutput {
   bool committed_ = false;
 };
 
+// Removes the temporary files of `target` (.NAME.tmp-PID, regular files
+// only, never through a symbolic link) left by processes that no longer
+// exist (SIGKILL, a crash): what AtomicOutput's constructor does, for
+// callers that may not write `target` again (a run resumed from a
+// checkpoint may finish before its next checkpoint).
+void remove_stale_temporaries(const std::string& target);
+
 // The same checks as AtomicOutput's constructor, without creating anything.
 void check_output_target(const std::string& target, const std::vector<std::string>& inputs = {});
 

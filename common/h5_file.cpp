@@ -15,6 +15,7 @@
 #include <cmath>
 
 #include "common/error.h"
+#include "common/h5_integrity.h"
 
 namespace fiberlab::h5 {
 
@@ -116,7 +117,14 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
   hsize_t n = 1;
   for (hsize_t d : dims) n *= d;
   Handle dcpl = checked(H5Pcreate(H5P_DATASET_CREATE), H5Pclose, "property list", path);
-  if ((n >= 4096 || slab_rows) && !dims.empty() && n > 0 &&
+  if (n > 0 && n < 4096 && !slab_rows && !dims.empty() &&
+      H5Zfilter_avail(H5Z_FILTER_FLETCHER32) > 0) {
+    // Small datasets (the ledger, photons, angles) in one chunk with a
+    // Fletcher-32 checksum, so that damage to their values is an HDF5 read
+    // error (common/h5_integrity.h); deflated ones are checked by inflate.
+    H5Pset_chunk(dcpl.id(), static_cast<int>(dims.size()), dims.data());
+    H5Pset_fletcher32(dcpl.id());
+  } else if ((n >= 4096 || slab_rows) && !dims.empty() && n > 0 &&
       H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
     const Dims chunk = chunk_shape(dims, slab_rows);
     H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
@@ -369,8 +377,16 @@ File File::create(const std::string& path, const std::string& shown_as) {
   // own close failed, so nothing of it is left open.
   Handle fapl = checked(H5Pcreate(H5P_FILE_ACCESS), H5Pclose, "property list", path);
   H5Pset_fclose_degree(fapl.id(), H5F_CLOSE_STRONG);
+  // HDF5 1.10's format: its metadata carries checksums (common/h5_integrity.h);
+  // h5py on HDF5 1.10 or later reads it.
+  H5Pset_libver_bounds(fapl.id(), H5F_LIBVER_LATEST, H5F_LIBVER_LATEST);
+  errno = 0;
   hid_t id = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl.id());
-  if (id < 0) throw Error(fmt::format("{}: cannot create file (is the folder writable?)", shown_as));
+  if (id < 0) {
+    if (errno == ENOSPC || errno == EDQUOT || errno == EIO)
+      throw Error(fmt::format("{}: cannot create file: {}", shown_as, std::strerror(errno)));
+    throw Error(fmt::format("{}: cannot create file (is the folder writable?)", shown_as));
+  }
   return File(Handle(id, abandon_written_file), shown_as);
 }
 
@@ -383,6 +399,9 @@ void File::start_writeback() const {
 
 File File::open_read(const std::string& path) {
   quiet_hdf5_errors();
+  // The whole file is read once in a child process first: damage that
+  // crashes HDF5 kills the child, not this process (common/h5_integrity.h).
+  probe_file(path);
   hid_t id = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   if (id < 0) throw Error(fmt::format("{}: cannot open as an HDF5 file", path));
   return File(Handle(id, H5Fclose), path);
@@ -390,6 +409,10 @@ File File::open_read(const std::string& path) {
 
 void File::close() {
   if (handle_.id() < 0) return;
+  // A file written here gets its attribute digest (common/h5_integrity.h).
+  unsigned intent = 0;
+  if (H5Fget_intent(handle_.id(), &intent) >= 0 && (intent & H5F_ACC_RDWR))
+    set_attr("/", kDigestAttribute, attribute_digest(handle_.id(), path_));
   errno = 0;
   check(H5Fflush(handle_.id(), H5F_SCOPE_GLOBAL), "cannot write the file", path_);
   const hid_t id = handle_.id();

@@ -2,7 +2,9 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <limits>
 #include <optional>
@@ -172,7 +174,38 @@ Flat flatten(const std::vector<AtlasFiberResult>& fibers) {
   return flat;
 }
 
+// FNV-1a (64 bits) of an array's values as stored (little-endian 8-byte
+// words): /dataset_digests holds one per dataset, in kDigestOrder, so that
+// datasets swapped or edited within their shapes (sim_energy and sim_error
+// share one) are refused.
+template <class T>
+std::uint64_t values_digest(const std::vector<T>& v) {
+  static_assert(sizeof(T) == 8);
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (const T& x : v) {
+    unsigned char b[8];
+    std::memcpy(b, &x, 8);
+    for (unsigned char c : b) h = (h ^ c) * 0x100000001b3ULL;
+  }
+  return h;
+}
+
+constexpr const char* kDigestOrder =
+    "photons,shape,seconds,theta_i,sim_energy,sim_error,model_state,model_seconds,comparisons,"
+    "fit_numbers,fit_values";
+
+template <class Arrays>
+std::vector<std::uint64_t> dataset_digests(const Arrays& a, const std::vector<double>& fit_numbers,
+                                           const std::vector<double>& fit_values) {
+  return {values_digest(a.photons),      values_digest(a.shape),       values_digest(a.seconds),
+          values_digest(a.theta_i),      values_digest(a.sim_energy),  values_digest(a.sim_error),
+          values_digest(a.model_state),  values_digest(a.model_seconds),
+          values_digest(a.comparisons),  values_digest(fit_numbers),   values_digest(fit_values)};
+}
+
 void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std::size_t M) {
+  f.set_attr("/", "dataset_digest_order", std::string(kDigestOrder));
+  f.set_attr("/", "dataset_digests", dataset_digests(flat, flat.fit_numbers, flat.fit_values));
   const std::size_t columns = comparison_columns().size();
   f.set_attr("/", "fiber_labels", lines_attr(flat.labels));
   f.set_attr("/", "status", lines_attr(flat.status));
@@ -502,6 +535,20 @@ AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
   if (at.comparison * comparison_columns().size() != stored.comparisons.size() ||
       at.fit_value * kFitValues != stored.fits.values.size())
     r.fail("it holds more comparisons or fitted values than its models");
+  // Last, so that a value out of range is named first: values that pass
+  // every check but are not those written (datasets swapped or edited).
+  if (!f.has_attr("/", "dataset_digests") || r.text("/", "dataset_digest_order") != kDigestOrder)
+    r.fail("its dataset digests are missing (written by another build?)");
+  const std::vector<std::uint64_t> want = f.attr_uint64s("/", "dataset_digests", 64),
+                                   got = dataset_digests(stored, stored.fits.numbers, stored.fits.values);
+  std::string order = kDigestOrder;
+  std::replace(order.begin(), order.end(), ',', '\n');
+  const std::vector<std::string> names = lines_of(order);
+  for (std::size_t d = 0; d < got.size(); ++d)
+    if (d >= want.size() || want[d] != got[d])
+      r.fail(fmt::format("dataset {} does not hold the values written with it (its digest in "
+                         "/dataset_digests differs: datasets swapped, edited or damaged)",
+                         names[d]));
   return c;
 }
 

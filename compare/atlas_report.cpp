@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "common/file_schema.h"
 #include "compare/report.h"
+#include "compare/report_folder.h"
 
 namespace fiberlab::compare {
 
@@ -118,10 +119,14 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
   return s;
 }
 
-std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
-                               const std::vector<AtlasFiberResult>& fibers, const std::string& command) {
-  make_report_dir(dir);
-  copy_atlas_file(atlas_path, dir);
+namespace {
+
+// Every file of the report into the folder's staging folder, then moved into place.
+std::string write_staged(ReportFolder& folder, const std::string& dir, const std::string& atlas_path,
+                         const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers,
+                         const std::string& command) {
+  const std::string& staged = folder.staging();
+  copy_atlas_file(atlas_path, staged);
   double sim_s = 0.0, fit_s = 0.0;
   for (const auto& f : fibers) {
     sim_s += f.sim_seconds;
@@ -142,17 +147,30 @@ std::string write_atlas_report(const std::string& dir, const std::string& atlas_
       fibers.empty() ? 0 : fibers[0].photons, sim_s, fit_s,
       fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(), fixed_parameters(config), headline, table);
   // The tables for the page (scripts/plot_atlas.py turns them into HTML).
-  write_text(dir, "atlas_tables.md",
+  write_text(staged, "atlas_tables.md",
              "## Per model and lobe (median over fibers)\n\n" + headline + "\n## Per fiber\n\n" + table);
-  const PlotOutcome plots = make_plots("atlas", dir);
+  const PlotOutcome plots = make_plots("atlas", staged);
   if (!plots.pngs.empty()) {
     md += "## Figures\n\n";
     for (const auto& png : plots.pngs) md += fmt::format("![{}]({})\n\n", png, png);
   }
   if (!plots.ran) md += plots.message + "\n";
-  write_text(dir, "report.md", md);
+  write_text(staged, "report.md", md);
+  folder.commit();
   return fmt::format("report: {}/report.md{}{}\n", dir, plots.html ? ", " + dir + "/report.html" : "",
                      plots.ran ? "" : " (" + plots.message + ")");
+}
+
+}  // namespace
+
+std::string write_atlas_report(const std::string& dir, const std::string& atlas_path, const AtlasConfig& config,
+                               const std::vector<AtlasFiberResult>& fibers, const std::string& command) {
+  ReportFolder folder(dir);
+  try {
+    return write_staged(folder, dir, atlas_path, config, fibers, command);
+  } catch (const std::exception& e) {
+    folder.rethrow(e);
+  }
 }
 
 }  // namespace fiberlab::compare

@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sys/wait.h>
@@ -15,6 +17,7 @@
 #include "common/file_schema.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
+#include "compare/report_folder.h"
 
 #ifndef FIBERLAB_SOURCE_DIR
 #define FIBERLAB_SOURCE_DIR ""
@@ -24,19 +27,16 @@ namespace fiberlab::compare {
 
 namespace fs = std::filesystem;
 
-void make_report_dir(const std::string& dir) {
-  std::error_code ec;
-  fs::create_directories(dir, ec);
-  if (ec || !fs::is_directory(dir))
-    throw Error(fmt::format("--report {}: cannot create the folder ({})", dir, ec.message()));
-}
+void make_report_dir(const std::string& dir) { check_report_dir_possible(dir); }
 
 void write_text(const std::string& dir, const std::string& name, const std::string& text) {
   AtomicOutput out((fs::path(dir) / name).string());
   {
     std::ofstream f(out.temp_path(), std::ios::binary);
+    errno = 0;
     f << text;
-    if (!f) throw Error(fmt::format("cannot write {}", out.target()));
+    f.close();  // a full disk shows here
+    if (!f) throw Error(fmt::format("cannot write {}: {}", out.target(), std::strerror(errno)));
   }
   out.commit();
 }
@@ -124,8 +124,6 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
     return o;
   }
   const fs::path page = fs::path(dir) / "report.html";
-  std::error_code ignored;
-  fs::remove(page, ignored);  // never leave a page describing an earlier run
   const std::string log = (fs::path(dir) / "plot_log.txt").string();
   const std::string cmd = fmt::format("{} {} {} {} > {} 2>&1", shell_quote(python), shell_quote(script),
                                       kind, shell_quote(dir), shell_quote(log));
@@ -143,8 +141,9 @@ PlotOutcome make_plots(const std::string& kind, const std::string& dir) {
   } else if (code == 3) {
     o.message = fmt::format("plots skipped: {} ({})", tail, python);
   } else {
-    o.message = fmt::format("plots failed (exit status {}; see {}): {}", code, log, tail);
+    o.message = fmt::format("plots failed (exit status {}; see plot_log.txt in the report folder): {}", code, tail);
   }
+  if (code != 0) fs::remove(page);  // the page of a failed script is not the report's
   for (const auto& entry : fs::directory_iterator(dir))
     if (entry.path().extension() == ".png") o.pngs.push_back(entry.path().filename().string());
   std::sort(o.pngs.begin(), o.pngs.end());

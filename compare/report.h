@@ -12,7 +12,9 @@
 
 namespace fiberlab::compare {
 
-// Creates DIR (and parents); throws fiberlab::Error when it cannot.
+// Checks that DIR can be made (compare/report_folder.h), before any work;
+// throws fiberlab::Error when it cannot. The report's files are written into
+// a ReportFolder's staging folder: `dir` below is that folder.
 void make_report_dir(const std::string& dir);
 
 // Writes `text` to DIR/name atomically.
@@ -35,8 +37,8 @@ struct PlotOutcome {
   std::vector<std::string> pngs;  // file names in DIR, sorted
   bool html = false;              // DIR/report.html written
 };
-// Runs `/usr/bin/python3 SCRIPT KIND DIR` (KIND "compare" or "energy"),
-// after removing a report.html left by an earlier run.
+// Runs `/usr/bin/python3 SCRIPT KIND DIR` (KIND "compare", "energy" or
+// "atlas") with its output in DIR/plot_log.txt (DIR: a fresh staging folder).
 // $FIBERLAB_PYTHON replaces /usr/bin/python3 (tests use it to simulate a
 // machine without matplotlib).
 PlotOutcome make_plots(const std::string& kind, const std::string& dir);

@@ -2,7 +2,11 @@
 
 #include <fmt/core.h>
 
+#include <cmath>
+#include <string_view>
+
 #include "common/error.h"
+#include "common/h5_integrity.h"
 #include "common/result_layout.h"
 #include "sim/result_stream.h"
 
@@ -15,6 +19,55 @@ std::string checkpoint_path(const std::string& output) {
   return output + ".checkpoint.h5";
 }
 
+namespace {
+
+// FNV-1a (64 bits) of the resolved config's text (to_yaml), stored as
+// /checkpoint@config_digest: a stored config_yaml that was changed, or that
+// does not resolve to itself, is refused.
+std::uint64_t config_digest(std::string_view text) {
+  std::uint64_t h = 0xcbf29ce484222325ULL;
+  for (unsigned char ch : text) h = (h ^ ch) * 0x100000001b3ULL;
+  return h;
+}
+
+// FNV-1a (64 bits) continued over a direction's exact words (ExactTally::words:
+// photons, counts, bin sums, ledger), each as 16 little-endian bytes: stored
+// as /checkpoint@sums_digest over every direction in order, so that a sum
+// edited within the tally's identities (a count moved between bins) is refused.
+std::uint64_t add_sums(std::uint64_t h, const ExactTally& t) {
+  for (const ExactTally::Word w : t.words())
+    for (int b = 0; b < 16; ++b) h = (h ^ static_cast<unsigned char>(w >> (8 * b))) * 0x100000001b3ULL;
+  return h;
+}
+constexpr std::uint64_t kFnvBasis = 0xcbf29ce484222325ULL;
+
+[[noreturn]] void inconsistent(const std::string& path, const std::string& what) {
+  throw Error(fmt::format("{}: inconsistent checkpoint: {} (it was damaged or edited; delete it "
+                          "and run again)", path, what));
+}
+
+// /fiber and /roughness hold the stored config's values (sim/result_file.cpp
+// writes both from the same Settings), exactly.
+void check_parameter_groups(const h5::File& f, const Settings& s, const std::string& path) {
+  const auto same = [&](const char* group, const char* name, const std::vector<double>& expected) {
+    const std::string obj = std::string("/") + group;
+    if (!f.has_attr(obj, name)) inconsistent(path, fmt::format("{}@{} is missing", obj, name));
+    if (f.attr_doubles(obj, name) != expected)
+      inconsistent(path, fmt::format("{}@{} does not match the stored config_yaml's {}.{}", obj,
+                                     name, group, name));
+  };
+  same("fiber", "eta", {s.fiber.eta});
+  same("fiber", "eccentricity", {s.fiber.eccentricity});
+  same("fiber", "scale_tilt", {s.fiber.scale_tilt});
+  same("fiber", "sigma_a", s.fiber.sigma_a);
+  same("roughness", "beta_long", {s.roughness.beta_long});
+  same("roughness", "beta_azim", {s.roughness.beta_azim});
+  if (f.attr_string("/roughness", "model") != to_string(s.roughness.model))
+    inconsistent(path, "/roughness@model does not match the stored config_yaml's roughness.model");
+}
+
+}  // namespace
+
 ResultFile result_header(const Settings& settings, const BinGrid& grid) {
   return make_result(settings, grid, {});
 }
@@ -22,13 +75,20 @@ ResultFile result_header(const Settings& settings, const BinGrid& grid) {
 void write_checkpoint(const std::string& path, const Simulation& sim, const RunProgress& state,
                       double target_error) {
   ResultWriter w(path, result_header(sim.settings(), sim.grid()));
-  for (std::size_t k = 0; k < state.tallies.size(); ++k) w.write(k, state.tallies[k].exact());
+  std::uint64_t sums = kFnvBasis;
+  for (std::size_t k = 0; k < state.tallies.size(); ++k) {
+    const ExactTally t = state.tallies[k].exact();
+    sums = add_sums(sums, t);
+    w.write(k, t);
+  }
   h5::File& f = w.file();
   f.set_attr("/", "target_error", target_error);
   f.create_group("/checkpoint");
   f.set_attr("/checkpoint", "checkpoint_version", static_cast<std::int64_t>(kCheckpointVersion));
   f.set_attr("/checkpoint", "chunk", static_cast<std::int64_t>(Simulation::kChunk));
   f.set_attr("/checkpoint", "target_batch", static_cast<std::int64_t>(Simulation::kTargetBatch));
+  f.set_attr("/checkpoint", "config_digest", config_digest(to_yaml(sim.settings())));
+  f.set_attr("/checkpoint", "sums_digest", sums);
   f.write("/checkpoint/next_photon", {state.next_photon.size()}, state.next_photon);
   std::vector<std::uint64_t> done(state.done.begin(), state.done.end());
   f.write("/checkpoint/done", {done.size()}, done);
@@ -55,9 +115,20 @@ Checkpoint read_checkpoint(const std::string& path, bool with_tallies) {
       attr("target_batch") != static_cast<std::int64_t>(Simulation::kTargetBatch))
     throw Error(fmt::format("{}: written with another photon chunking: resume it with the "
                             "fiberlab build that wrote it", path));
+  // The config as resolved when written (its digest), then the parameter
+  // groups, the progress and the sums against it; last, the attribute digest
+  // (checked by h5::File::open_read when present) must be there.
+  if (!f.has_attr("/checkpoint", "config_digest"))
+    inconsistent(path, "/checkpoint@config_digest is missing");
   Checkpoint c;
   c.settings = reader.header().settings;
+  if (f.attr_uint64("/checkpoint", "config_digest") != config_digest(reader.header().config_yaml) ||
+      to_yaml(c.settings) != reader.header().config_yaml)
+    inconsistent(path, "config_yaml does not match /checkpoint@config_digest");
+  check_parameter_groups(f, c.settings, path);
   c.target_error = f.attr_double("/", "target_error");
+  if (!(std::isfinite(c.target_error) && c.target_error >= 0.0))
+    inconsistent(path, fmt::format("target_error = {} (must be finite and >= 0)", c.target_error));
   const std::size_t K = c.settings.incidences().size();
   c.state.next_photon = f.read_uint64s("/checkpoint/next_photon");
   const std::vector<std::uint64_t> done = f.read_uint64s("/checkpoint/done");
@@ -65,19 +136,35 @@ Checkpoint read_checkpoint(const std::string& path, bool with_tallies) {
     throw Error(fmt::format("{}: /checkpoint does not have one entry per incident direction", path));
   for (std::size_t k = 0; k < K; ++k) {
     const std::uint64_t next = c.state.next_photon[k];
+    // A direction is finished when all its photons are traced, or (with a
+    // target error) at a judged batch boundary (Simulation::run).
+    const bool early = next < c.settings.photons;
     if (done[k] > 1 || next > c.settings.photons || reader.header().photons[k] != next ||
-        (!done[k] && (next % Simulation::kChunk != 0 || next == c.settings.photons)))
-      throw Error(fmt::format("{}: /checkpoint of direction {} disagrees with its sums or config",
-                              path, k));
+        (!done[k] && (next % Simulation::kChunk != 0 || next == c.settings.photons)) ||
+        (done[k] && early &&
+         (next == 0 || c.target_error == 0.0 || next % Simulation::kTargetBatch != 0)))
+      inconsistent(path, fmt::format("/checkpoint of direction {} (next_photon {}, done {}) "
+                                     "disagrees with /tally/photons[{}] = {} or the config's "
+                                     "photons {} (target_error {})",
+                                     k, next, done[k], k, reader.header().photons[k],
+                                     c.settings.photons, c.target_error));
     c.state.done.push_back(static_cast<std::uint8_t>(done[k]));
   }
   if (with_tallies) {
+    // reader.read checks each direction's identities (sim/tally_consistency.h).
     const TallyShape s = reader.shape();
+    std::uint64_t sums = kFnvBasis;
     for (std::size_t k = 0; k < K; ++k) {
+      const ExactTally t = reader.read(k);
+      sums = add_sums(sums, t);
       c.state.tallies.emplace_back(s.lobes, s.n_theta, s.n_phi, s.channels);
-      c.state.tallies.back().add(reader.read(k));
+      c.state.tallies.back().add(t);
     }
+    if (!f.has_attr("/checkpoint", "sums_digest") || f.attr_uint64("/checkpoint", "sums_digest") != sums)
+      inconsistent(path, "its sums (/tally, /exact) do not match /checkpoint@sums_digest");
   }
+  if (!f.has_attr("/", h5::kDigestAttribute))
+    inconsistent(path, fmt::format("root attribute {} is missing", h5::kDigestAttribute));
   return c;
 }
 

@@ -11,6 +11,7 @@
 
 #include "common/error.h"
 #include "common/result_layout.h"
+#include "sim/tally_consistency.h"
 
 namespace fiberlab::sim {
 
@@ -335,6 +336,9 @@ ExactTally ResultReader::read(std::size_t k) const {
   t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
   if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
+  // Sums that break a tally's identities were damaged or edited: never added.
+  if (const std::string why = tally_inconsistency(t); !why.empty())
+    throw Error(fmt::format("{}: incident direction {}: {}", path_, k, why));
   return t;
 }
 
