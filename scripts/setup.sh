@@ -11,6 +11,7 @@ packages=(
   python3 python3-dev python3-h5py python3-numpy python3-matplotlib
   pybind11-dev python3-pybind11 python3-pytest python3-pandas
   libopenmpi-dev openmpi-bin
+  chromium                  # renders report.html in python/tests/test_report_html.py (skipped without it)
 )
 missing=()
 for p in "${packages[@]}"; do
