@@ -121,12 +121,12 @@ LEGEND_WIDTH = 0.13
 
 def readable_log_axis(ax, plt):
     """Log y axis whose ticks carry numbers even when the data span less
-    than a decade (ticks at 1, 2, 5 x 10^n then, labelled %.2g)."""
+    than a decade (ticks at 1, 2, 5 x 10^n then, two significant digits)."""
     lo, hi = ax.get_ylim()
     if lo > 0 and hi / lo < 30:
         from matplotlib import ticker
         ax.yaxis.set_major_locator(ticker.LogLocator(subs=(1.0, 2.0, 5.0)))
-        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: "%.2g" % v))
+        ax.yaxis.set_major_formatter(ticker.FuncFormatter(lambda v, _: "%g" % float("%.2g" % v)))
         ax.yaxis.set_minor_formatter(ticker.NullFormatter())
 
 
