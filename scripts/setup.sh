@@ -8,11 +8,12 @@ packages=(
   build-essential cmake pkg-config ccache
   libeigen3-dev libhdf5-dev libdeflate-dev libyaml-cpp-dev libcli11-dev libfmt-dev libxsimd-dev
   googletest libgtest-dev libbenchmark-dev libboost-dev libboost-math-dev
-  python3 python3-dev python3-h5py python3-numpy python3-matplotlib
+  python3 python3-dev python3-h5py python3-numpy python3-matplotlib python3-yaml
   pybind11-dev python3-pybind11 python3-pytest python3-pandas
   python3-xarray python3-nbclient python3-nbformat python3-ipykernel
   python3-setuptools python3-pip python3-venv
   libopenmpi-dev openmpi-bin
+  chromium                  # renders report.html in python/tests/test_report_html.py (skipped without it)
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -18,12 +18,35 @@ def png_size(path):
     return struct.unpack(">II", head[16:24])
 
 
-def assert_self_contained(page):
-    # Every image inline; no script, no stylesheet or link to fetch.
+def assert_self_contained(page, folder):
+    # Every image inline; no script, no stylesheet or URL to fetch. The only
+    # links: anchors in the page and the SVG files beside it.
     assert "<script" not in page
-    assert not re.search(r'(src|href)\s*=\s*"(?!data:|#)', page)
+    assert not re.search(r'src\s*=\s*"(?!data:)', page)
+    for target in re.findall(r'href\s*=\s*"([^"]*)"', page):
+        if not target.startswith("#"):
+            assert re.fullmatch(r"[A-Za-z0-9_.]+\.svg", target), target
+            assert (folder / target).exists(), target
     assert "http://" not in page and "https://" not in page
     assert "url(" not in page
+
+
+def assert_svg_beside_every_png(folder, page):
+    pngs = sorted(p.stem for p in folder.glob("*.png"))
+    assert pngs and pngs == sorted(p.stem for p in folder.glob("*.svg"))
+    for stem in pngs:
+        assert 'href="%s.svg"' % stem in page, stem
+
+
+def shown_width(page, alt_part):
+    """The width attribute of the <img> whose alt text contains alt_part,
+    and the pixel width of its embedded PNG."""
+    import base64
+    m = re.search(r'<img alt="[^"]*%s[^"]*" width="(\d+)" height="(\d+)" src="data:image/png;base64,([^"]+)"'
+                  % re.escape(alt_part), page)
+    assert m, alt_part
+    head = base64.b64decode(m.group(3)[:64])
+    return int(m.group(1)), struct.unpack(">I", head[16:20])[0]
 
 
 def render_in_chromium(page_path, shot):
@@ -60,7 +83,8 @@ def test_compare_report_html_is_self_contained_and_names_every_direction(compare
     assert page_path.exists(), stdout
     assert "report.html" in stdout
     page = page_path.read_text()
-    assert_self_contained(page)
+    assert_self_contained(page, rep)
+    assert_svg_beside_every_png(rep, page)
     for name in ("theta_i = 0.00 deg, phi_i = 0.00 deg", "theta_i = 40.00 deg, phi_i = 0.00 deg"):
         assert page.count(name) >= 2, name  # in the list and as a section heading
     assert "Left out of the figures" in page and "first 1 incident directions" in page
@@ -71,12 +95,27 @@ def test_compare_report_html_is_self_contained_and_names_every_direction(compare
 
 def test_compare_report_figure_sizes(compare_report):
     rep, _ = compare_report
-    for name, size in (("compare_theta0.0_phi0.0_heatmaps.png", (1200, 1200)),
-                       ("compare_theta0.0_phi0.0_marginals.png", (1200, 1200)),
-                       ("compare_theta0.0_phi0.0_polar.png", (1200, 400)), ("compare_energy.png", (1200, 400))):
+    lobes = 4  # (plot_report.py's docstring: heights per lobe)
+    for name, size in (("compare_theta0.0_phi0.0_heatmaps.png", (1200, 150 + 550 * lobes)),
+                       ("compare_theta0.0_phi0.0_marginals.png", (1200, 125 + 350 * lobes)),
+                       ("compare_theta0.0_phi0.0_polar.png", (1200, 450)), ("compare_energy.png", (1200, 425))):
         assert png_size(rep / name) == size, name
         assert (rep / name).stat().st_size > 20_000, name
     assert not (rep / "compare_theta40.0_phi0.0_heatmaps.png").exists()  # left out
+
+
+def test_compare_report_shows_heatmaps_at_natural_size(compare_report):
+    # Each heatmap panel is >= 400 px wide in the 1200 px PNG
+    # (test_plot_helpers.py); the page shows the PNG unscaled: its width
+    # attribute is the PNG's own and no style shrinks it (a narrow window
+    # scrolls the figure instead).
+    rep, _ = compare_report
+    page = (rep / "report.html").read_text()
+    shown, png = shown_width(page, "heatmaps")
+    assert shown == png == 1200
+    style = page[page.index("<style>"):page.index("</style>")]
+    assert re.search(r"\.fig img \{[^}]*max-width: none", style)
+    assert not re.search(r"(^|[^.\w])img \{[^}]*max-width: *\d", style)
 
 
 def test_compare_report_renders_in_headless_chromium(compare_report, tmp_path):
@@ -98,7 +137,8 @@ def test_energy_report_html(smooth_result, fiberlab_binary, tmp_path):
                          timeout=300)
     assert out.returncode == 0, out.stderr
     page = (tmp_path / "e" / "report.html").read_text()
-    assert_self_contained(page)
+    assert_self_contained(page, tmp_path / "e")
+    assert_svg_beside_every_png(tmp_path / "e", page)
     assert page.count("data:image/png;base64,") == 1
     assert "simulation" in page and "exact" in page
 
@@ -117,4 +157,5 @@ def test_energy_report_of_a_white_fiber_has_the_furnace_plot(fiberlab_binary, tm
     assert png_size(tmp_path / "e" / "energy_furnace.png") == (1200, 400)
     page = (tmp_path / "e" / "report.html").read_text()
     assert page.count("data:image/png;base64,") == 2 and "White furnace" in page
-    assert_self_contained(page)
+    assert_self_contained(page, tmp_path / "e")
+    assert_svg_beside_every_png(tmp_path / "e", page)

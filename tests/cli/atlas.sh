@@ -36,7 +36,8 @@ if ! "$fiberlab" atlas "$work/a.yaml" -o "$work/a.h5" --threads 2 >"$work/out" 2
 fi
 cat "$work/out"
 for f in a.h5 a_report/report.md a_report/report.html a_report/report_data.h5 \
-         a_report/atlas_error_vs_roughness.png a_report/atlas_error_vs_theta_i.png; do
+         a_report/atlas_error_vs_roughness.png a_report/atlas_error_vs_theta_i.png \
+         a_report/atlas_error_vs_roughness.svg a_report/atlas_error_vs_theta_i.svg; do
   [ -s "$work/$f" ] || { echo "FAIL: $f missing"; fail=1; }
 done
 grep -q "| deon2011 | 2 | TT |" "$work/a_report/report.md" || { echo "FAIL: no headline row in report.md"; fail=1; }

@@ -110,16 +110,20 @@ TEST(Report, CompareAndEnergyFolders) {
   for (const char* name : {"report.md", "metrics.csv", "metrics.json"})
     EXPECT_TRUE(fs::exists(erep / name)) << name;
   if (have_matplotlib()) {
-    for (const char* png : {"compare_theta31.0_phi0.0_heatmaps.png", "compare_theta31.0_phi0.0_marginals.png"}) {
+    // Heights per lobe count: scripts/plot_report.py's docstring (4 lobes here).
+    for (const auto& [png, height] : {std::pair{"compare_theta31.0_phi0.0_heatmaps.png", 150 + 550 * 4},
+                                      std::pair{"compare_theta31.0_phi0.0_marginals.png", 125 + 350 * 4}}) {
       const auto [w, h] = png_size(rep / png);
       EXPECT_EQ(w, 1200) << png;
-      EXPECT_EQ(h, 1200) << png;
+      EXPECT_EQ(h, height) << png;
       EXPECT_GT(fs::file_size(rep / png), 20000u) << png;  // not blank
+      EXPECT_TRUE(fs::exists(rep / fs::path(png).replace_extension(".svg"))) << png;
     }
     const auto [w, h] = png_size(erep / "energy.png");
     EXPECT_EQ(w, 1200);
     EXPECT_EQ(h, 800);
     EXPECT_GT(fs::file_size(erep / "energy.png"), 20000u);
+    EXPECT_TRUE(fs::exists(erep / "energy.svg"));
   } else {
     std::printf("matplotlib missing: PNG checks skipped\n");
   }
