@@ -74,7 +74,7 @@ set -m
   >"$work/along.out" 2>"$work/along.err" &
 pid=$!
 set +m
-for _ in $(seq 1 1000); do
+for _ in $(seq 1 2500); do
   [ -e "$work/atlas_long.checkpoint.h5" ] && break
   kill -0 "$pid" 2>/dev/null || break
   sleep 0.02
