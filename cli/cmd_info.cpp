@@ -1,4 +1,6 @@
-// `fiberlab info RESULT.h5`: what a result (or prediction) file holds.
+// `fiberlab info FILE.h5`: what a fiberlab file of any kind holds
+// (docs/FILE_FORMAT.md): result, run checkpoint, prediction, report data,
+// atlas, atlas checkpoint.
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
@@ -6,8 +8,15 @@
 
 #include "cli/commands.h"
 #include "cli/summary_table.h"
+#include "common/error.h"
+#include "common/h5_file.h"
+#include "common/result_layout.h"
 #include "common/units.h"
+#include "compare/atlas_checkpoint.h"
+#include "compare/atlas_file.h"
 #include "compare/prediction_file.h"
+#include "compare/report.h"
+#include "sim/checkpoint.h"
 #include "sim/result_file.h"
 
 namespace fiberlab::cli {
@@ -20,11 +29,7 @@ std::string degrees(const std::vector<double>& radians) {
   return "[" + s + "]";
 }
 
-void info(const std::string& path) {
-  if (compare::is_prediction_file(path)) {  // info reads predictions too
-    fmt::print("{}", compare::describe_prediction(compare::read_prediction(path)));
-    return;
-  }
+void result_info(const std::string& path) {
   const sim::ResultFile r = sim::read_result(path);
   const sim::Settings& s = r.settings;
   fmt::print("{}: fiberlab result (software {}, created {})\n", path, r.software_version, r.created_utc);
@@ -46,12 +51,35 @@ void info(const std::string& path) {
   print_summary(stdout, r);
 }
 
+void info(const std::string& path) {
+  const std::string format = file_format(path);
+  if (format == "fiber-histogram") {
+    if (h5::File::open_read(path).exists("/checkpoint")) fmt::print("{}", sim::describe_checkpoint(path));
+    else result_info(path);
+  } else if (format == "fiber-prediction") {
+    fmt::print("{}", compare::describe_prediction(compare::read_prediction(path)));
+  } else if (format == "fiber-report-data") {
+    fmt::print("{}", compare::describe_report_data(path));
+  } else if (format == "fiber-atlas") {
+    fmt::print("{}", compare::describe_atlas_file(path));
+  } else if (format == "fiber-atlas-checkpoint") {
+    fmt::print("{}", compare::describe_atlas_checkpoint(path));
+  } else {
+    throw Error(fmt::format("{}: not a fiberlab result file nor any other kind (root attribute format is {}; "
+                            "info reads fiber-histogram, fiber-prediction, fiber-report-data, fiber-atlas, "
+                            "fiber-atlas-checkpoint)",
+                            path, format.empty() ? "missing" : "\"" + format + "\""));
+  }
+}
+
 }  // namespace
 
 void add_info_command(CLI::App& app) {
   auto path = std::make_shared<std::string>();
-  CLI::App* cmd = app.add_subcommand("info", "Describe a result file: parameters, photons, lobe energies");
-  cmd->add_option("result", *path, "Result file (.h5)")->required();
+  CLI::App* cmd = app.add_subcommand("info", "Describe a fiberlab file: a result (parameters, photons, lobe "
+                                               "energies), run checkpoint, prediction, report data, atlas or "
+                                               "atlas checkpoint");
+  cmd->add_option("file", *path, "A fiberlab HDF5 file (.h5)")->required();
   cmd->callback([path] { info(*path); });
 }
 

@@ -41,20 +41,23 @@ void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin) {
   f.set_attr("/", "channel_names", join_names(channel_names(channels, from_melanin)));
 }
 
-void describe_bins_and_source(h5::File& f) {
-  describe(f, "/bins/theta_edges", "theta_edge", "radians",
+void describe_bins_and_source(h5::File& f, const AxisPaths& at) {
+  describe(f, at.bins + "theta_edges", "theta_edge", "radians",
            "theta_r bin edges, inclination from the plane normal to the fiber axis, in [-pi/2, pi/2]");
-  describe(f, "/bins/phi_edges", "phi_edge", "radians",
+  describe(f, at.bins + "phi_edges", "phi_edge", "radians",
            "relative azimuth phi_r - phi_i bin edges, in [-pi, pi]");
-  describe(f, "/bins/solid_angle", "theta,phi", "steradians",
+  describe(f, at.bins + "solid_angle", "theta,phi", "steradians",
            "(sin theta_hi - sin theta_lo)(phi_hi - phi_lo) per bin");
-  describe(f, "/source/theta_i", "incidence", "radians", "incident inclination per incident direction");
-  describe(f, "/source/phi_i", "incidence", "radians",
+  describe(f, at.source + "theta_i", "incidence", "radians", "incident inclination per incident direction");
+  describe(f, at.source + "phi_i", "incidence", "radians",
            "incident azimuth per incident direction (NaN: randomly rotated fiber)");
 }
 
-void describe_result_datasets(h5::File& f) {
+void describe_tally_photons(h5::File& f) {
   describe(f, "/tally/photons", "incidence", "photons", "photons launched per incident direction (N)");
+}
+
+void describe_result_datasets(h5::File& f) {
   describe(f, "/tally/weight_sum", kHistogramDims, "weight",
            "S1: sum of exit weights per bin; probability P = S1/N");
   describe(f, "/tally/weight_sq_sum", kHistogramDims, "weight^2",
@@ -71,6 +74,22 @@ void describe_result_datasets(h5::File& f) {
            "the fiber's parameters (attributes)");
   describe(f, "/roughness", "", "beta_long, beta_azim: radians; alpha: 1 (slope)",
            "the surface roughness (attributes)");
+}
+
+void describe_exact_datasets(h5::File& f) {
+  const char* residual =
+      "E - (the float64 sum) x 2^60, where E is the exact sum x 2^60 (a 128-bit integer; "
+      "docs/FILE_FORMAT.md)";
+  describe(f, "/exact/weight_sum_residual", kHistogramDims, "weight x 2^60",
+           std::string("exact S1: ") + residual);
+  describe(f, "/exact/weight_sq_sum_residual", kHistogramDims, "weight^2 x 2^60",
+           std::string("exact S2: ") + residual);
+  const char* pairs = "(high, low) 64-bit words of the exact sum x 2^60, an unsigned 128-bit integer";
+  describe(f, "/exact/exited", "incidence,lobe,channel,word", "weight x 2^60",
+           std::string("exact /ledger/exited: ") + pairs);
+  for (const char* name : {"absorbed", "truncated", "lost"})
+    describe(f, std::string("/exact/") + name, "incidence,channel,word", "weight x 2^60",
+             fmt::format("exact /ledger/{}: {}", name, pairs));
 }
 
 }  // namespace fiberlab

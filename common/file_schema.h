@@ -33,15 +33,37 @@ inline constexpr const char* kAtlasDims = "fiber,incidence,lobe,channel";
 void describe(h5::File& f, const std::string& path, const std::string& dimensions, const std::string& units,
               const std::string& description);
 
+// A dataset written and described in one place (h5::File::write, then describe).
+template <class T>
+void write_described(h5::File& f, const std::string& path, const h5::Dims& dims, const std::vector<T>& data,
+                     const std::string& dimensions, const std::string& units, const std::string& description) {
+  f.write(path, dims, data);
+  describe(f, path, dimensions, units, description);
+}
+
 // Root attributes `lobe_names` and `channel_names` (comma-separated).
 void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin);
 
-// The dimension labels, units and descriptions of /bins and /source/theta_i,
-// /source/phi_i (common/result_layout.h writes those datasets).
-void describe_bins_and_source(h5::File& f);
+// Where the bin edges, solid angles and incident directions are: in a
+// result or prediction file /bins/... and /source/... (common/result_layout.h
+// writes them), in report data at the root (compare/report.h).
+struct AxisPaths {
+  std::string bins = "/bins/", source = "/source/";
+};
+
+// The dimension labels, units and descriptions of theta_edges, phi_edges,
+// solid_angle, theta_i and phi_i.
+void describe_bins_and_source(h5::File& f, const AxisPaths& at = {});
 
 // Dimension labels, units and descriptions of a result file's /tally and
-// /ledger datasets (sim/result_file.h writes them).
+// /ledger datasets (sim/result_file.h writes them), but /tally/photons:
+// describe_tally_photons, since the streaming writer (sim/result_stream.h)
+// describes the others when it creates them and writes the photons last.
 void describe_result_datasets(h5::File& f);
+void describe_tally_photons(h5::File& f);
+
+// The same for its exact sums, /exact (sim/result_stream.h writes them): the
+// trailing axis `word` of the 128-bit sums holds (high, low).
+void describe_exact_datasets(h5::File& f);
 
 }  // namespace fiberlab

@@ -44,6 +44,12 @@ bool is_hdf5_file(const std::string& path) {
   return in.gcount() == 8 && std::string(magic, 8) == std::string("\x89HDF\r\n\x1a\n", 8);
 }
 
+std::string file_format(const std::string& path) {
+  if (!is_hdf5_file(path)) throw Error(fmt::format("{}: not an HDF5 file (fiberlab files are HDF5)", path));
+  const h5::File f = h5::File::open_read(path);
+  return f.has_attr("/", "format") ? f.attr_string("/", "format") : std::string();
+}
+
 void write_bins(h5::File& f, const BinGrid& grid) {
   if (!f.exists("/bins")) f.create_group("/bins");
   f.write("/bins/theta_edges", {grid.theta_edges.size()}, grid.theta_edges);

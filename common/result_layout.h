@@ -28,6 +28,11 @@ std::int64_t read_format_version(const h5::File& f, const std::string& path);
 // it cannot be read.
 bool is_hdf5_file(const std::string& path);
 
+// The root attribute `format` of an HDF5 file (the kind, docs/FILE_FORMAT.md),
+// "" when it has none. Throws fiberlab::Error naming `path` when it is not
+// an HDF5 file or cannot be read.
+std::string file_format(const std::string& path);
+
 // /bins/theta_edges, /bins/phi_edges, /bins/solid_angle, and the attribute
 // /bins@theta_bins ("uniform" | "equal_area").
 void write_bins(h5::File& f, const BinGrid& grid);

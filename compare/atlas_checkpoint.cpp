@@ -14,8 +14,10 @@
 #include "analytic/model_registry.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
+#include "compare/atlas_file.h"
 #include "compare/fit.h"
 #include "sim/settings.h"
 
@@ -213,18 +215,31 @@ void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std
   f.set_attr("/", "params_after", lines_attr(flat.params_after));
   f.set_attr("/", "fit_keys", lines_attr(flat.fit_keys));
   f.set_attr("/", "comparison_columns", joined(comparison_columns(), ","));
-  f.write("photons", {F}, flat.photons);
-  f.write("shape", {F, 2}, flat.shape);
-  f.write("seconds", {F, 2}, flat.seconds);
-  f.write("theta_i", {F, K}, flat.theta_i);
-  f.write("sim_energy", {flat.sim_energy.size()}, flat.sim_energy);
-  f.write("sim_error", {flat.sim_error.size()}, flat.sim_error);
-  f.write("model_state", {F, M, 4}, flat.model_state);
-  f.write("model_seconds", {F, M}, flat.model_seconds);
-  if (!flat.comparisons.empty()) f.write("comparisons", {flat.comparisons.size() / columns, columns}, flat.comparisons);
+  const char* energies = "each saved fiber's K x L x C lobe energies (its own L, C), one fiber after another";
+  write_described(f, "/photons", {F}, flat.photons, "fiber", "photons", "photons per incident direction");
+  write_described(f, "/shape", {F, 2}, flat.shape, "fiber,field", "", "(lobes, channels) of each fiber");
+  write_described(f, "/seconds", {F, 2}, flat.seconds, "fiber,field", "seconds",
+                  "wall time of the simulation, of the comparisons and fits");
+  write_described(f, "/theta_i", {F, K}, flat.theta_i, "fiber,incidence", "radians", "incident inclinations");
+  write_described(f, "/sim_energy", {flat.sim_energy.size()}, flat.sim_energy, "fiber_incidence_lobe_channel",
+                  "fraction of incident light", std::string("simulated lobe energies: ") + energies);
+  write_described(f, "/sim_error", {flat.sim_error.size()}, flat.sim_error, "fiber_incidence_lobe_channel",
+                  "fraction of incident light", std::string("standard errors of sim_energy: ") + energies);
+  write_described(f, "/model_state", {F, M, 4}, flat.model_state, "fiber,model,field", "",
+                  "(applicable, fitted, comparison rows before, rows after) per fiber and model");
+  write_described(f, "/model_seconds", {F, M}, flat.model_seconds, "fiber,model", "seconds",
+                  "wall time of each model's comparison and fit");
+  if (!flat.comparisons.empty())
+    write_described(f, "/comparisons", {flat.comparisons.size() / columns, columns}, flat.comparisons, "row,field", "",
+                    "per fiber and model, its LobeComparison rows (compare/comparison.h) before, then after "
+                    "the fit; fields named by comparison_columns, each in its member's unit");
   if (!flat.fit_numbers.empty()) {
-    f.write("fit_numbers", {flat.fit_numbers.size() / kFitNumbers, kFitNumbers}, flat.fit_numbers);
-    f.write("fit_values", {flat.fit_values.size() / kFitValues, kFitValues}, flat.fit_values);
+    write_described(f, "/fit_numbers", {flat.fit_numbers.size() / kFitNumbers, kFitNumbers}, flat.fit_numbers,
+                    "fitted_model,field", "",
+                    "chi2_start, chi2, residuals, dof, iterations, evaluations, converged per fitted model");
+    write_described(f, "/fit_values", {flat.fit_values.size() / kFitValues, kFitValues}, flat.fit_values,
+                    "fit_key,field", "the key's unit (degrees for angles)",
+                    "start, value, error, error_unscaled, at_bound per key of each fitted model");
   }
 }
 
@@ -485,6 +500,7 @@ void write_atlas_checkpoint(const std::string& path, const AtlasRunSetup& setup,
     f.set_attr("/", "identity", atlas_config_identity(config));
     f.set_attr("/", "fibers_total", static_cast<std::uint64_t>(config.fibers.size()));
     f.set_attr("/", "fibers_saved", static_cast<std::uint64_t>(fibers.size()));
+    write_atlas_axis_names(f, config);
     if (!fibers.empty()) write_flat(f, flatten(fibers), fibers.size(), config.theta_i.size(), config.models.size());
     f.close();
   }
@@ -550,6 +566,15 @@ AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
                          "/dataset_digests differs: datasets swapped, edited or damaged)",
                          names[d]));
   return c;
+}
+
+std::string describe_atlas_checkpoint(const std::string& path) {
+  const h5::File f = h5::File::open_read(path);
+  return fmt::format("{}: fiberlab atlas checkpoint (software {}, created {})\nconfig {}, output {} (in the "
+                     "checkpoint's folder): {} of {} fibers saved\nresume with: fiberlab atlas --resume {}\n",
+                     path, f.attr_string("/", "software_version"), f.attr_string("/", "created_utc"),
+                     f.attr_string("/", "config_path"), f.attr_string("/", "output_name"),
+                     f.attr_uint64("/", "fibers_saved"), f.attr_uint64("/", "fibers_total"), path);
 }
 
 void check_same_atlas_config(const AtlasCheckpoint& checkpoint, const AtlasConfig& given,

@@ -69,6 +69,11 @@ void write_atlas_checkpoint(const std::string& path, const AtlasRunSetup& setup,
 // exactly as fit_model made it (atlas_start_params plus the fitted values).
 AtlasCheckpoint read_atlas_checkpoint(const std::string& path);
 
+// What `fiberlab info` prints for a checkpoint: the config and output it
+// runs, the fibers saved of the sweep's, the command that resumes it (from
+// the root attributes alone; --resume checks the rest).
+std::string describe_atlas_checkpoint(const std::string& path);
+
 // Refuses resuming with a config whose identity is not the checkpoint's
 // (--photons of the checkpoint applied to it first): one line naming the
 // checkpoint, the config and the first line that differs.

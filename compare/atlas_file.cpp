@@ -32,13 +32,12 @@ struct Shape {
   h5::Dims dims() const { return {F, K, L, C}; }
 };
 
-// One dataset and its description (common/file_schema.h describe()): each
-// array is named, shaped, written and described in one place.
+// One dataset and its description (common/file_schema.h): each array is
+// named, shaped, written and described in one place.
 template <class T>
 void put(h5::File& f, const std::string& path, const h5::Dims& dims, const std::vector<T>& data,
          const std::string& dimensions, const std::string& units, const std::string& description) {
-  f.write(path, dims, data);
-  describe(f, "/" + path, dimensions, units, description);
+  write_described(f, "/" + path, dims, data, dimensions, units, description);
 }
 
 void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResult>& fibers) {
@@ -164,9 +163,9 @@ void write_model(h5::File& f, const Shape& s, const std::string& name, const std
   put(f, g + "/judged", s.dims(), judged, kAtlasDims, "0/1", "1: the lobe has enough energy to be judged");
   put(f, g + "/fit_start", FP, start, "fiber,fit_key", key_unit, "start value of each fit key (attribute fit_keys)");
   put(f, g + "/fit_value", FP, value, "fiber,fit_key", key_unit, "fitted value");
-  put(f, g + "/fit_error", FP, error, "fiber,fit_key", "the key's unit",
+  put(f, g + "/fit_error", FP, error, "fiber,fit_key", key_unit,
       "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
-  put(f, g + "/fit_error_unscaled", FP, unscaled, "fiber,fit_key", "the key's unit", "sqrt(diag((J^T W J)^-1))");
+  put(f, g + "/fit_error_unscaled", FP, unscaled, "fiber,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
   put(f, g + "/fit_at_bound", FP, bound, "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
   put(f, g + "/fit_chi2_start", F, chi2_start, "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
   put(f, g + "/fit_chi2", F, chi2, "fiber", "", "the fit's chi-square at the minimum");
@@ -175,6 +174,17 @@ void write_model(h5::File& f, const Shape& s, const std::string& name, const std
 }
 
 }  // namespace
+
+void write_atlas_axis_names(h5::File& f, const AtlasConfig& config) {
+  int lobes = 0, channels = 0;
+  bool from_melanin = true;
+  for (const AtlasFiber& fiber : config.fibers) {
+    lobes = std::max(lobes, fiber.settings.tally.lobes);
+    channels = std::max(channels, static_cast<int>(fiber.settings.fiber.sigma_a.size()));
+    from_melanin = from_melanin && fiber.settings.fiber.eumelanin.has_value();
+  }
+  write_axis_names(f, lobes, channels, from_melanin);
+}
 
 void write_atlas_file(const std::string& path, const AtlasConfig& config,
                       const std::vector<AtlasFiberResult>& fibers) {
@@ -189,7 +199,7 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
     std::string models;
     for (const auto& m : config.models) models += (models.empty() ? "" : ",") + m;
     f.set_attr("/", "models", models);
-    f.set_attr("/", "lobe_names", join_names(lobe_names(static_cast<int>(s.L))));
+    write_atlas_axis_names(f, config);
     put(f, "theta_i", {s.K}, config.theta_i, "incidence", "radians", "incident inclinations, the same for every fiber");
     write_fibers(f, s, fibers);
     f.create_group("models");
@@ -197,6 +207,34 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
     f.close();
   }
   out.commit();
+}
+
+std::string describe_atlas_file(const std::string& path) {
+  const h5::File f = h5::File::open_read(path);
+  const h5::Dims F = f.shape("/fibers/photons");
+  if (F.size() != 1) throw Error(fmt::format("{}: /fibers/photons must be one-dimensional (F fibers)", path));
+  const h5::Dims K = f.shape("/theta_i");
+  if (K.size() != 1) throw Error(fmt::format("{}: /theta_i must be one-dimensional (K directions)", path));
+  std::string theta;
+  for (double t : f.read_doubles("/theta_i", K, "")) theta += fmt::format("{}{:g}", theta.empty() ? "" : ", ", rad_to_deg(t));
+  std::string s = fmt::format("{}: fiberlab atlas (software {}, created {})\n", path,
+                              f.attr_string("/", "software_version"), f.attr_string("/", "created_utc"));
+  s += fmt::format("{} fibers x {} incident direction(s) (theta_i {} deg), lobes {}, channels {}\n", F[0], K[0],
+                   theta, f.attr_string("/", "lobe_names"), f.attr_string("/", "channel_names"));
+  const auto count = [&](const std::string& name) {
+    std::size_t n = 0;
+    for (std::uint64_t v : f.read_uint64s(name, F, "fibers")) n += v != 0;
+    return n;
+  };
+  std::string models = f.attr_string("/", "models");
+  for (std::size_t start = 0; start < models.size();) {
+    const std::size_t comma = std::min(models.find(',', start), models.size());
+    const std::string m = models.substr(start, comma - start), g = "/models/" + m + "/";
+    s += fmt::format("model {}: applicable to {}, fitted to {}, converged on {} of {} fibers\n", m,
+                     count(g + "applicable"), count(g + "fitted"), count(g + "converged"), F[0]);
+    start = comma + 1;
+  }
+  return s;
 }
 
 }  // namespace fiberlab::compare

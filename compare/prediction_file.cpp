@@ -5,7 +5,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include "analytic/model_registry.h"
+#include "common/atomic_output.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 #include "common/units.h"
@@ -45,6 +48,39 @@ std::string split_lines_joined(const std::vector<std::string>& lines) {
 }
 
 }  // namespace
+
+void write_prediction(const std::string& path, const PredictionFile& p, const sim::Settings& settings,
+                      const analytic::ModelParams& params, const std::vector<std::string>& inputs) {
+  AtomicOutput out(path, inputs);
+  {
+    h5::File f = h5::File::create(out.temp_path(), out.target());
+    write_file_identity(f, "fiber-prediction", utc_timestamp());
+    f.set_attr("/", "config_yaml", sim::to_yaml(settings));
+    write_axis_names(f, p.lobes, p.channels, settings.fiber.eumelanin.has_value());
+    write_bins(f, p.grid);
+    write_incidences(f, p.theta_i, p.phi_i);
+    describe_bins_and_source(f);
+    f.create_group("/prediction");
+    const auto h = [](auto n) { return static_cast<hsize_t>(n); };
+    f.write_finite("/prediction/probability",
+                   {h(p.configs()), h(p.lobes), h(p.grid.n_theta()), h(p.grid.n_phi()), h(p.channels)},
+                   p.probability);
+    describe(f, "/prediction/probability", kHistogramDims, "probability",
+             "the model's probability of each bin (its density integrated over the bin)");
+    f.set_attr("/prediction", "model", p.model);
+    std::string approx;
+    for (const std::string& a : analytic::approximations(p.model, params)) approx += a + "\n";
+    f.set_attr("/prediction", "approximations", approx);
+    // Only this model's parameters (its table), angles in radians.
+    for (const analytic::ParamAttribute& a : analytic::param_attributes(p.model, params)) {
+      if (a.is_text) f.set_attr("/prediction", a.name, a.text);
+      else if (a.numbers.size() == 1) f.set_attr("/prediction", a.name, a.numbers[0]);
+      else f.set_attr("/prediction", a.name, a.numbers);
+    }
+    f.close();
+  }
+  out.commit();
+}
 
 bool is_prediction_file(const std::string& path) {
   try {

@@ -17,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "analytic/model_params.h"
 #include "common/bin_grid.h"
 #include "sim/result_file.h"
 
@@ -36,6 +37,16 @@ struct PredictionFile {
     return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
   }
 };
+
+// Writes `pred` (grid, theta_i, phi_i, lobes, channels, probability; its
+// model is the registry's name) atomically as `fiberlab predict` does: the
+// format and identity, the config it was made for, lobe and channel names,
+// every dataset described (docs/FILE_FORMAT.md), and /prediction's attributes
+// model, approximations and the model's parameters (angles in radians).
+// `inputs`: files the output must not replace. Refuses a non-finite
+// probability with one line, writing nothing.
+void write_prediction(const std::string& path, const PredictionFile& pred, const sim::Settings& settings,
+                      const analytic::ModelParams& params, const std::vector<std::string>& inputs = {});
 
 // Whether `path` is an HDF5 file whose root attribute format is
 // "fiber-prediction" (false for anything else, including missing files).

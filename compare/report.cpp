@@ -18,6 +18,7 @@
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 #include "compare/report_folder.h"
+#include "compare/verdict_tables.h"
 
 #ifndef FIBERLAB_SOURCE_DIR
 #define FIBERLAB_SOURCE_DIR ""
@@ -79,11 +80,7 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     f.write("sim_p", dims, p);
     f.write("sim_se", dims, se);
     f.write("model_p", dims, m);
-    describe(f, "/theta_edges", "theta_edge", "radians", "theta_r bin edges, in [-pi/2, pi/2]");
-    describe(f, "/phi_edges", "phi_edge", "radians", "relative azimuth phi_r - phi_i bin edges, in [-pi, pi]");
-    describe(f, "/solid_angle", "theta,phi", "steradians", "(sin theta_hi - sin theta_lo)(phi_hi - phi_lo)");
-    describe(f, "/theta_i", "incidence", "radians", "incident inclination per incident direction");
-    describe(f, "/phi_i", "incidence", "radians", "incident azimuth (NaN: randomly rotated fiber)");
+    describe_bins_and_source(f, {.bins = "/", .source = "/"});
     describe(f, "/photons", "incidence", "photons", "photons launched per incident direction");
     describe(f, "/sim_p", kHistogramDims, "probability", "simulated probability of each bin, S1/N");
     describe(f, "/sim_se", kHistogramDims, "probability", "standard error of sim_p");
@@ -91,6 +88,40 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     f.close();
   }
   out.commit();
+}
+
+std::string describe_report_data(const std::string& path) {
+  const h5::File f = h5::File::open_read(path);
+  const h5::Dims d = f.shape("/sim_p");
+  if (d.size() != 5 || d[0] == 0)
+    throw Error(fmt::format("{}: /sim_p must be K x L x n_theta x n_phi x C with K >= 1", path));
+  const std::vector<double> theta_i = f.read_doubles("/theta_i", {d[0]}, "sim_p's first dimension");
+  const std::vector<double> phi_i = f.read_doubles("/phi_i", {d[0]}, "sim_p's first dimension");
+  const std::vector<double> sim = f.read_doubles("/sim_p", d, "");
+  const std::vector<double> model = f.read_doubles("/model_p", d, "sim_p's shape");
+  const std::size_t L = d[1], bins = d[2] * d[3], C = d[4];
+  std::string s = fmt::format("{}: fiberlab report data of `{}` (model {}; software {}, created {})\n", path,
+                              f.attr_string("/", "kind"), f.attr_string("/", "model"),
+                              f.attr_string("/", "software_version"), f.attr_string("/", "created_utc"));
+  s += fmt::format("bins: {} x {} (theta x phi), lobes {}, channels {}, {} incident direction(s)\n", d[2], d[3],
+                   f.attr_string("/", "lobe_names"), f.attr_string("/", "channel_names"), d[0]);
+  s += "lobe energies, simulated / model, per channel:\n";
+  for (std::size_t k = 0; k < d[0]; ++k) {
+    s += incidence_label(theta_i[k], phi_i[k]) + ":";
+    for (std::size_t l = 0; l < L; ++l) {
+      s += fmt::format("  {}", lobe_name(static_cast<int>(l), static_cast<int>(L)));
+      for (std::size_t c = 0; c < C; ++c) {
+        double e_sim = 0.0, e_model = 0.0;
+        for (std::size_t b = 0; b < bins; ++b) {
+          e_sim += sim[((k * L + l) * bins + b) * C + c];
+          e_model += model[((k * L + l) * bins + b) * C + c];
+        }
+        s += fmt::format(" {:.4f}/{:.4f}", e_sim, e_model);
+      }
+    }
+    s += "\n";
+  }
+  return s;
 }
 
 std::string plot_script_path() {

@@ -27,6 +27,11 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& result,
                         const std::vector<std::vector<double>>& model_bins,
                         const std::string& model_label, int plot_channel);
 
+// What `fiberlab info` prints for a compare report's report_data.h5: the
+// model, the bins, lobes and channels, and per incident direction each
+// lobe's simulated and predicted energy (the sums of sim_p and model_p).
+std::string describe_report_data(const std::string& path);
+
 // The plotting script: $FIBERLAB_PLOT_SCRIPT, else
 // FIBERLAB_SOURCE_DIR/scripts/plot_report.py. Empty when neither exists.
 std::string plot_script_path();

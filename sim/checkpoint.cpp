@@ -6,8 +6,10 @@
 #include <string_view>
 
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/h5_integrity.h"
 #include "common/result_layout.h"
+#include "common/units.h"
 #include "sim/result_stream.h"
 
 namespace fiberlab::sim {
@@ -92,6 +94,9 @@ void write_checkpoint(const std::string& path, const Simulation& sim, const RunP
   f.write("/checkpoint/next_photon", {state.next_photon.size()}, state.next_photon);
   std::vector<std::uint64_t> done(state.done.begin(), state.done.end());
   f.write("/checkpoint/done", {done.size()}, done);
+  describe(f, "/checkpoint/next_photon", "incidence", "photons",
+           "photons [0, next_photon) of each incident direction are in the sums");
+  describe(f, "/checkpoint/done", "incidence", "0/1", "1 once the incident direction is finished");
   w.commit();
 }
 
@@ -166,6 +171,22 @@ Checkpoint read_checkpoint(const std::string& path, bool with_tallies) {
   if (!f.has_attr("/", h5::kDigestAttribute))
     inconsistent(path, fmt::format("root attribute {} is missing", h5::kDigestAttribute));
   return c;
+}
+
+std::string describe_checkpoint(const std::string& path) {
+  const Checkpoint c = read_checkpoint(path, /*with_tallies=*/false);
+  const ResultReader reader(path, /*allow_empty_directions=*/true);
+  std::string s = fmt::format("{}: fiberlab run checkpoint of {} (software {}, created {}), seed {}\n", path,
+                              c.settings.output, reader.header().software_version, reader.header().created_utc,
+                              c.settings.seed);
+  const std::vector<Settings::Incidence> inc = c.settings.incidences();
+  for (std::size_t k = 0; k < inc.size(); ++k) {
+    const std::string phi =
+        std::isnan(inc[k].phi_i) ? std::string("uniform") : fmt::format("{:g} deg", rad_to_deg(inc[k].phi_i));
+    s += fmt::format("theta_i {:g} deg, phi_i {}: {} of {} photons{}\n", rad_to_deg(inc[k].theta_i), phi,
+                     c.state.next_photon[k], c.settings.photons, c.state.done[k] ? ", finished" : "");
+  }
+  return s + fmt::format("resume with: fiberlab run --resume {}\n", path);
 }
 
 void check_same_config(const Checkpoint& checkpoint, const Settings& given,

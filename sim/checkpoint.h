@@ -39,6 +39,11 @@ struct Checkpoint {
 // version or checkpoint format, or one whose contents disagree with its config.
 Checkpoint read_checkpoint(const std::string& path, bool with_tallies);
 
+// What `fiberlab info` prints for a checkpoint: its output, each incident
+// direction's photons so far and whether it is finished, the command that
+// resumes it. Read with read_checkpoint (the same refusals).
+std::string describe_checkpoint(const std::string& path);
+
 // Refuses resuming with a config (and flags) other than the checkpoint's.
 void check_same_config(const Checkpoint& checkpoint, const Settings& given,
                        const std::string& checkpoint_file);

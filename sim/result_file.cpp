@@ -83,6 +83,16 @@ void write_result_header(h5::File& f, const ResultFile& r) {
   write_parameters(f, r.settings);
 }
 
+void describe_result_file(h5::File& f, const ResultFile& r) {
+  write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
+  describe_bins_and_source(f);
+  describe_result_datasets(f);
+  if (f.exists("/exact")) describe_exact_datasets(f);
+  if (f.exists("/merge/direction_seeds"))
+    describe(f, "/merge/direction_seeds", "row,field", "",
+             "(direction index, seed) per row: the seeds summed into each incident direction");
+}
+
 void write_result(const ResultFile& r, const std::string& path,
                   const std::vector<std::string>& inputs) {
   AtomicOutput out(path, inputs);
@@ -102,10 +112,8 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
     f.write("/ledger/lost", {K, C}, r.lost);
-    // Descriptive attributes (docs/FILE_FORMAT.md): axis names, units, lobe and channel names.
-    write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
-    describe_bins_and_source(f);
-    describe_result_datasets(f);
+    describe_result_file(f, r);
+    describe_tally_photons(f);
     f.close();
   }
   out.commit();

@@ -49,6 +49,14 @@ void write_result(const ResultFile& result, const std::string& path,
 // Everything but /tally and /ledger: identity, seeds, config, /bins, /source
 // and the parameter groups (shared with the streaming writer, sim/result_stream).
 void write_result_header(h5::File& f, const ResultFile& header);
+// The descriptive attributes of a result file (docs/FILE_FORMAT.md): root
+// lobe_names and channel_names, and each dataset's dimensions, units and
+// description, for /bins, /source, /tally, /ledger and, when the file has
+// them, /exact and /merge; all but /tally/photons (describe_tally_photons,
+// common/file_schema.h), which the streaming writer writes last. Called by
+// every writer of results (write_result; ResultWriter: run, merge,
+// checkpoints) once those datasets exist.
+void describe_result_file(h5::File& f, const ResultFile& header);
 // Reads and validates a result file (sim/result_reader.cpp): format and
 // format_version, every dataset's shape against K x L x n_theta x n_phi x C
 // from the stored config_yaml (checked before anything is allocated), /bins

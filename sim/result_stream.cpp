@@ -10,6 +10,7 @@
 #include <iterator>
 
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/result_layout.h"
 #include "sim/tally_consistency.h"
 
@@ -123,6 +124,9 @@ void ResultWriter::create_file() {
     f.create_group("/merge");
     f.write("/merge/direction_seeds", {rows.size() / 2, 2}, rows);
   }
+  // Attributes only (object headers, no chunk): on this thread, HDF5's, while
+  // the others deflate the first direction (write_direction).
+  describe_result_file(f, header_);
 }
 
 void ResultWriter::write(std::size_t k, const ExactTally& t) {
@@ -245,6 +249,7 @@ void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const B
 
 void ResultWriter::commit() {
   file().write("/tally/photons", {photons_.size()}, photons_);
+  describe_tally_photons(*file_);
   file_->close();
   file_.reset();
   out_.commit();

@@ -83,7 +83,8 @@ class ResultWriter {
   // deflated into its rows of out, on one thread with its scratch.
   void prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins, Scratch& s,
                     std::array<h5::File::PreparedRow, 5>& out);
-  // The temporary file with the header and every dataset (none written).
+  // The temporary file with the header and every dataset (none written),
+  // described (describe_result_file).
   void create_file();
   // The row plan of bin dataset `name` as create_file makes it.
   h5::File::RowPlan planned(const std::string& name) const;
