@@ -363,7 +363,9 @@ def plot_energy_lobes(r, np, plt):
                 sel = sorted((x for x in rows if x["lobe"] == l and x["channel"] == c and x["phi_i_deg"] == phi),
                              key=lambda x: x["theta_i_deg"])
                 th = [x["theta_i_deg"] for x in sel]
-                ax.plot(th, [x["model_energy"] for x in sel], line, color="C1", lw=1.4, zorder=2)
+                # A wide dash marks each model value: with one theta_i there is no line to see.
+                ax.plot(th, [x["model_energy"] for x in sel], line, marker="_", ms=16, mew=1.6, color="C1", lw=1.4,
+                        zorder=2)
                 ax.errorbar(th, [x["sim_energy"] for x in sel], yerr=[x["sim_error"] or 0 for x in sel],
                             fmt=marker, ms=4, color="k", mfc="white" if c else "k", zorder=3)
             title = r["lobe_names"][l] + ("" if phi is None or len(phis) == 1 else ", phi_i %g deg" % phi)
@@ -373,7 +375,7 @@ def plot_energy_lobes(r, np, plt):
             if l == 0:
                 ax.set_ylabel("energy (fraction of incident light)", fontsize=9)
     handles = [Line2D([], [], color="k", marker="o", ls="none", label="simulation (1 se)"),
-               Line2D([], [], color="C1", lw=1.4, label=r["model"])]
+               Line2D([], [], color="C1", lw=1.4, marker="_", ms=16, mew=1.6, label=r["model"])]
     if C > 1:
         for c in range(C):
             line, marker = CHANNEL_STYLES[c % len(CHANNEL_STYLES)]

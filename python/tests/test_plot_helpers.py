@@ -211,6 +211,7 @@ def test_compare_energy_panels_one_colour_per_source_channels_by_style(plot_repo
         model = [ln for ln in ax.get_lines() if ln.get_linestyle() not in ("None", "none", "")]
         assert len(model) == 3 and len(distinct_colours(model)) == 1  # one colour for the model ...
         assert len({ln.get_linestyle() for ln in model}) == 3  # ... the channels by line style
+        assert all(ln.get_marker() not in (None, "", "None") for ln in model)  # seen with a single theta_i too
         assert "(deg)" in ax.get_xlabel()
     assert "fraction of incident light" in axes[0].get_ylabel()
     assert_legends_outside_axes(fig)
