@@ -234,6 +234,7 @@ std::vector<std::string> per_lobe_keys(const std::string& model_name, const std:
 
 namespace {
 constexpr double kChi2DropTolerance = 1e-2;  // of max(1, chi2/dof): fit.h "Stopping"
+constexpr int kExtensions = 3;               // doublings of a step along a valley: fit.h
 }  // namespace
 
 const char* outcome_name(FitOutcome o) {
@@ -356,6 +357,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     return e;
   };
   std::string last_move;  // the last accepted step, for a fit stopped by the cap
+  Eigen::VectorXd last_step = Eigen::VectorXd::Zero(n);
   for (fr.iterations = 0; fr.iterations < max_iterations; ++fr.iterations) {
     const Eigen::MatrixXd A = J.transpose() * J;
     Eigen::VectorXd g = J.transpose() * r;
@@ -379,17 +381,41 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
           gh[j] = 0.0;
         }
       const Eigen::VectorXd xn = project(x + Ad.ldlt().solve(-gh));
-      const Eigen::VectorXd step = xn - x;
+      Eigen::VectorXd step = xn - x;
       const Eigen::VectorXd rn = residuals(xn);
       ++fr.evaluations;
       const double chi2n = rn.squaredNorm();
       if (chi2n < chi2) {
-        const double drop = chi2 - chi2n;
+        double drop = chi2 - chi2n;
+        const Eigen::VectorXd from = x;
         x = xn;
         r = rn;
         chi2 = chi2n;
         lambda = std::max(lambda / 10.0, 1e-9);
         improved = true;
+        // A valley: with large residuals (a model that does not describe the
+        // data) J^T J underrates how far chi2 keeps falling, and successive
+        // steps are short and point the same way. Then the step is doubled
+        // while chi2 keeps falling (at most kExtensions evaluations).
+        const double norms = step.norm() * last_step.norm();
+        if (norms > 0.0 && step.dot(last_step) > 0.9 * norms) {
+          Eigen::VectorXd ahead = step;
+          for (int e = 0; e < kExtensions; ++e) {
+            ahead *= 2.0;
+            const Eigen::VectorXd xe = project(x + ahead);
+            if (xe == x) break;
+            const Eigen::VectorXd re = residuals(xe);
+            ++fr.evaluations;
+            const double chi2e = re.squaredNorm();
+            if (!(chi2e < chi2)) break;
+            drop += chi2 - chi2e;
+            x = xe;
+            r = re;
+            chi2 = chi2e;
+          }
+          step = x - from;
+        }
+        last_step = step;
         // The largest step in units of its parameter's error.
         double step_in_errors = 0.0;
         for (int j = 0; j < n; ++j)

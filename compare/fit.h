@@ -31,6 +31,10 @@
 // error; converged also when no step lowers
 // chi2 at any damping (a minimum, to the prediction's resolution). The
 // result says which (stop_reason) and whether a parameter sits on a bound.
+// Along a valley (an accepted step within 26 deg of the previous one) the
+// step is doubled while chi2 keeps falling, up to 3 times: with a model that
+// does not describe the data, Gauss-Newton steps are short there and the
+// fit would otherwise crawl.
 //
 // Bounds: each value stays in the table's range (fit_range(); projected
 // steps, a parameter held at a bound while the gradient points outwards).
