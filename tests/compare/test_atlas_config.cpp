@@ -36,7 +36,7 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());
   // huang2022's quadrature sized for the atlas (the config's comment says why).
   EXPECT_EQ(full.model_parameters.at("huang2022"), std::vector<std::string>{"quadrature_points=262144"});
-  EXPECT_EQ(full.max_iterations, 10);
+  EXPECT_EQ(full.max_iterations, 40);
   // The medium sweep: 8 of the default's fibers with its settings.
   const AtlasConfig medium = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas_medium.yaml");
   EXPECT_EQ(medium.fibers.size(), 8u);
