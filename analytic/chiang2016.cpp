@@ -8,6 +8,7 @@
 #include "analytic/deon2011.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
+#include "analytic/pbrt_v4_mp.h"
 #include "analytic/physical_defaults.h"
 #include "analytic/quadrature.h"
 #include "analytic/smooth_cylinder.h"
@@ -206,7 +207,12 @@ void order_energy(const cylinder::Attenuation& att, int p, std::vector<double>& 
 
 // Integral of M_p(v, theta_eff, theta_r) cos(theta_r) over every theta bin,
 // added to out[i].
-void theta_bin_integrals(double v, double theta_eff, const BinGrid& grid, double refine,
+// log M_p: d'Eon's (the paper's) or pbrt-v4's as shipped (pbrt_v4_mp.h).
+double log_mp(bool pbrt, double v, double theta_i, double theta_r) {
+  return pbrt ? pbrt_v4::log_M_p(v, theta_i, theta_r) : deon2011::log_M_p(v, theta_i, theta_r);
+}
+
+void theta_bin_integrals(bool pbrt, double v, double theta_eff, const BinGrid& grid, double refine,
                          std::vector<double>& out) {
   const double peak = -theta_eff;
   if (v < kDeltaV) {
@@ -228,7 +234,7 @@ void theta_bin_integrals(double v, double theta_eff, const BinGrid& grid, double
       const double mid = t0 + (2 * k + 1) * half;
       for (int q = 0; q < kOrder; ++q) {
         const double tr = mid + half * gl.x[q];
-        sum += half * gl.w[q] * std::exp(deon2011::log_M_p(v, theta_eff, tr)) * std::cos(tr);
+        sum += half * gl.w[q] * std::exp(log_mp(pbrt, v, theta_eff, tr)) * std::cos(tr);
       }
     }
     out[i] += sum;
@@ -299,7 +305,8 @@ void Chiang2016::density(int lobe, double theta_i, double, double theta_r, doubl
   for (int p = 0; p <= kResidualP; ++p) {
     if (lobe_of(p, L) != lobe) continue;
     const double v = std::max(variance(p), kDensityMinV);
-    const double m = std::exp(deon2011::log_M_p(v, rotated_theta_i(p, theta_i), theta_r)) * std::cos(theta_r);
+    const double m =
+        std::exp(log_mp(params_.pbrt_v4_mp, v, rotated_theta_i(p, theta_i), theta_r)) * std::cos(theta_r);
     std::fill(n.begin(), n.end(), 0.0);
     if (p < kResidualP) {
       logistic_nodes(p, att.eta_p(), s, {phi}, true, 1.0, nodes);
@@ -341,7 +348,7 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
   std::vector<HNode> nodes;
   for (int p = 0; p <= kResidualP; ++p) {
     theta_w.assign(nt, 0.0);
-    theta_bin_integrals(variance(p), rotated_theta_i(p, theta_i), grid, refine_, theta_w);
+    theta_bin_integrals(params_.pbrt_v4_mp, variance(p), rotated_theta_i(p, theta_i), grid, refine_, theta_w);
     phi_w.assign(static_cast<std::size_t>(np) * C, 0.0);
     if (p == kResidualP) {
       // The residual is uniform in phi: E_3 / n_phi per bin.
@@ -381,14 +388,18 @@ std::unique_ptr<Model> make_chiang2016(const ModelParams& mp) {
   p.beta_n = mp.beta_n;
   p.alpha = mp.scale_tilt;
   p.lobes = mp.lobes;
+  p.pbrt_v4_mp = mp.chiang_mp == 1;
   return std::make_unique<Chiang2016>(p);
 }
 
 namespace {
 
-std::vector<std::string> chiang_approximations(const ModelParams&) {
+std::vector<std::string> chiang_approximations(const ModelParams& p) {
   return {"far field: pbrt's BCSDF averaged over h, with pbrt's wo read as our wi (A_p at theta_i)",
-          "M_p: d'Eon's von Mises-Fisher lobe; tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha",
+          p.chiang_mp == 1
+              ? "M_p: pbrt-v4's as shipped (10-term I0, its log I0 above 12, csch(1/v) ~ 2 exp(-1/v) for v <= 0.1); "
+                "tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha"
+              : "M_p: d'Eon's von Mises-Fisher lobe; tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha",
           "N_p: trimmed logistic about Phi(p, h) (not a physical detector)",
           "every order p >= 3 in one lobe, uniform in phi (p_max = 3)",
           "absorption: the chord (SPEC s7)"};
@@ -421,6 +432,11 @@ ModelInfo chiang2016_info() {
               fittable(beta_m, 0.0, 1.0),
               fittable(beta_n, 0.0, 1.0),
               fittable(alpha, -45.0 + 1e-6, 45.0 - 1e-6),
+              choice_param("mp",
+                           "longitudinal function M_p: exact (d'Eon 2011 Eq. 7, the paper's) or pbrt_v4 (pbrt-v4's "
+                           "HairBxDF numerics as shipped: 10-term I0, its asymptotic log I0 above 12)",
+                           "exact", {"exact", "pbrt_v4"}, [](ModelParams& p, int i) { p.chiang_mp = i; },
+                           [](const ModelParams& p) { return p.chiang_mp; }),
               lobes_param()};
   m.make = [](const ModelParams& p) { return make_chiang2016(p); };
   m.approximations = chiang_approximations;

@@ -89,6 +89,9 @@ struct Chiang2016Params {
   double beta_m = 0.3, beta_n = 0.3;    // in [0, 1]
   double alpha = 0.0;                   // scale tilt, radians (sign: see above)
   int lobes = 4;                        // 1..4
+  // M_p: false d'Eon 2011 Eq. 7 exactly (the paper's function); true
+  // pbrt-v4's numerics as shipped (analytic/pbrt_v4_mp.h).
+  bool pbrt_v4_mp = false;
 };
 
 class Chiang2016 : public Model {

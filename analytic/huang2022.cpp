@@ -10,6 +10,7 @@
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
 #include "analytic/physical_defaults.h"
+#include "analytic/quadrature.h"
 #include "common/error.h"
 #include "common/fresnel.h"
 #include "common/ggx.h"
@@ -28,31 +29,81 @@ constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta 
 // Halton's point set: coordinate k of point i is the radical inverse of i in
 // the k-th prime base. Deterministic; its one-dimensional projections are
 // stratified, the first (base 2) exactly for N a power of 2.
-constexpr unsigned kBases[9] = {2, 3, 5, 7, 11, 13, 17, 19, 23};
+constexpr int kDims = 9;
+constexpr unsigned kBases[kDims] = {2, 3, 5, 7, 11, 13, 17, 19, 23};
 
-double radical_inverse(std::uint64_t i, unsigned base) {
-  const double inv = 1.0 / base;
-  double f = inv, r = 0.0;
-  while (i > 0) {
-    r += static_cast<double>(i % base) * f;
-    i /= base;
-    f *= inv;
+// The points i = first, first + 1, ... in order. The radical inverse of i in
+// base b is sum_k T(c_k) / B^k over i's digits c_k in base B = b^e (a block
+// of e base-b digits; T the radical inverse of a block, tabulated): the
+// blocks are carried as i advances, so no point needs a division.
+class Halton {
+ public:
+  Halton(std::uint64_t first, long n, std::uint64_t end) : half_cell_(0.5 / static_cast<double>(n)) {
+    for (int k = 0; k < kDims; ++k) {
+      Digits& d = digits_[k];
+      const unsigned b = kBases[k];
+      d.block = 1;
+      int e = 0;
+      while (d.block * b <= kBlockMax) d.block *= b, ++e;
+      d.table.resize(d.block);
+      for (unsigned j = 0; j < d.block; ++j) {
+        // radical inverse of the e-digit block j: the digits of j reversed.
+        double f = 1.0 / b, r = 0.0;
+        for (unsigned x = j, q = 0; q < static_cast<unsigned>(e); ++q, x /= b, f /= b) r += (x % b) * f;
+        d.table[j] = r;
+      }
+      d.inv_block = 1.0 / d.block;
+      std::uint64_t x = first;
+      for (int q = 0; q < kMaxBlocks; ++q, x /= d.block) d.c[q] = static_cast<unsigned>(x % d.block);
+      d.used = 1;  // blocks that any index below `end` has
+      for (std::uint64_t top = end / d.block; top > 0 && d.used < kMaxBlocks; top /= d.block) ++d.used;
+    }
   }
-  return r;
-}
+  // The current point; then advance().
+  void get(double* u) const {
+    for (int k = 0; k < kDims; ++k) {
+      const Digits& d = digits_[k];
+      double r = 0.0;
+      for (int q = d.used - 1; q >= 0; --q) r = (r + d.table[d.c[q]]) * (q > 0 ? d.inv_block : 1.0);
+      u[k] = r;
+    }
+    u[0] += half_cell_;  // midpoints in dimension 0
+    if (u[0] >= 1.0) u[0] -= 1.0;
+  }
+  void advance() {
+    for (Digits& d : digits_)
+      for (int q = 0; q < kMaxBlocks; ++q) {
+        if (++d.c[q] < d.block) break;
+        d.c[q] = 0;
+      }
+  }
+
+ private:
+  static constexpr unsigned kBlockMax = 4096;  // tables of at most 4096 entries (32 KiB)
+  static constexpr int kMaxBlocks = 8;          // 23^2 = 529 per block: 8 blocks hold i < 2^64
+  struct Digits {
+    unsigned block = 1;
+    int used = kMaxBlocks;
+    double inv_block = 1.0;
+    std::vector<double> table;
+    unsigned c[kMaxBlocks] = {};
+  };
+  Digits digits_[kDims];
+  double half_cell_;
+};
 
 // Coordinates: 0 the entry angle, 1-2 / 3-4 / 5-6 the microfacet normals of
 // interfaces 1 / 2 / 3, 7-8 the residual's spread.
 struct Point {
-  double u[9];
+  double u[kDims];
 };
-Point point(std::uint64_t i, long n) {
-  Point p;
-  p.u[0] = radical_inverse(i, 2) + 0.5 / static_cast<double>(n);  // midpoints in dimension 0
-  if (p.u[0] >= 1.0) p.u[0] -= 1.0;
-  for (int k = 1; k < 9; ++k) p.u[k] = radical_inverse(i, kBases[k]);
-  return p;
-}
+
+// Per-channel weights without allocation (at most 8 channels: the
+// constructor's limit).
+constexpr int kMaxChannels = 8;
+struct Weights {
+  double c[kMaxChannels];
+};
 
 // ---- Geometry (SPEC s2) ----------------------------------------------------------
 // A boundary point of the ellipse (semi-axes rv, rw) with its outward macro
@@ -129,10 +180,12 @@ class Surface {
   Surface(double alpha, HuangMasking masking) : a_(alpha), masking_(masking) {}
   double alpha() const { return a_; }
   // Smith's Lambda of a direction at |cos| c to the mesonormal (isotropic GGX).
+  // ggx::Lambda's formula for an isotropic alpha written in c alone:
+  // 1/a^2 = alpha^2 tan^2 = alpha^2 (1 - c^2) / c^2 (inf at c = 0, as there).
   double lambda(double c) const {
     if (a_ == 0.0) return 0.0;
     c = std::min(1.0, std::abs(c));
-    return ggx::Lambda(Vec3(std::sqrt(1.0 - c * c), 0.0, c), a_, a_);
+    return 0.5 * (-1.0 + std::sqrt(1.0 + a_ * a_ * (1.0 - c * c) / (c * c)));
   }
   // Weight of the leaving direction given the normals were drawn from the
   // arriving direction's VNDF (which holds G1 of the arrival): separable
@@ -206,10 +259,11 @@ class Paths {
     // the paper's flux over the mesonormal scales it by (wi.ns)/(wi.n0).
     double w0 = base * 0.5 * kPi * std::cos(g);
     if (p_.mesonormal_flux) w0 *= std::max(0.0, meso) / macro;
-    std::vector<double> w(C_, w0);
+    Weights w;
+    for (int c = 0; c < C_; ++c) w.c[c] = w0;
     sink.incident(w0);
     if (!(macro > 0.0) || w0 == 0.0) return;
-    if (!(meso > 0.0)) return sink.lost(false, w.data());  // macro flux only: no visible scale
+    if (!(meso > 0.0)) return sink.lost(false, w.c);  // macro flux only: no visible scale
     const Vec3 m = surface_.normal(h.ns, wi_, pt.u[1], pt.u[2]);
     const double ci = wi_.dot(m);
     const double F = fresnel_dielectric(ci, p_.eta);
@@ -233,42 +287,43 @@ class Paths {
   // side = +1 outside (arriving along d0 from outside) and -1 inside.
   template <class Next>
   void branch(int inside_events, const Vec3& d, const Vec3& o, const Hit& h, int cross,
-              double prob, const std::vector<double>& w, Sink& sink, Next next) const {
+              double prob, const Weights& w, Sink& sink, Next next) const {
     const double side = inside_events == 0 ? 1.0 : -1.0;
     const Vec3 nf = side * h.ns, nm = side * h.n0;
-    std::vector<double> wo(C_), lost(C_);
+    Weights wo, lost;
     const double on = o.dot(nf) * cross, om = o.dot(nm) * cross;
     if (!(on > 0.0) || !(om > 0.0)) {
-      for (int c = 0; c < C_; ++c) lost[c] = w[c] * prob;
-      if (prob > 0.0) sink.lost(false, lost.data());
+      for (int c = 0; c < C_; ++c) lost.c[c] = w.c[c] * prob;
+      if (prob > 0.0) sink.lost(false, lost.c);
       return;
     }
     const double g = surface_.leaving(-d.dot(nf), on);
     for (int c = 0; c < C_; ++c) {
-      wo[c] = w[c] * prob * g;
-      lost[c] = w[c] * prob * (1.0 - g);
+      wo.c[c] = w.c[c] * prob * g;
+      lost.c[c] = w.c[c] * prob * (1.0 - g);
     }
-    if (g < 1.0) sink.lost(true, lost.data());
-    if (prob > 0.0) next(o, wo.data());
+    if (g < 1.0) sink.lost(true, lost.c);
+    if (prob > 0.0) next(o, wo.c);
   }
 
   // Segment k (1 or 2) from `from` along d with weight w, then the event at
   // its end. For k = 2: a1 the first segment's transmittance, t2 the Fresnel
   // transmittance of interface 2 (both for the residual).
   void inside(const Point& pt, int k, const Hit& from, const Vec3& d, const double* w, Sink& sink,
-              const std::vector<double>* a1, double t2) const {
+              const Weights* a1, double t2) const {
     Hit h;
     double len;
-    std::vector<double> wa(w, w + C_), a(C_);
-    if (!fiber_.next(from, d, h, len)) return sink.lost(false, wa.data());
+    Weights wa, a;
+    for (int c = 0; c < C_; ++c) wa.c[c] = w[c];
+    if (!fiber_.next(from, d, h, len)) return sink.lost(false, wa.c);
     for (int c = 0; c < C_; ++c) {
-      a[c] = std::exp(-p_.sigma_a[c] * len);  // the chord's 3D length (SPEC s4)
-      wa[c] *= a[c];
+      a.c[c] = std::exp(-p_.sigma_a[c] * len);  // the chord's 3D length (SPEC s4)
+      wa.c[c] *= a.c[c];
     }
-    if (!sink.arrive(k - 1, h, d, wa.data())) return;
+    if (!sink.arrive(k - 1, h, d, wa.c)) return;
     const Vec3 nf = -h.ns;
     const Vec3 wv = -d;
-    if (!(wv.dot(nf) > 0.0)) return sink.lost(false, wa.data());  // the scale faces away
+    if (!(wv.dot(nf) > 0.0)) return sink.lost(false, wa.c);  // the scale faces away
     const Vec3 m = surface_.normal(nf, wv, pt.u[2 * k + 1], pt.u[2 * k + 2]);
     const double F = fresnel_dielectric(wv.dot(m), 1.0 / p_.eta);
     // Out: order p = k.
@@ -290,12 +345,12 @@ class Paths {
     // here: the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)).
     branch(1, d, r, h, +1, F, wa, sink, [&](const Vec3&, const double* wr) {
       const double t_avg = std::max(1e-5, 0.5 * (t2 + (1.0 - F)));
-      std::vector<double> e(C_);
+      Weights e;
       for (int c = 0; c < C_; ++c) {
-        const double a_avg = std::sqrt((*a1)[c] * a[c]);
-        e[c] = wr[c] * a_avg * t_avg / (1.0 - a_avg * (1.0 - t_avg));
+        const double a_avg = std::sqrt(a1->c[c] * a.c[c]);
+        e.c[c] = wr[c] * a_avg * t_avg / (1.0 - a_avg * (1.0 - t_avg));
       }
-      sink.residual(e.data(), pt.u[7], pt.u[8]);
+      sink.residual(e.c, pt.u[7], pt.u[8]);
     });
   }
 
@@ -309,7 +364,12 @@ class Paths {
 // Runs every point of an n-point set through the paths.
 void integrate(const Paths& paths, long n, Sink& sink) {
   const double base = 1.0 / static_cast<double>(n);
-  for (long i = 0; i < n; ++i) paths.trace(point(static_cast<std::uint64_t>(i), n), base, sink);
+  Halton set(0, n, static_cast<std::uint64_t>(n));
+  Point pt;
+  for (long i = 0; i < n; ++i, set.advance()) {
+    set.get(pt.u);
+    paths.trace(pt, base, sink);
+  }
 }
 
 // The residual's inclination for the point (u1, u2): a von Mises-Fisher
@@ -339,7 +399,7 @@ Huang2022::Huang2022(Huang2022Params params) : params_(std::move(params)) {
     bad(fmt::format("eccentricity = {} must be in (0, 1]", p.eccentricity));
   if (p.lobes < 1 || p.lobes > 4)
     bad(fmt::format("lobes = {} must be 1..4 (every order p >= 3 is one residual lobe)", p.lobes));
-  if (p.sigma_a.empty() || p.sigma_a.size() > 8) bad("sigma_a needs 1 to 8 channels");
+  if (p.sigma_a.empty() || p.sigma_a.size() > kMaxChannels) bad("sigma_a needs 1 to 8 channels");
   for (double s : p.sigma_a)
     if (!(s >= 0.0) || !std::isfinite(s)) bad(fmt::format("sigma_a = {} must be finite and >= 0", s));
   if (p.lobe_scale.empty()) bad("lobe_scale needs at least one value");
@@ -351,29 +411,68 @@ Huang2022::Huang2022(Huang2022Params params) : params_(std::move(params)) {
 
 namespace {
 
-// Bin probabilities: each exit lands in one bin; the residual in one theta
-// bin, spread evenly over phi.
+// The residual's share of each theta bin: the integral over the bin of its
+// theta-marginal M_p(v, theta_i, theta_r) cos(theta_r) (d'Eon 2011 Eq. 7, the
+// von Mises-Fisher spread's marginal: SPEC s3), by Gauss-Legendre on panels
+// narrower than a third of the spread sqrt(v). Exact up to the rule's
+// error (far below 1e-12 of the lobe), where sampling the spread by two
+// more coordinates of the point set added their quadrature noise.
+constexpr double kMinExactResidualV = 1e-6;  // below: the spread is sampled by the points
+std::vector<double> residual_theta_masses(const BinGrid& grid, double theta_i, double v) {
+  const GaussLegendre& gl = gauss_legendre(8);
+  std::vector<double> mass(grid.n_theta(), 0.0);
+  for (int i = 0; i < grid.n_theta(); ++i) {
+    const double a = grid.theta_edges[i], b = grid.theta_edges[i + 1];
+    const int panels = std::clamp(static_cast<int>(std::ceil((b - a) / (std::sqrt(v) / 3.0))), 1, 4096);
+    const double h = (b - a) / panels;
+    for (int k = 0; k < panels; ++k)
+      for (std::size_t q = 0; q < gl.x.size(); ++q) {
+        const double t = a + h * (k + 0.5 * (1.0 + gl.x[q]));
+        mass[i] += 0.5 * h * gl.w[q] * std::exp(deon2011::log_M_p(v, theta_i, t)) * std::cos(t);
+      }
+  }
+  return mass;
+}
+
+// Bin probabilities: each exit lands in one bin; the residual's weight is
+// spread over the theta bins by its M_p (or, for v below
+// kMinExactResidualV, lands in the theta bin of its sampled inclination),
+// evenly over phi (finish()).
 class BinSink : public Sink {
  public:
   BinSink(const Paths& paths, const BinGrid& grid, double theta_i, double phi_i, std::vector<double>& out)
       : paths_(paths), grid_(grid), theta_i_(theta_i), phi_i_(phi_i), out_(out),
-        C_(paths.channels()), L_(paths.params().lobes), v_(4.0 * paths.params().roughness) {}
+        C_(paths.channels()), L_(paths.params().lobes), v_(4.0 * paths.params().roughness),
+        residual_(static_cast<std::size_t>(grid.n_theta()) * C_, 0.0) {
+    for (int p = 0; p < kResidualP; ++p) scale_[p] = paths.scale(p);
+  }
   void exit(int p, const Vec3& o, const double* w) override {
     const int i = grid_.theta_bin(inclination(o)), j = grid_.phi_bin(wrap_angle(azimuth(o) - phi_i_));
     double* b = bin(lobe_index(p, L_), i, j);
-    const double s = paths_.scale(p);
+    const double s = scale_[p];
     for (int c = 0; c < C_; ++c) b[c] += s * w[c];
   }
   void residual(const double* w, double u1, double u2) override {
-    const int i = grid_.theta_bin(residual_theta(theta_i_, v_, u1, u2));
-    const int np = grid_.n_phi();
-    for (int j = 0; j < np; ++j) {
-      double* b = bin(lobe_index(kResidualP, L_), i, j);
-      for (int c = 0; c < C_; ++c) b[c] += w[c] / np;
-    }
+    const int i = v_ < kMinExactResidualV ? grid_.theta_bin(residual_theta(theta_i_, v_, u1, u2)) : 0;
+    for (int c = 0; c < C_; ++c) residual_[static_cast<std::size_t>(i) * C_ + c] += w[c];
   }
   void lost(bool, const double*) override {}
   void incident(double) override {}
+  // Spreads the residual (call once, after the points).
+  void finish() {
+    const int np = grid_.n_phi(), nt = grid_.n_theta();
+    std::vector<double> per_theta(residual_);
+    if (v_ >= kMinExactResidualV) {
+      const std::vector<double> mass = residual_theta_masses(grid_, theta_i_, v_);
+      for (int i = 0; i < nt; ++i)
+        for (int c = 0; c < C_; ++c) per_theta[static_cast<std::size_t>(i) * C_ + c] = residual_[c] * mass[i];
+    }
+    for (int i = 0; i < nt; ++i)
+      for (int j = 0; j < np; ++j) {
+        double* b = bin(lobe_index(kResidualP, L_), i, j);
+        for (int c = 0; c < C_; ++c) b[c] += per_theta[static_cast<std::size_t>(i) * C_ + c] / np;
+      }
+  }
 
  private:
   double* bin(int lobe, int i, int j) {
@@ -385,6 +484,8 @@ class BinSink : public Sink {
   std::vector<double>& out_;
   int C_, L_;
   double v_;
+  double scale_[kResidualP];
+  std::vector<double> residual_;  // per theta bin (sampled spread) or in row 0 (the total)
 };
 
 class EnergySink : public Sink {
@@ -483,6 +584,7 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   const Paths paths(params_, theta_i, phi_i);
   BinSink sink(paths, grid, theta_i, phi_i, out);
   integrate(paths, params_.quadrature_points, sink);
+  sink.finish();
   return out;
 }
 
@@ -549,10 +651,12 @@ std::vector<std::string> huang_approximations(const ModelParams& p) {
   std::vector<std::string> a = {
       "far field: Cycles' wi read as our wi (the light); S normalised by the light's projected width",
       "TT, TRT: the paper's sampled microfacet normals as a fixed Halton point set (deterministic quadrature)",
-      "p >= 3: Cycles' residual (geometric series from the TRT path, M_p with v = 4 alpha, uniform in phi)",
+      "p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, uniform "
+      "in phi), not Cycles' eval()'s",
       "no GGX glass albedo correction (Cycles' energy_scale table)"};
   if (p.mesonormal_flux)
-    a.push_back("flux onto the mesonormal (wi.ns): not the projected width's once tilted (paper, Cycles' eval)");
+    a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
+        "also rescales at the inner interfaces, not done here)");
   if (p.huang_masking == static_cast<int>(HuangMasking::Correlated))
     a.push_back("masking: height-correlated G2 (Cycles' code)");
   return a;
@@ -589,7 +693,8 @@ ModelInfo huang2022_info() {
       "separable", {"separable", "correlated", "none"},
       [](ModelParams& p, int i) { p.huang_masking = i; }, [](const ModelParams& p) { return p.huang_masking; });
   ParamSpec flux = choice_param(
-      "flux", "light reaching the arc: mesonormal (wi.ns) dl (paper, Cycles' eval) or macro (wi.n0) dl",
+      "flux", "light reaching the arc: mesonormal (wi.ns) dl (paper; Cycles' eval at the entry) or macro (wi.n0) dl "
+      "(Cycles' sampler)",
       "mesonormal", {"mesonormal", "macro"},
       [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
       [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });

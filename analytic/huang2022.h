@@ -43,6 +43,13 @@
 //
 // What follows the paper and what Cycles (equation numbers are not quoted:
 // the paper was learnt through its Cycles implementation and abstract):
+// What fiberlab follows where the paper and Cycles' eval() differ: the
+// paper's and Cycles' sampler's transport (every interface one microfacet
+// event, light onto the arc by flux=mesonormal at the entry only); Cycles'
+// eval() also rescales the light at the inner interfaces by ratios of
+// mesonormal cosines, does not require TT light to leave on the outer side
+// of the exit normal, and uses its own p >= 3 formula: none of these is
+// here.
 // - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
 //   integral over the lit arc of F(wi.h) D(h) G2(wi, wr) / 4 dl, h the half
 //   vector, D and G about the mesonormal, the arc length dl of the ellipse;
@@ -61,13 +68,17 @@
 //   G2 = 1 / (1 + Lambda_i + Lambda_o) that Cycles' code uses (bsdf_G, and
 //   bsdf_Go = G2 / G1(wi) for the sampled interfaces); `masking=none` G = 1
 //   (a limit for tests).
-// - p >= 3 (Cycles, not the paper's three lobes): Cycles' residual after
-//   Chiang et al. 2016: the weight reflected at the third interface times
-//   the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)),
-//   A_avg = sqrt(A_t A_tr) (the two chords' transmittances), T_avg =
-//   max(1e-5, (T_2 + T_3)/2) (Fresnel transmittances at interfaces 2, 3),
-//   spread by d'Eon's M_p with v = 4 alpha (Cycles' choice) about
-//   theta_r = -theta_i and uniformly in phi.
+// - p >= 3 (Cycles, not the paper's three lobes): the residual of Cycles'
+//   sampler (sample_residual) after Chiang et al. 2016: the weight reflected
+//   at the third interface times the geometric series
+//   A_avg T_avg / (1 - A_avg (1 - T_avg)), A_avg = sqrt(A_t A_tr) (the two
+//   chords' transmittances), T_avg = max(1e-5, (T_2 + T_3)/2) (Fresnel
+//   transmittances at interfaces 2, 3), spread by d'Eon's M_p with
+//   v = 4 alpha (Cycles' choice) about theta_r = -theta_i and uniformly in
+//   phi. The third interface's reflection is also stopped when it leaves on
+//   the wrong side of the mesonormal or the macro normal (as every event
+//   here). Cycles' eval() uses another residual formula (larger on white
+//   fibers); it is not this one.
 // - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
 //   1 = the physical model); the residual is not scaled (as in Cycles).
 // - Left out (Cycles): the GGX glass albedo correction (energy_scale, a
@@ -77,21 +88,22 @@
 //
 // Bin probabilities are the exact push-forward of the same quadrature: every
 // point of the point set (h uniform over the projected width, the
-// microfacet normals of up to three interfaces, two more coordinates for the
-// residual's von Mises-Fisher spread, whose theta-marginal is M_p: SPEC s3)
-// is one path whose exit direction lands in one bin, with weight 1/N times
-// its Fresnel, masking and absorption factors. Each lobe's total is
+// microfacet normals of up to three interfaces) is one path whose exit
+// direction lands in one bin, with weight 1/N times its Fresnel, masking
+// and absorption factors; the residual's weight is spread over the theta
+// bins by the integral of its M_p over each bin (Gauss-Legendre, exact to
+// the rule) and evenly over phi (for v = 4 alpha below 1e-6 the spread is
+// sampled by two more coordinates of the point set). Each lobe's total is
 // therefore the model's energy up to the quadrature error, and alpha = 0 is
 // the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
 // smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
-// `quadrature_points`: 2^22 by default, about 4 s per incidence on one core
-// (90 x 180 bins, 4 lobes). Convergence, measured against 2^23 points
-// (alpha 0.05 and 0.3, tilt 3 deg, e 0.85, theta_i 29 deg): the mean squared
-// bin error over the variance of a 1M-photon simulation's bin is 0.004-0.04
-// at 2^22 (0.03-0.29 at 2^20, 0.17-1.3 at 2^18; TT the largest): about 4x
-// smaller per 4x points (a lower bound: against the simulator, 300k photons,
-// TT's chi2/dof is 1.29-1.35 at 2^20 and 1.07-1.11 at 2^23). Lower it for
-// quick looks, raise it for long simulations.
+// `quadrature_points` (2^22 by default). The quadrature error of R, TT and
+// TRT falls about 4x per 4x points (a push-forward of a fixed point set
+// into bins converges like an estimate from as many independent paths, a
+// little better): at the atlas's grid (24 x 36 bins) and photon count (300k)
+// the mean squared bin error over the simulated bin's variance is about
+// N_photons / N_points times 0.2-0.5 for TT and TRT. Lower it for quick
+// looks, raise it for long simulations.
 #include <memory>
 #include <vector>
 

@@ -57,6 +57,7 @@ struct ModelParams {
   // the root as SPEC's scale_tilt; the model rotates by 2^k of it).
   double beta_m = 0.3, beta_n = 0.3;
   double scale_tilt = 0.0;
+  int chiang_mp = 0;  // M_p: 0 d'Eon's exact, 1 pbrt-v4's numerics (`mp=exact|pbrt_v4`)
   // Huang et al. 2022 only (huang2022.h): GGX roughness alpha, per-lobe
   // factors (R, TT, TRT), masking (0 separable, 1 correlated, 2 none), the
   // flux onto the mesonormal (true) or the projected width, and the number

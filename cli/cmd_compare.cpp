@@ -33,7 +33,8 @@ namespace fiberlab::cli {
 namespace {
 
 struct CompareOptions {
-  std::string result, model, prediction, fit, report;
+  std::string result, model, prediction, fit, report, fit_lobes;
+  bool per_lobe = false;
   std::vector<std::string> settings;
   double max_chi2 = 0.0;  // <= 0: the five-sigma rule of compare/verdict.h
   double min_effective = 30.0, model_error = 1e-4, min_energy = 1e-4;
@@ -80,6 +81,37 @@ Predicted predicted_by_file(const sim::ResultFile& result, const CompareOptions&
   return p;
 }
 
+// --per-lobe: compare::fit_each_lobe's fits printed, each with its lobe's
+// chi2/dof before and after; returned as markdown for the report. The
+// verdict stays the joint fit's.
+std::string per_lobe_fits(const sim::ResultFile& result, const compare::ModelSpec& spec,
+                          const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                          const compare::Options& joint, double max_chi2, const compare::Verdict& before) {
+  std::string md = "\n## Per-lobe fits\n";
+  for (const compare::LobeFit& lf : compare::fit_each_lobe(
+           result, spec.name, start, keys, joint, 40, [](const std::string& line) { fmt::print(stderr, "{}\n", line); })) {
+    const Predicted fitted = predicted_by_model(result, spec, lf.fit.params);
+    const compare::Verdict after =
+        compare::judge(compare::compare(result, fitted.bins, fitted.alpha, joint), max_chi2);
+    auto only = [&](const compare::Verdict& v) {  // this lobe's rows
+      compare::Verdict w = v;
+      w.rows.clear();
+      w.accepted.clear();
+      for (std::size_t i = 0; i < v.rows.size(); ++i)
+        if (v.rows[i].lobe == lf.lobe) {
+          w.rows.push_back(v.rows[i]);
+          w.accepted.push_back(v.accepted[i]);
+        }
+      return w;
+    };
+    const std::string name = compare::lobe_name(lf.lobe, result.lobes);
+    fmt::print("\nper-lobe fit of {}:", name);
+    fmt::print("{}", compare::fit_text(lf.fit, only(before), only(after), result.lobes));
+    md += fmt::format("\n### {}\n\n", name) + compare::fit_markdown(lf.fit, only(before), only(after), result.lobes);
+  }
+  return md;
+}
+
 void compare_command(const CompareOptions& o) {
   if (o.max_chi2 < 0.0) throw Error(fmt::format("--max-chi2 = {} must be > 0", o.max_chi2));
   if (!(o.min_effective > 0.0)) throw Error("--min-effective must be > 0");
@@ -88,6 +120,8 @@ void compare_command(const CompareOptions& o) {
     throw Error("compare: give either --model NAME or --prediction PRED.h5 (exactly one)");
   if (from_file && (!o.settings.empty() || !o.fit.empty()))
     throw Error("compare --prediction: --set and --fit need a --model (a file's parameters cannot be changed)");
+  if (o.fit.empty() && (o.per_lobe || !o.fit_lobes.empty()))
+    throw Error("compare: --fit-lobes and --per-lobe need --fit KEYS");
   const sim::ResultFile result = sim::read_result(o.result);
   if (o.channel < 0 || o.channel >= result.channels)
     throw Error(fmt::format("--channel {} out of range (the result has {} channels)", o.channel, result.channels));
@@ -103,6 +137,9 @@ void compare_command(const CompareOptions& o) {
   copt.min_effective = o.min_effective;
   copt.model_rel_error = o.model_error;
   copt.min_lobe_energy = o.min_energy;
+  compare::Options fit_opt = copt;  // the lobes the fit judges and fits
+  if (!o.fit_lobes.empty())
+    fit_opt.lobes = compare::parse_fit_lobes(split_commas(o.fit_lobes), result.lobes, "--fit-lobes");
   const Predicted pred = from_file ? predicted_by_file(result, o) : Predicted{};
   if (!o.report.empty()) compare::make_report_dir(o.report);
 
@@ -117,8 +154,9 @@ void compare_command(const CompareOptions& o) {
   std::string fit_json = "null", fit_md;
   if (!o.fit.empty()) {
     const compare::FitResult fr = compare::fit_model(
-        result, spec.name, params, split_commas(o.fit), copt, 40,
+        result, spec.name, params, split_commas(o.fit), fit_opt, 40,
         [](const std::string& line) { fmt::print(stderr, "{}\n", line); });
+    const analytic::ModelParams start = params;
     // The verdict and the report use the fitted model.
     params = fr.params;
     current = predicted_by_model(result, spec, params);
@@ -129,6 +167,7 @@ void compare_command(const CompareOptions& o) {
     fit_json = compare::fit_json(fr, before, v);
     fmt::print("\nafter the fit: {}", current.header);
     fmt::print("{}", compare::verdict_table(v, result.lobes));
+    if (o.per_lobe) fit_md += per_lobe_fits(result, spec, start, split_commas(o.fit), fit_opt, o.max_chi2, before);
   }
 
   fmt::print("\n{} of {} judged lobes accepted ({}); {:.1f} s\n", v.judged - v.rejected, v.judged, v.criterion,
@@ -167,6 +206,11 @@ void add_compare_command(CLI::App& app) {
   cmd->add_option("--fit", o->fit,
                   "Comma-separated parameters to fit: the model's numeric keys (eta, beta_long, beta_m, ...), NAME[p] "
                   "for one lobe's entry (beta_long[0],alpha[2]), or the physical scale_tilt (shift rule)");
+  cmd->add_option("--fit-lobes", o->fit_lobes,
+                  "Comma-separated lobes the fit judges and fits (R,TT,TRT,p>=3 or indices; default every lobe)");
+  cmd->add_flag("--per-lobe", o->per_lobe,
+                "Also fit each lobe alone (its own beta_long[p], beta_azim[p], alpha[p] where the model has them), "
+                "after the joint fit");
   cmd->add_option("--report", o->report, "Write a report folder (report.md, metrics.csv/json, PNG plots)");
   cmd->add_option("--max-chi2", o->max_chi2,
                   "Accept a lobe when chi2/dof <= X (default: 1 + 5 sqrt(2/dof), five standard deviations)");

@@ -51,6 +51,16 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
   return compare(r, predict_result(*model, r), p.alpha);
 }
 
+// "fitted (converged: why)", "fitted (at a bound: key = value; why)" or
+// "fitted (not converged: why)": the per-fiber table's status.
+std::string fit_status(const FitResult& fit) {
+  std::string bound;
+  for (std::size_t j = 0; j < fit.keys.size(); ++j)
+    if (fit.at_bound[j]) bound += fmt::format("{}{} = {:.6g}", bound.empty() ? "" : ", ", fit.keys[j], fit.value[j]);
+  if (fit.outcome == FitOutcome::AtBound) return fmt::format("fitted (at a bound: {}; {})", bound, fit.stop_reason);
+  return fmt::format("fitted ({}: {})", outcome_name(fit.outcome), fit.stop_reason);
+}
+
 AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fiber, const sim::ResultFile& r,
                                 const std::string& name, const AtlasControl& control) {
   const auto t0 = Clock::now();
@@ -75,12 +85,14 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
   } else {
     check_interrupt();
     try {
-      m.fit = fit_model(r, name, p, keys, Options{}, config.max_iterations, [&](const std::string& line) {
+      Options fit_options;
+      fit_options.lobes = config.fit_lobes;
+      m.fit = fit_model(r, name, p, keys, fit_options, config.max_iterations, [&](const std::string& line) {
         check_interrupt();
         say(control, "  " + name + " " + line);
       });
       m.fitted = true;
-      m.status = m.fit.converged ? "fitted" : "fitted (not converged)";
+      m.status = fit_status(m.fit);
       m.params_after = analytic::describe_params(name, m.fit.params);
       m.after = judge_model(r, name, m.fit.params);
     } catch (const Error& e) {

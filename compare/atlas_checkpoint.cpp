@@ -343,6 +343,10 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
     fit.error_unscaled.push_back(v[3]);
     fit.at_bound.push_back(from_cell<bool>(r, v[4], where + ".fit.at_bound"));
   }
+  // The outcome follows from these (fit_model's rule); the stop reason is
+  // kept in the model's status line.
+  const bool bound = std::find(fit.at_bound.begin(), fit.at_bound.end(), true) != fit.at_bound.end();
+  fit.outcome = !fit.converged ? FitOutcome::NotConverged : bound ? FitOutcome::AtBound : FitOutcome::Converged;
   // The parameters at the minimum, as fit_model made them: the start
   // parameters with each key set to its fitted value.
   try {

@@ -12,6 +12,7 @@
 #include "analytic/model_registry.h"
 #include "common/error.h"
 #include "common/units.h"
+#include "compare/fit.h"
 
 namespace fiberlab::compare {
 
@@ -241,7 +242,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   c.models = read_models(r, top["models"]);
   c.model_parameters = read_model_parameters(r, top["model_parameters"], c.models);
   if (const YAML::Node fit = top["fit"]) {
-    only_keys(r, fit, "fit", {"max_iterations"});
+    only_keys(r, fit, "fit", {"max_iterations", "lobes"});
     if (fit["max_iterations"])
       c.max_iterations = static_cast<int>(integer(r, fit["max_iterations"], "fit.max_iterations", 0, 1000));
   }
@@ -284,6 +285,20 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
                                 tilts[t], eccs[e]);
           c.fibers.push_back(std::move(f));
         }
+  // fit.lobes: names of the tally's lobes (every fiber shares the tally).
+  if (top["fit"] && top["fit"]["lobes"]) {
+    const YAML::Node lobes = top["fit"]["lobes"];
+    std::vector<std::string> names;
+    for (const YAML::Node& n : items(r, lobes, "fit.lobes")) {
+      if (!n.IsScalar()) r.fail(fmt::format("fit.lobes: {} must be a lobe name such as TT", show(n)));
+      names.push_back(n.Scalar());
+    }
+    try {
+      c.fit_lobes = parse_fit_lobes(names, c.fibers.at(0).settings.tally.lobes, "fit.lobes");
+    } catch (const Error& e) {
+      r.fail(e.what());
+    }
+  }
   return c;
 }
 

@@ -19,7 +19,7 @@
 //   models: all           # or a list of registered model names
 //   model_parameters:     # optional: fixed (not fitted) parameters per model
 //     huang2022: {quadrature_points: 262144}
-//   fit: {max_iterations: 20}
+//   fit: {max_iterations: 20, lobes: [R, TT, TRT]}   # lobes: optional, default every lobe
 //
 // model_parameters: for a model of `models`, keys of its own parameter table
 // (`fiberlab models`) that the fit does not move (a free key is refused: the
@@ -61,6 +61,8 @@ struct AtlasConfig {
   // model name -> its fixed settings "KEY=VALUE" (model_parameters), checked.
   std::map<std::string, std::vector<std::string>> model_parameters;
   int max_iterations = 20;
+  // fit.lobes: the tally lobes the fit judges and fits (empty: every lobe).
+  std::vector<int> fit_lobes;
   std::vector<double> theta_i;  // radians
 };
 

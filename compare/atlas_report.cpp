@@ -35,6 +35,7 @@ std::string fitted_params(const AtlasModelResult& m) {
   for (std::size_t j = 0; j < m.fit.keys.size(); ++j)
     s += fmt::format("{}{} = {:.4g} ± {:.2g}{}", j ? ", " : "", m.fit.keys[j], m.fit.value[j], m.fit.error[j],
                      m.fit.at_bound[j] ? " (at bound)" : "");
+  if (m.fit.outcome == FitOutcome::NotConverged) s += " (not converged)";
   return s;
 }
 

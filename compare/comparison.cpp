@@ -150,6 +150,7 @@ Selection select_bins(const sim::ResultFile& r, const Options& o) {
   for (std::size_t k = 0; k < r.configs(); ++k)
     for (int lobe = 0; lobe < r.lobes; ++lobe)
       for (int c = 0; c < r.channels; ++c) {
+        if (!o.lobes.empty() && std::find(o.lobes.begin(), o.lobes.end(), lobe) == o.lobes.end()) continue;
         Selection::Block b{k, lobe, c, {}, {}};
         for (int i = 0; i < r.grid.n_theta(); ++i)
           for (int j = 0; j < r.grid.n_phi(); ++j) {

@@ -32,6 +32,10 @@ struct Options {
   double min_effective = 30.0;   // S1^2/S2 per compared bin (SPEC s10)
   double model_rel_error = 1e-4; // relative quadrature error assumed for M_b
   double min_lobe_energy = 1e-4; // lobes with less simulated and predicted energy are not judged
+  // The lobes a fit's selection takes (tally lobe indices; empty: every
+  // lobe): select_bins() leaves the others out, so a fit judges and fits
+  // only these (`fit: {lobes: [...]}`, `compare --fit-lobes`).
+  std::vector<int> lobes;
 };
 
 struct ChiSquare {

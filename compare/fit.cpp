@@ -10,6 +10,7 @@
 #include <tuple>
 
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/units.h"
 #include "analytic/model_registry.h"
 #include "analytic/physical_defaults.h"
@@ -197,6 +198,54 @@ void check_fit_key(const std::string& model_name, const std::string& key) {
                             "alpha[p] per lobe (e.g. alpha[0],alpha[1]) or the physical scale_tilt"));
 }
 
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what) {
+  const std::vector<std::string> known = lobe_names(lobes);
+  std::vector<int> out;
+  for (const std::string& name : names) {
+    int found = -1;
+    for (int l = 0; l < lobes; ++l)
+      if (name == known[l] || name == std::to_string(l)) found = l;
+    if (found < 0)
+      throw Error(fmt::format("{}: unknown lobe '{}' (allowed: {}, or an index 0..{})", what, name,
+                              join_names(known), lobes - 1));
+    if (std::find(out.begin(), out.end(), found) != out.end())
+      throw Error(fmt::format("{}: lobe '{}' given twice", what, name));
+    out.push_back(found);
+  }
+  if (out.empty()) throw Error(fmt::format("{}: no lobe given (allowed: {})", what, join_names(known)));
+  return out;
+}
+
+std::vector<std::string> per_lobe_keys(const std::string& model_name, const std::vector<std::string>& keys,
+                                       int lobe) {
+  std::vector<std::string> out;
+  for (const std::string& key : keys) {
+    const Key k = parse_key(key);
+    const analytic::ParamSpec* spec = spec_of(model_name, k);
+    if (k.index < 0 && k.name == "scale_tilt" && has_alpha_list(model_name))
+      out.push_back(fmt::format("alpha[{}]", lobe));
+    else if (k.index < 0 && spec && !table_scalar(spec) && (k.name == "beta_long" || k.name == "beta_azim"))
+      out.push_back(fmt::format("{}[{}]", k.name, lobe));
+    else
+      out.push_back(key);
+  }
+  return out;
+}
+
+namespace {
+constexpr double kChi2DropTolerance = 1e-2;  // of max(1, chi2/dof): fit.h "Stopping"
+constexpr int kExtensions = 3;               // doublings of a step along a valley: fit.h
+}  // namespace
+
+const char* outcome_name(FitOutcome o) {
+  switch (o) {
+    case FitOutcome::Converged: return "converged";
+    case FitOutcome::AtBound: return "at a bound";
+    case FitOutcome::NotConverged: return "not converged";
+  }
+  return "not converged";
+}
+
 FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
                     const analytic::ModelParams& start, const std::vector<std::string>& keys,
                     const Options& options, int max_iterations,
@@ -218,6 +267,9 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     for (int j = 0; j < n; ++j) x[j] = std::clamp(x[j], lo[j], hi[j]);
     return x;
   };
+  for (int l : options.lobes)
+    if (l < 0 || l >= result.lobes)
+      throw Error(fmt::format("--fit: lobe {} is not in the result (its lobes are 0..{})", l, result.lobes - 1));
   const Selection sel = select_bins(result, options);
 
   auto params_at = [&](const Eigen::VectorXd& x) {
@@ -232,9 +284,14 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     const auto model = compare::make_model(model_name, params_at(x));
     return to_vector(normalised_residuals(result, sel, predict_result(*model, result), options));
   };
-  // Central differences; steps in the keys' units (degrees for angles).
+  // Central differences; steps in the keys' units (degrees for angles),
+  // sized as fit.h says.
   auto step = [&](int j, double x) {
-    return std::max(1e-3 * std::fabs(x), keys[j].rfind("eta", 0) == 0 ? 1e-5 : 1e-3);
+    const double width = hi[j] - lo[j];
+    const double floor = std::isfinite(width) ? 2e-3 * width : 1e-3;
+    double h = std::max(2e-2 * std::fabs(x), floor);
+    if (std::isfinite(width)) h = std::min(h, 0.1 * width);
+    return h;
   };
   // The 2n trial points' predictions are 2n x K independent model
   // evaluations (K incident configurations): one parallel loop over all of
@@ -292,6 +349,15 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   double chi2 = fr.chi2_start, lambda = 1e-3;
   Eigen::MatrixXd J = jacobian(x, m);
   fr.evaluations += 2 * n;
+  // Parameter errors at x (scaled as the result's): the yardstick of a step.
+  auto errors_at = [&](const Eigen::MatrixXd& Jx, double chi2x) {
+    const Eigen::MatrixXd cov = (Jx.transpose() * Jx).completeOrthogonalDecomposition().pseudoInverse();
+    Eigen::VectorXd e(n);
+    for (int j = 0; j < n; ++j) e[j] = std::sqrt(std::max(0.0, cov(j, j)) * std::max(1.0, chi2x / fr.dof));
+    return e;
+  };
+  std::string last_move;  // the last accepted step, for a fit stopped by the cap
+  Eigen::VectorXd last_step = Eigen::VectorXd::Zero(n);
   for (fr.iterations = 0; fr.iterations < max_iterations; ++fr.iterations) {
     const Eigen::MatrixXd A = J.transpose() * J;
     Eigen::VectorXd g = J.transpose() * r;
@@ -301,6 +367,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     std::vector<bool> held(n, false);
     for (int j = 0; j < n; ++j)
       held[j] = (x[j] <= lo[j] && g[j] > 0.0) || (x[j] >= hi[j] && g[j] < 0.0);
+    const Eigen::VectorXd err = errors_at(J, chi2);
     bool improved = false;
     for (int tries = 0; tries < 12 && !improved; ++tries) {
       Eigen::MatrixXd Ad = A;
@@ -314,30 +381,63 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
           gh[j] = 0.0;
         }
       const Eigen::VectorXd xn = project(x + Ad.ldlt().solve(-gh));
-      const Eigen::VectorXd step = xn - x;
+      Eigen::VectorXd step = xn - x;
       const Eigen::VectorXd rn = residuals(xn);
       ++fr.evaluations;
       const double chi2n = rn.squaredNorm();
       if (chi2n < chi2) {
-        const double drop = chi2 - chi2n;
+        double drop = chi2 - chi2n;
+        const Eigen::VectorXd from = x;
         x = xn;
         r = rn;
         chi2 = chi2n;
         lambda = std::max(lambda / 10.0, 1e-9);
         improved = true;
-        // Converged when chi2 moves by less than 1e-3 (absolute: chi2 is a
-        // sum of squared normalised residuals, a 1e-3 change is far below
-        // its own noise) or the step is tiny against the parameter.
-        bool small_step = true;
+        // A valley: with large residuals (a model that does not describe the
+        // data) J^T J underrates how far chi2 keeps falling, and successive
+        // steps are short and point the same way. Then the step is doubled
+        // while chi2 keeps falling (at most kExtensions evaluations).
+        const double norms = step.norm() * last_step.norm();
+        if (norms > 0.0 && step.dot(last_step) > 0.9 * norms) {
+          Eigen::VectorXd ahead = step;
+          for (int e = 0; e < kExtensions; ++e) {
+            ahead *= 2.0;
+            const Eigen::VectorXd xe = project(x + ahead);
+            if (xe == x) break;
+            const Eigen::VectorXd re = residuals(xe);
+            ++fr.evaluations;
+            const double chi2e = re.squaredNorm();
+            if (!(chi2e < chi2)) break;
+            drop += chi2 - chi2e;
+            x = xe;
+            r = re;
+            chi2 = chi2e;
+          }
+          step = x - from;
+        }
+        last_step = step;
+        // The largest step in units of its parameter's error.
+        double step_in_errors = 0.0;
         for (int j = 0; j < n; ++j)
-          if (std::fabs(step[j]) > 1e-6 * std::max(1.0, std::fabs(x[j]))) small_step = false;
-        // For a model that does not describe the data (chi2/dof = S >> 1)
-        // the parameters' errors are scaled by sqrt(S), so the chi2 change
-        // that moves them by one error is S, not 1: the same test is then
-        // drop < 1e-3 S (the atlas's fits of wrong models stop there instead
-        // of polishing digits far below their errors).
+          step_in_errors = std::max(step_in_errors, err[j] > 0.0 ? std::fabs(step[j]) / err[j]
+                                                                 : (step[j] != 0.0 ? HUGE_VAL : 0.0));
+        // A chi2 change of S = max(1, chi2/dof) moves the parameters by one
+        // (scaled) error: for a model that does not describe the data
+        // (S >> 1) the errors are scaled by sqrt(S). A drop below 1e-2 S is
+        // a move of 0.1 error: what is left to gain is far below the errors
+        // (fits of wrong models stop there instead of polishing digits).
         const double unit = std::max(1.0, chi2 / fr.dof);
-        if (drop < 1e-3 * unit || small_step) fr.converged = true;
+        last_move = fmt::format("chi2 fell by {:.3g} (tolerance {:.3g}), the largest step {:.3g} errors",
+                                drop, kChi2DropTolerance * unit, step_in_errors);
+        if (drop < kChi2DropTolerance * unit) {
+          fr.converged = true;
+          fr.stop_reason = fmt::format("chi2 fell by {:.3g} < {:.3g} (1e-2 max(1, chi2/dof))", drop,
+                                       kChi2DropTolerance * unit);
+        } else if (step_in_errors < 1e-2) {
+          fr.converged = true;
+          fr.stop_reason = fmt::format("every step below 1% of its parameter's error (largest {:.3g})",
+                                       step_in_errors);
+        }
       } else {
         lambda *= 10.0;
       }
@@ -350,12 +450,21 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     }
     if (!improved) {
       fr.converged = true;  // no downhill step at any damping: at the minimum
+      fr.stop_reason = "no step lowers chi2 at any damping (a minimum, to the prediction's resolution)";
+      ++fr.iterations;
       break;
     }
     J = jacobian(x, m);
     fr.evaluations += 2 * n;
-    if (fr.converged) break;
+    if (fr.converged) {
+      ++fr.iterations;
+      break;
+    }
   }
+  if (!fr.converged)
+    fr.stop_reason = max_iterations == 0 ? "no iterations allowed (max_iterations = 0)"
+                                         : fmt::format("stopped at the iteration cap ({}): last step: {}",
+                                                       max_iterations, last_move);
   fr.chi2 = chi2;
   const Eigen::MatrixXd cov = (J.transpose() * J).inverse();
   const double scale = std::sqrt(std::max(1.0, fr.per_dof()));
@@ -367,8 +476,34 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
     const double tol = 1e-9 * (1.0 + std::fabs(x[j]));
     fr.at_bound.push_back(x[j] <= lo[j] + tol || x[j] >= hi[j] - tol);
   }
+  const bool bound = std::find(fr.at_bound.begin(), fr.at_bound.end(), true) != fr.at_bound.end();
+  fr.outcome = !fr.converged ? FitOutcome::NotConverged : bound ? FitOutcome::AtBound : FitOutcome::Converged;
   fr.params = params_at(x);
   return fr;
+}
+
+std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::string& model_name,
+                                   const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                                   const Options& options, int max_iterations,
+                                   const std::function<void(const std::string&)>& progress) {
+  std::vector<int> lobes = options.lobes;
+  if (lobes.empty())
+    for (int l = 0; l < result.lobes; ++l) lobes.push_back(l);
+  std::vector<LobeFit> out;
+  for (int lobe : lobes) {
+    Options one = options;
+    one.lobes = {lobe};
+    const std::string name = lobe_name(lobe, result.lobes);
+    try {
+      out.push_back({lobe, fit_model(result, model_name, start, per_lobe_keys(model_name, keys, lobe), one,
+                                     max_iterations, [&](const std::string& line) {
+                                       if (progress) progress(name + " " + line);
+                                     })});
+    } catch (const Error& e) {
+      throw Error(fmt::format("per-lobe fit of {}: {}", name, e.what()));
+    }
+  }
+  return out;
 }
 
 }  // namespace fiberlab::compare

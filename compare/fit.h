@@ -15,6 +15,27 @@
 // problem (the PDG's scale factor); when it does they are the bare ones.
 // Both are reported.
 //
+// Derivatives: central differences with a step of 2% of the value, at
+// least 0.2% of the fit range (1e-3 in the key's units when the range is
+// unbounded): the models' predictions are free of noise but not all of
+// them are smooth on a finer scale (huang2022's bins are a fixed point set
+// pushed through the model: a step must move many of its paths across bin
+// edges for the difference to be the derivative, not a count of the few that
+// crossed); the truncation error of a 2% central difference is ~1e-4
+// relative for smooth models, far below what the damping absorbs.
+//
+// Stopping (checked after every accepted step): converged when chi2 fell by
+// less than 1e-2 max(1, chi2/dof) (chi2 rises by max(1, chi2/dof) when a
+// parameter moves by one of its scaled errors: this drop is a move of 0.1
+// error) or every parameter moved by less than 1% of its current (scaled)
+// error; converged also when no step lowers
+// chi2 at any damping (a minimum, to the prediction's resolution). The
+// result says which (stop_reason) and whether a parameter sits on a bound.
+// Along a valley (an accepted step within 26 deg of the previous one) the
+// step is doubled while chi2 keeps falling, up to 3 times: with a model that
+// does not describe the data, Gauss-Newton steps are short there and the
+// fit would otherwise crawl.
+//
 // Bounds: each value stays in the table's range (fit_range(); projected
 // steps, a parameter held at a bound while the gradient points outwards).
 // A value that ends on a bound is flagged (at_bound): its error is the
@@ -70,6 +91,13 @@ std::vector<std::string> free_fit_keys(const std::string& model_name);
 // Refuses (fiberlab::Error) a key that model `model_name` cannot fit.
 void check_fit_key(const std::string& model_name, const std::string& key);
 
+// How a fit ended. Converged: a step changed chi2 by a negligible amount, or
+// moved every parameter by a negligible part of its error, or no downhill
+// step existed at any damping. AtBound: converged with a parameter held on
+// an end of fit_range(). NotConverged: the iteration cap came first.
+enum class FitOutcome { Converged, AtBound, NotConverged };
+const char* outcome_name(FitOutcome o);  // "converged", "at a bound", "not converged"
+
 struct FitResult {
   std::vector<std::string> keys;
   std::vector<double> start, value;
@@ -78,10 +106,24 @@ struct FitResult {
   std::vector<bool> at_bound;          // the value sits on an end of fit_range()
   double chi2_start = 0.0, chi2 = 0.0;
   int residuals = 0, dof = 0, iterations = 0, evaluations = 0;
-  bool converged = false;
+  bool converged = false;  // outcome != NotConverged
+  FitOutcome outcome = FitOutcome::NotConverged;
+  std::string stop_reason;  // one line: why the fit stopped (the test that ended it, with its numbers)
   analytic::ModelParams params;  // at the minimum
   double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
 };
+
+// Tally lobe indices of lobe names (R, TT, TRT, ..., the last lobe's "p>=N",
+// or a lobe index), checked against `lobes`; throws fiberlab::Error naming
+// `what` (the flag or config key) and the allowed names.
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what);
+
+// The keys of a per-lobe fit of lobe `lobe`: a per-lobe list key of the
+// model (beta_long, beta_azim) becomes that lobe's entry (beta_long[lobe]),
+// the physical scale_tilt of a model with per-lobe shifts becomes the
+// lobe's shift alpha[lobe]; scalars stay (fitted to that lobe's bins only).
+std::vector<std::string> per_lobe_keys(const std::string& model_name, const std::vector<std::string>& keys,
+                                       int lobe);
 
 // `progress` (optional) receives one line per iteration (the CLI prints it
 // on stderr: fits take minutes).
@@ -89,5 +131,17 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
                     const analytic::ModelParams& start, const std::vector<std::string>& keys,
                     const Options& options = {}, int max_iterations = 40,
                     const std::function<void(const std::string&)>& progress = {});
+
+// One fit per lobe: for each lobe of options.lobes (every lobe of the
+// result when empty), fit_model() on that lobe's bins alone with
+// per_lobe_keys(model, keys, lobe), from the same start.
+struct LobeFit {
+  int lobe = 0;
+  FitResult fit;
+};
+std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::string& model_name,
+                                   const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                                   const Options& options = {}, int max_iterations = 40,
+                                   const std::function<void(const std::string&)>& progress = {});
 
 }  // namespace fiberlab::compare

@@ -22,8 +22,9 @@ std::string unit_of(const std::string& key) {
 }  // namespace
 
 std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
-  std::string s = fmt::format("\nfit ({} residuals, {} iterations, {} model evaluations{}):\n", fr.residuals,
-                              fr.iterations, fr.evaluations, fr.converged ? "" : ", NOT converged");
+  std::string s = fmt::format("\nfit ({} residuals, {} iterations, {} model evaluations, {}: {}):\n",
+                              fr.residuals, fr.iterations, fr.evaluations, outcome_name(fr.outcome),
+                              fr.stop_reason);
   s += fmt::format("  chi2/dof {:.4f} -> {:.4f} (dof {}); errors scaled by sqrt(max(1, chi2/dof)) = {:.3f}\n",
                    fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, std::sqrt(std::max(1.0, fr.per_dof())));
   for (std::size_t i = 0; i < fr.keys.size(); ++i)
@@ -41,9 +42,10 @@ std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& 
 }
 
 std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
-  std::string md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations).\n\n"
+  std::string md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations; {}: {}).\n\n"
                                "| key | start | fitted | error | unscaled error |\n|---|---|---|---|---|\n",
-                               fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations);
+                               fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations,
+                               outcome_name(fr.outcome), fr.stop_reason);
   for (std::size_t i = 0; i < fr.keys.size(); ++i)
     md += fmt::format("| {} | {:.6g} | {:.6g} | {:.3g} | {:.3g} |\n", fr.keys[i], fr.start[i], fr.value[i],
                       fr.error[i], fr.error_unscaled[i]);
@@ -73,9 +75,10 @@ std::string fit_json(const FitResult& fr, const Verdict& before, const Verdict& 
   }
   return fmt::format(
       "{{\"parameters\": [{}], \"chi2_start\": {}, \"chi2\": {}, \"dof\": {}, \"iterations\": {}, "
-      "\"converged\": {}, \"error_scale\": \"sqrt(max(1, chi2/dof))\", \"per_lobe\": [{}]}}",
+      "\"converged\": {}, \"outcome\": {}, \"stop_reason\": {}, \"error_scale\": \"sqrt(max(1, chi2/dof))\", \"per_lobe\": [{}]}}",
       items, json_number(fr.chi2_start), json_number(fr.chi2), fr.dof, fr.iterations,
-      fr.converged ? "true" : "false", per_lobe);
+      fr.converged ? "true" : "false", json_string(outcome_name(fr.outcome)), json_string(fr.stop_reason),
+      per_lobe);
 }
 
 }  // namespace fiberlab::compare

@@ -25,7 +25,8 @@ TEST(ModelParams, EveryTableKeyParses) {
       {"n_theta_d", "specular"}, {"beta_m", "0.4"}, {"beta_n", "0.6"}};
   // Keys whose meaning is the model's own (chiang2016's alpha is the tilt itself).
   const std::map<std::string, std::string> own{
-      {"chiang2016 alpha", "3"},          {"huang2022 roughness", "0.2"},
+      {"chiang2016 alpha", "3"},          {"chiang2016 mp", "pbrt_v4"},
+      {"huang2022 roughness", "0.2"},
       {"huang2022 tilt", "3"},            {"huang2022 lobe_scale", "1,0.5,2"},
       {"huang2022 masking", "correlated"}, {"huang2022 flux", "macro"},
       {"huang2022 quadrature_points", "65536"}};

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Honest comparisons through the real program.
+# Honest comparisons through the real program, and the fit's lobe choices
+# (--fit-lobes / --per-lobe).
 # 1. A smooth *absorbing* circle against `--model exact` with no --set is
 #    accepted (the exact model uses the chord by default); a wrong index, or
 #    the published attenuation, is rejected (exit 1).
@@ -40,6 +41,16 @@ grep -q "k_g" "$work/err" || { echo "FAIL: the error does not name k_g"; fail=1;
 expect 2 "a fit key exact does not have" -- "$fiberlab" compare "$work/r.h5" --model exact --fit k_g
 expect 2 "one alpha for every lobe" -- "$fiberlab" compare "$work/r.h5" --model deon2011 --fit alpha
 [ -s "$work/out" ] && { echo "FAIL: output before the --fit error"; fail=1; }
+# A fit of one lobe (the right model: eta 1.55 is recovered from TRT alone),
+# and each lobe alone after it; the outcome of each fit is printed.
+expect 0 "fit eta on TRT, per lobe" -- "$fiberlab" compare "$work/r.h5" --model exact --set eta=1.5 --fit eta \
+  --fit-lobes TRT --per-lobe
+grep -q "per-lobe fit of TRT" "$work/out" || { echo "FAIL: no per-lobe fit of TRT"; fail=1; }
+grep -q "per-lobe fit of TT" "$work/out" && { echo "FAIL: a per-lobe fit of a lobe not asked for"; fail=1; }
+grep -Eq "iterations, [0-9]+ model evaluations, converged: " "$work/out" || { echo "FAIL: no fit outcome"; fail=1; }
+expect 2 "an unknown lobe" -- "$fiberlab" compare "$work/r.h5" --model exact --fit eta --fit-lobes TX
+grep -q "unknown lobe 'TX' (allowed: R,TT,TRT,p>=3" "$work/err" || { echo "FAIL: the error does not list the lobes"; fail=1; }
+expect 2 "--per-lobe without --fit" -- "$fiberlab" compare "$work/r.h5" --model exact --per-lobe
 
 py=/usr/bin/python3
 $py "$source_dir/tests/cli/write_exact_prediction.py" "$work/r.h5" "$work/right.h5" || exit 1

@@ -36,7 +36,7 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());
   // huang2022's quadrature sized for the atlas (the config's comment says why).
   EXPECT_EQ(full.model_parameters.at("huang2022"), std::vector<std::string>{"quadrature_points=262144"});
-  EXPECT_EQ(full.max_iterations, 10);
+  EXPECT_EQ(full.max_iterations, 40);
   // The medium sweep: 8 of the default's fibers with its settings.
   const AtlasConfig medium = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas_medium.yaml");
   EXPECT_EQ(medium.fibers.size(), 8u);
@@ -95,6 +95,14 @@ TEST(AtlasConfig, ErrorsNameTheEntry) {
   EXPECT_NE(error_of("photons: 10\nfit: {max_iterations: -1}\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n")
                 .find("fit.max_iterations"),
             std::string::npos);
+  // fit.lobes: the tally's lobe names (4 lobes: R, TT, TRT, p>=3), each once.
+  EXPECT_EQ(parse_atlas_config(sweep + "fit: {lobes: [TRT]}\n", "t").fit_lobes, std::vector<int>{2});
+  EXPECT_EQ(parse_atlas_config(sweep + "fit: {lobes: [R, TT, TRT]}\n", "t").fit_lobes, (std::vector<int>{0, 1, 2}));
+  EXPECT_TRUE(parse_atlas_config(sweep, "t").fit_lobes.empty());
+  const std::string bad_lobe = error_of(sweep + "fit: {lobes: [TRT, TTT]}\n");
+  EXPECT_NE(bad_lobe.find("fit.lobes: unknown lobe 'TTT' (allowed: R,TT,TRT,p>=3"), std::string::npos) << bad_lobe;
+  EXPECT_NE(error_of(sweep + "fit: {lobes: [TT, TT]}\n").find("lobe 'TT' given twice"), std::string::npos);
+  EXPECT_NE(error_of(sweep + "fit: {lobes: []}\n").find("fit.lobes is empty"), std::string::npos);
 }
 
 // Fixed model parameters reach the model on top of its physical defaults:
@@ -126,9 +134,13 @@ TEST(AtlasConfig, ModelParametersApplyOnTopOfThePhysicalDefaults) {
 // atlas's grid and photon count. Checked on the config's own ggx 0.3 fiber
 // (tilt 3 deg, e 0.85, white) at theta_i 45 deg against 4x the points: the
 // mean over bins with >= 10 expected photons of (bin error)^2 / (p / N) (the
-// simulated bin's variance, weights 1) is below 0.1 for R and p >= 3
-// (measured 0.014 and 0.003) and below 0.6 for TT and TRT (measured 0.43 and
-// 0.40: RMS errors of 0.65 standard errors, as the config's comment says).
+// simulated bin's variance, weights 1) is below 0.1 for R (measured 0.014),
+// below 1e-3 for p >= 3 (its M_p integrated per theta bin: only its total
+// carries quadrature error; measured 1.3e-7 here, up to 1.3e-4 on the
+// config's other white fibers; spreading it by sampled points gave 0.003,
+// which this bound catches) and below 0.6 for
+// TT and TRT (measured 0.43 and 0.40: RMS errors of 0.65 standard errors, as
+// the config's comment says).
 TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
   const AtlasConfig c = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas.yaml");
   const AtlasFiber& fiber = c.fibers.at(27);
@@ -156,7 +168,7 @@ TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
     }
     ASSERT_GT(n, 0) << "lobe " << lobe;
     std::printf("lobe %d: mean squared quadrature error / simulated variance %.3f (%d bins)\n", lobe, sum / n, n);
-    EXPECT_LT(sum / n, lobe == 1 || lobe == 2 ? 0.6 : 0.1) << "lobe " << lobe;
+    EXPECT_LT(sum / n, lobe == 1 || lobe == 2 ? 0.6 : lobe == 3 ? 1e-3 : 0.1) << "lobe " << lobe;
   }
 }
 
