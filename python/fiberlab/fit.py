@@ -22,7 +22,9 @@ class Fit:
     params: every model parameter at the minimum, as predict() takes them
     (predict(result, model, **fit.params) is the fitted model).
     before, after: the per-lobe Comparisons with the start and the fitted
-    parameters (their .table is the per-lobe table)."""
+    parameters (their .table is the per-lobe table).
+    outcome: "converged", "at a bound" or "not converged"; stop_reason: the
+    test that ended the fit, in one line (compare/fit.h)."""
     model: str
     keys: list
     values: dict
@@ -37,6 +39,8 @@ class Fit:
     iterations: int
     evaluations: int
     converged: bool
+    outcome: str
+    stop_reason: str
     params: dict
     params_start: dict
     before: Comparison
@@ -55,11 +59,11 @@ class Fit:
         values = ", ".join("%s = %.6g +- %.2g" % (k, self.values[k], self.errors[k]) for k in self.keys)
         return "<fiberlab.Fit %s: %s; chi2 %.6g -> %.6g (dof %d), %s>" % (
             self.model, values, self.chi2_before, self.chi2_after, self.dof,
-            "converged" if self.converged else "NOT converged")
+            self.outcome)
 
 
 def fit(result, model, keys, max_chi2=None, min_effective=30.0, model_error=1e-4, min_energy=1e-4,
-        max_iterations=40, progress=None, **fixed):
+        max_iterations=40, lobes=None, progress=None, **fixed):
     """Fits `keys` of analytic model `model` to a Result, as `fiberlab compare
     RESULT --model MODEL --fit KEYS --set KEY=VALUE...` does. keys: a list
     (or a comma-separated string) of the model's numeric keys: eta,
@@ -67,6 +71,8 @@ def fit(result, model, keys, max_chi2=None, min_effective=30.0, model_error=1e-4
     scale_tilt, ...; `fiberlab models` lists them. **fixed: other
     parameters held at the given values (predict()'s keywords, degrees).
     max_chi2, min_effective, model_error, min_energy: as compare().
+    lobes: the lobes whose bins the fit takes (names such as ["TRT"] or
+    "R,TT", as `compare --fit-lobes`); None: every lobe.
     progress: a callable getting the CLI's line per iteration (None: quiet).
     Ctrl-C stops a fit at the next iteration (KeyboardInterrupt).
     """
@@ -80,15 +86,23 @@ def fit(result, model, keys, max_chi2=None, min_effective=30.0, model_error=1e-4
     if not isinstance(keys, (list, tuple)) or not all(isinstance(k, str) for k in keys):
         raise _fiberlab.Error("keys must be a list of the model's parameter names (e.g. [\"beta_long\"])")
     max_iterations = count_argument("max_iterations", max_iterations, 1, 10000)
+    if lobes is None:
+        lobes = []
+    elif isinstance(lobes, str):
+        lobes = [n.strip() for n in lobes.split(",")]
+    if not isinstance(lobes, (list, tuple)) or not all(isinstance(n, str) for n in lobes):
+        raise _fiberlab.Error("lobes must be None or a list of lobe names (e.g. [\"TRT\"])")
     if progress is not None and not callable(progress):
         raise _fiberlab.Error("progress must be None or a callable(line)")
     d = _fiberlab.fit(result._file, model, list(keys), settings_overrides(fixed),
-                      *_options(max_chi2, min_effective, model_error, min_energy), max_iterations, progress)
+                      *_options(max_chi2, min_effective, model_error, min_energy), max_iterations, list(lobes),
+                      progress)
     per_key = lambda name: dict(zip(d["keys"], d[name]))
     return Fit(model=model, keys=list(d["keys"]), values=per_key("value"), errors=per_key("error"),
                errors_unscaled=per_key("error_unscaled"), start=per_key("start"),
                at_bound=per_key("at_bound"), chi2_before=d["chi2_start"], chi2_after=d["chi2"],
                residuals=d["residuals"], dof=d["dof"], iterations=d["iterations"],
-               evaluations=d["evaluations"], converged=d["converged"], params=dict(d["params"]),
+               evaluations=d["evaluations"], converged=d["converged"], outcome=d["outcome"],
+               stop_reason=d["stop_reason"], params=dict(d["params"]),
                params_start=dict(d["params_start"]), before=Comparison(d["before"], model),
                after=Comparison(d["after"], model))

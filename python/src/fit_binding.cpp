@@ -52,8 +52,10 @@ class FitProgress {
 
 py::dict fit(const sim::ResultFile& result, const std::string& model_name, const std::vector<std::string>& keys,
              const std::vector<std::string>& sets, std::optional<double> max_chi2, double min_effective,
-             double model_error, double min_energy, int max_iterations, py::object progress) {
-  const compare::Options o = comparison_options(max_chi2, min_effective, model_error, min_energy);
+             double model_error, double min_energy, int max_iterations, const std::vector<std::string>& lobes,
+             py::object progress) {
+  compare::Options o = comparison_options(max_chi2, min_effective, model_error, min_energy);
+  if (!lobes.empty()) o.lobes = compare::parse_fit_lobes(lobes, result.lobes, "lobes");
   if (max_iterations < 1) throw Error("max_iterations must be an integer >= 1");
   if (keys.empty()) throw Error("fit: give at least one key to fit (e.g. [\"beta_long\"])");
   std::set<std::string> seen;
@@ -99,6 +101,8 @@ py::dict fit(const sim::ResultFile& result, const std::string& model_name, const
   d["iterations"] = fr.iterations;
   d["evaluations"] = fr.evaluations;
   d["converged"] = fr.converged;
+  d["outcome"] = std::string(compare::outcome_name(fr.outcome));
+  d["stop_reason"] = fr.stop_reason;
   d["params_start"] = params_dict(spec.name, start);
   d["params"] = params_dict(spec.name, fr.params);
   d["before"] = verdict_dict(before, result.lobes);
@@ -111,7 +115,8 @@ py::dict fit(const sim::ResultFile& result, const std::string& model_name, const
 void bind_fit(py::module_& m) {
   m.def("fit", &fit, py::arg("result"), py::arg("model"), py::arg("keys"), py::arg("settings_overrides"),
         py::arg("max_chi2") = py::none(), py::arg("min_effective") = 30.0, py::arg("model_error") = 1e-4,
-        py::arg("min_energy") = 1e-4, py::arg("max_iterations") = 40, py::arg("progress") = py::none(),
+        py::arg("min_energy") = 1e-4, py::arg("max_iterations") = 40, py::arg("lobes") = std::vector<std::string>{},
+        py::arg("progress") = py::none(),
         "compare::fit_model (the fit of `fiberlab compare --fit`) with the verdicts before and after it");
 }
 

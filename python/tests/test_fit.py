@@ -104,3 +104,22 @@ def test_progress_gets_the_commands_lines_and_an_exception_in_it_stops_the_fit(b
 
     with pytest.raises(Stop):
         fiberlab.fit(blur_result, "deon2011", ["beta_long"], beta_long=9, progress=stop, **SWITCHES)
+
+
+def test_a_fit_of_one_lobe_takes_that_lobes_bins_and_recovers_the_width(blur_result, blur_fit):
+    """lobes=["TT"] is `compare --fit-lobes TT`: the fit sees TT's bins alone
+    (fewer residuals than the joint fit), still recovers the configured
+    6 deg (the model is exact for this fiber in every lobe), and says how it
+    stopped."""
+    f = fiberlab.fit(blur_result, "deon2011", ["beta_long"], beta_long=9, lobes=["TT"], **SWITCHES)
+    assert 0 < f.residuals < blur_fit.residuals
+    assert abs(f.values["beta_long"] - 6.0) <= 5 * f.errors["beta_long"] + 1e-3
+    assert f.outcome in ("converged", "at a bound", "not converged")
+    assert f.converged == (f.outcome != "not converged")
+    assert f.stop_reason
+
+
+@pytest.mark.parametrize("lobes", [["TX"], [1], "p>=9"])
+def test_bad_fit_lobes_are_refused(blur_result, lobes):
+    with pytest.raises(fiberlab.Error, match="lobe"):
+        fiberlab.fit(blur_result, "deon2011", ["beta_long"], lobes=lobes)
