@@ -463,7 +463,7 @@ using HostileFuzz = Fuzz;
 
 // The sanitizer job's share: fewer flips (each run is ~10x slower there).
 TEST_F(HostileFuzz, BitFlipsInAResultAndACheckpoint) {
-  const int n = kSanitized ? 25 : 100;
+  const int n = kSanitized ? 10 : 30;
   const FuzzTally r = fuzz_result(n, 32), c = fuzz_checkpoint(n, 33);
   std::cout << "    result: " << r.refused << " refused, " << r.same << " read as undamaged; checkpoint: "
             << c.refused << " refused, " << c.same << " resumed as undamaged\n";
