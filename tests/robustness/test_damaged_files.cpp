@@ -195,6 +195,14 @@ TEST_F(HostileDamage, ChangedConfigTextIsRefusedByEveryReader) {
                                   "compare " + f + " --model deon2011"})
     expect_refused(fiberlab(args), {f, "attribute_digest"}, args);
   EXPECT_FALSE(fs::exists(path("m.h5")));
+  // fiberlab.load (the Python module next to the binary's build folder): fiberlab.Error.
+  const fs::path module = fs::path(FIBERLAB_BINARY).parent_path().parent_path() / "python";
+  if (!fs::exists(module / "fiberlab")) GTEST_SKIP() << "no Python module built at " << module;
+  spit(path("load.py"), "import sys, fiberlab\ntry:\n    fiberlab.load(sys.argv[1])\nexcept fiberlab.Error as e:\n"
+                        "    print(e)\n    sys.exit(2)\n");
+  const Outcome py = run("cd / && PYTHONPATH=" + module.string() + " /usr/bin/python3 " + path("load.py") + " " + f);
+  EXPECT_EQ(py.status, 2) << py.out << py.err;
+  EXPECT_NE(py.out.find("attribute_digest"), std::string::npos) << py.out;
 }
 
 // Files in the old layout (no checksums) are read in a child process first
@@ -465,16 +473,18 @@ using HostileFuzz = Fuzz;
 TEST_F(HostileFuzz, BitFlipsInAResultAndACheckpoint) {
   const int n = kSanitized ? 10 : 30;
   const FuzzTally r = fuzz_result(n, 32), c = fuzz_checkpoint(n, 33);
-  std::cout << "    result: " << r.refused << " refused, " << r.same << " read as undamaged; checkpoint: "
-            << c.refused << " refused, " << c.same << " resumed as undamaged\n";
+  std::cout << "    result (info and merge of each copy): " << r.refused << " refused, " << r.same
+            << " read as undamaged; checkpoint (--resume): " << c.refused << " refused, " << c.same
+            << " resumed as undamaged\n";
 }
 
 using BitFlipFuzz = Fuzz;
 
 TEST_F(BitFlipFuzz, FiveHundredEach) {
   const FuzzTally r = fuzz_result(500, 3201), c = fuzz_checkpoint(500, 3202);
-  std::cout << "    result: " << r.refused << " refused, " << r.same << " read as undamaged; checkpoint: "
-            << c.refused << " refused, " << c.same << " resumed as undamaged\n";
+  std::cout << "    result (info and merge of each copy): " << r.refused << " refused, " << r.same
+            << " read as undamaged; checkpoint (--resume): " << c.refused << " refused, " << c.same
+            << " resumed as undamaged\n";
 }
 
 }  // namespace
