@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_output.h"
 #include "common/error.h"
 #include "sim/checkpoint.h"
 #include "sim/settings.h"
@@ -96,7 +97,27 @@ class Files : public ::testing::Test {
 
   // A checkpoint whose run writes OUT (absolute, in this test's folder):
   // OUT's name with .checkpoint.h5.
+  // Written in a child process: a writer's AtomicOutput installs signal
+  // handlers for good (common/interrupt.h), which test_interrupt.cpp's tests
+  // in this binary must not find installed.
   std::string make_checkpoint(const std::string& out) const {
+    const std::string ck = fiberlab::sim::checkpoint_path(out);
+    const pid_t child = fork();
+    if (child == 0) {
+      try {
+        write_partial_checkpoint(out);
+      } catch (...) {
+        _exit(1);
+      }
+      _exit(0);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writing " << ck;
+    return ck;
+  }
+
+  static void write_partial_checkpoint(const std::string& out) {
     using namespace fiberlab::sim;
     Settings s = parse_settings_yaml(kConfig, "fuzz.yaml");
     s.seed = 1;
@@ -107,11 +128,9 @@ class Files : public ::testing::Test {
     RunProgress state = first.start();
     RunControl control;
     control.threads = 1;
-    EXPECT_EQ(first.run(state, control), RunOutcome::Finished);
+    if (first.run(state, control) != RunOutcome::Finished) throw fiberlab::Error("interrupted");
     state.done.assign(state.done.size(), 0);
-    const std::string ck = checkpoint_path(out);
-    write_checkpoint(ck, whole, state, 0.0);
-    return ck;
+    write_checkpoint(checkpoint_path(out), whole, state, 0.0);
   }
 
   Outcome run(const std::string& command, const std::string& env = "") const {
@@ -315,6 +334,29 @@ TEST_F(HostileCheckpoint, StaleCheckpointTemporaryIsRemovedByTheNextRun) {
   EXPECT_FALSE(fs::exists(fs::symlink_status(stale)));
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_EQ(slurp(path("precious")), "keep me");
+}
+
+// The temporary's name is predictable (.NAME.tmp-PID): a link planted there
+// is removed, never written through, whatever then writes the temporary.
+TEST_F(HostileCheckpoint, LinkPlantedAtTheTemporaryNameIsNotFollowed) {
+  const std::string target = path("out.h5");
+  spit(path("precious"), "keep me");
+  // In a child (see make_checkpoint), which plants the link at its own name.
+  const pid_t child = fork();
+  if (child == 0) {
+    const fs::path planted = dir_ / (".out.h5.tmp-" + std::to_string(getpid()));
+    fs::create_symlink(path("precious"), planted);
+    fiberlab::AtomicOutput out(target);
+    const bool ok = out.temp_path() == planted.string() && !fs::is_symlink(planted);
+    std::ofstream(out.temp_path()) << "written";
+    out.commit();
+    _exit(ok ? 0 : 1);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the temporary was not made anew";
+  EXPECT_EQ(slurp(path("precious")), "keep me");
+  EXPECT_EQ(slurp(target), "written");
 }
 
 // ------------------------------------------------------------ report folders
