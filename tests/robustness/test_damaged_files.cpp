@@ -216,7 +216,14 @@ TEST_F(HostileDamage, ChangedConfigTextIsRefusedByEveryReader) {
   EXPECT_FALSE(fs::exists(path("m.h5")));
   // fiberlab.load (the Python module next to the binary's build folder): fiberlab.Error.
   const fs::path module = fs::path(FIBERLAB_BINARY).parent_path().parent_path() / "python";
-  if (!fs::exists(module / "fiberlab")) GTEST_SKIP() << "no Python module built at " << module;
+  bool built = false;  // the compiled extension (the sanitizer job builds none)
+  if (fs::is_directory(module / "fiberlab"))
+    for (const auto& e : fs::directory_iterator(module / "fiberlab"))
+      built = built || e.path().filename().string().starts_with("_fiberlab.");
+  if (!built) {
+    std::cout << "    no Python module built at " << module << ": fiberlab.load not tried\n";
+    return;
+  }
   spit(path("load.py"), "import sys, fiberlab\ntry:\n    fiberlab.load(sys.argv[1])\nexcept fiberlab.Error as e:\n"
                         "    print(e)\n    sys.exit(2)\n");
   const Outcome py = run("cd / && PYTHONPATH=" + module.string() + " /usr/bin/python3 " + path("load.py") + " " + f);
