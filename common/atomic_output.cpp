@@ -114,7 +114,17 @@ AtomicOutput::AtomicOutput(std::string target, const std::vector<std::string>& i
   const std::string name = fs::path(target_).filename().string();
   remove_stale_in(dir_, name);
   temp_ = (fs::path(dir_) / fmt::format(".{}.tmp-{}", name, getpid())).string();
+  // The temporary's name is predictable: whatever is there already (a link
+  // planted to make the writer truncate another file, or the file of a dead
+  // process of the same id) is removed (unlink removes a link, not its
+  // target), and the file is made here, new and never through a link
+  // (O_EXCL | O_NOFOLLOW), before any writer (HDF5, an ofstream) opens it.
   guard_.emplace(temp_);
+  unlink(temp_.c_str());
+  const int fd = open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_NOFOLLOW | O_CLOEXEC, 0666);
+  if (fd < 0)
+    refuse(target_, fmt::format("cannot create its temporary file {}: {}", temp_, std::strerror(errno)));
+  close(fd);
 }
 
 void remove_stale_temporaries(const std::string& target) {

@@ -5,6 +5,9 @@
 //
 // The temporary file is removed on every way out: an exception (destructor),
 // SIGINT/SIGTERM during the write (a TempFileGuard, common/interrupt.h).
+// The temporary file is created by the constructor (O_EXCL | O_NOFOLLOW,
+// after removing whatever had its name), so that no writer follows a link
+// planted at that predictable name.
 // Temporary files of the same target left by processes that no longer exist
 // (a crash, SIGKILL) are removed when the next AtomicOutput for that target
 // is made.

@@ -42,9 +42,14 @@ std::uint64_t attribute_digest(hid_t file, const std::string& path);
 // most kProbeDatasetBytes, and checks attribute_digest when the file has one;
 // in a child process (fork), so that a damaged file that crashes HDF5 kills
 // the child, not the caller. Throws fiberlab::Error with one line naming
-// `path`: the HDF5 error, the digest mismatch, or that reading it crashed.
+// `path`: the HDF5 error, the digest mismatch, or that reading it crashed
+// or did not finish.
 // Called by File::open_read before the file is opened in this process.
 void probe_file(const std::string& path);
 inline constexpr std::uint64_t kProbeDatasetBytes = std::uint64_t{64} << 20;
+// The child's time limit, plus a second per 20 MB of file: HDF5 can also
+// loop forever on damaged metadata; a child still reading then is killed
+// and the file refused.
+inline constexpr double kProbeSeconds = 20.0;
 
 }  // namespace fiberlab::h5

@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "common/atomic_output.h"
 #include "common/error.h"
 #include "sim/checkpoint.h"
 #include "sim/settings.h"
@@ -96,7 +97,27 @@ class Files : public ::testing::Test {
 
   // A checkpoint whose run writes OUT (absolute, in this test's folder):
   // OUT's name with .checkpoint.h5.
+  // Written in a child process: a writer's AtomicOutput installs signal
+  // handlers for good (common/interrupt.h), which test_interrupt.cpp's tests
+  // in this binary must not find installed.
   std::string make_checkpoint(const std::string& out) const {
+    const std::string ck = fiberlab::sim::checkpoint_path(out);
+    const pid_t child = fork();
+    if (child == 0) {
+      try {
+        write_partial_checkpoint(out);
+      } catch (...) {
+        _exit(1);
+      }
+      _exit(0);
+    }
+    int status = 0;
+    waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "writing " << ck;
+    return ck;
+  }
+
+  static void write_partial_checkpoint(const std::string& out) {
     using namespace fiberlab::sim;
     Settings s = parse_settings_yaml(kConfig, "fuzz.yaml");
     s.seed = 1;
@@ -107,11 +128,9 @@ class Files : public ::testing::Test {
     RunProgress state = first.start();
     RunControl control;
     control.threads = 1;
-    EXPECT_EQ(first.run(state, control), RunOutcome::Finished);
+    if (first.run(state, control) != RunOutcome::Finished) throw fiberlab::Error("interrupted");
     state.done.assign(state.done.size(), 0);
-    const std::string ck = checkpoint_path(out);
-    write_checkpoint(ck, whole, state, 0.0);
-    return ck;
+    write_checkpoint(checkpoint_path(out), whole, state, 0.0);
   }
 
   Outcome run(const std::string& command, const std::string& env = "") const {
@@ -195,6 +214,21 @@ TEST_F(HostileDamage, ChangedConfigTextIsRefusedByEveryReader) {
                                   "compare " + f + " --model deon2011"})
     expect_refused(fiberlab(args), {f, "attribute_digest"}, args);
   EXPECT_FALSE(fs::exists(path("m.h5")));
+  // fiberlab.load (the Python module next to the binary's build folder): fiberlab.Error.
+  const fs::path module = fs::path(FIBERLAB_BINARY).parent_path().parent_path() / "python";
+  bool built = false;  // the compiled extension (the sanitizer job builds none)
+  if (fs::is_directory(module / "fiberlab"))
+    for (const auto& e : fs::directory_iterator(module / "fiberlab"))
+      built = built || e.path().filename().string().starts_with("_fiberlab.");
+  if (!built) {
+    std::cout << "    no Python module built at " << module << ": fiberlab.load not tried\n";
+    return;
+  }
+  spit(path("load.py"), "import sys, fiberlab\ntry:\n    fiberlab.load(sys.argv[1])\nexcept fiberlab.Error as e:\n"
+                        "    print(e)\n    sys.exit(2)\n");
+  const Outcome py = run("cd / && PYTHONPATH=" + module.string() + " /usr/bin/python3 " + path("load.py") + " " + f);
+  EXPECT_EQ(py.status, 2) << py.out << py.err;
+  EXPECT_NE(py.out.find("attribute_digest"), std::string::npos) << py.out;
 }
 
 // Files in the old layout (no checksums) are read in a child process first
@@ -307,6 +341,29 @@ TEST_F(HostileCheckpoint, StaleCheckpointTemporaryIsRemovedByTheNextRun) {
   EXPECT_FALSE(fs::exists(fs::symlink_status(stale)));
   EXPECT_TRUE(fs::is_symlink(link));
   EXPECT_EQ(slurp(path("precious")), "keep me");
+}
+
+// The temporary's name is predictable (.NAME.tmp-PID): a link planted there
+// is removed, never written through, whatever then writes the temporary.
+TEST_F(HostileCheckpoint, LinkPlantedAtTheTemporaryNameIsNotFollowed) {
+  const std::string target = path("out.h5");
+  spit(path("precious"), "keep me");
+  // In a child (see make_checkpoint), which plants the link at its own name.
+  const pid_t child = fork();
+  if (child == 0) {
+    const fs::path planted = dir_ / (".out.h5.tmp-" + std::to_string(getpid()));
+    fs::create_symlink(path("precious"), planted);
+    fiberlab::AtomicOutput out(target);
+    const bool ok = out.temp_path() == planted.string() && !fs::is_symlink(planted);
+    std::ofstream(out.temp_path()) << "written";
+    out.commit();
+    _exit(ok ? 0 : 1);
+  }
+  int status = 0;
+  waitpid(child, &status, 0);
+  EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "the temporary was not made anew";
+  EXPECT_EQ(slurp(path("precious")), "keep me");
+  EXPECT_EQ(slurp(target), "written");
 }
 
 // ------------------------------------------------------------ report folders
@@ -463,18 +520,20 @@ using HostileFuzz = Fuzz;
 
 // The sanitizer job's share: fewer flips (each run is ~10x slower there).
 TEST_F(HostileFuzz, BitFlipsInAResultAndACheckpoint) {
-  const int n = kSanitized ? 25 : 100;
+  const int n = kSanitized ? 10 : 30;
   const FuzzTally r = fuzz_result(n, 32), c = fuzz_checkpoint(n, 33);
-  std::cout << "    result: " << r.refused << " refused, " << r.same << " read as undamaged; checkpoint: "
-            << c.refused << " refused, " << c.same << " resumed as undamaged\n";
+  std::cout << "    result (info and merge of each copy): " << r.refused << " refused, " << r.same
+            << " read as undamaged; checkpoint (--resume): " << c.refused << " refused, " << c.same
+            << " resumed as undamaged\n";
 }
 
 using BitFlipFuzz = Fuzz;
 
 TEST_F(BitFlipFuzz, FiveHundredEach) {
   const FuzzTally r = fuzz_result(500, 3201), c = fuzz_checkpoint(500, 3202);
-  std::cout << "    result: " << r.refused << " refused, " << r.same << " read as undamaged; checkpoint: "
-            << c.refused << " refused, " << c.same << " resumed as undamaged\n";
+  std::cout << "    result (info and merge of each copy): " << r.refused << " refused, " << r.same
+            << " read as undamaged; checkpoint (--resume): " << c.refused << " refused, " << c.same
+            << " resumed as undamaged\n";
 }
 
 }  // namespace
