@@ -181,10 +181,12 @@ TEST_F(HostileRanks, DifferentTargetErrorAndOutput) {
 // round's size once depended on each rank's own thread count, so ranks with
 // different --threads traced overlapping photons).
 TEST_F(HostileRanks, DifferentThreadsGiveTheSingleProcessFile) {
-  const std::string a = config("a.yaml", kBase);
+  // Several rounds: a round takes (threads x ranks) chunks of
+  // Simulation::kChunk = 4096 photons at first.
+  const std::string a = config("a.yaml", kBase) + " --photons 60000";
   const std::string single = std::string(FIBERLAB_BINARY) + " run " + a + " --quiet --threads 1 -o " + path("single.h5");
   ASSERT_EQ(std::system(single.c_str()), 0);
-  const Outcome o = two_ranks(a + " --quiet --threads 2 -o " + path("ranks.h5"),
+  const Outcome o = two_ranks(a + " --quiet --threads 3 -o " + path("ranks.h5"),
                               a + " --quiet --threads 1 -o " + path("ranks.h5"));
   ASSERT_EQ(o.status, 0) << o.err;
   std::ofstream(path("same.py")) << R"(import sys, h5py, numpy as np
