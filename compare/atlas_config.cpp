@@ -204,8 +204,8 @@ std::map<std::string, std::vector<std::string>> read_model_parameters(const Read
       // otherwise would predict another fiber or another tally shape, and
       // fail only once the fibers are simulated.
       if (spec->from_fiber.rfind("fiber.", 0) == 0 || spec->from_fiber.rfind("tally.", 0) == 0)
-        r.fail(fmt::format("{}.{} is each fiber's own ({}): set it in the atlas config's fibers, not "
-                           "per model", path, key, spec->from_fiber));
+        r.fail(fmt::format("{}.{} is each fiber's own ({}): the atlas sets it from its eta, tally and "
+                           "sweep, not per model", path, key, spec->from_fiber));
       std::string value;
       if (setting.second.IsScalar()) {
         value = setting.second.Scalar();
