@@ -680,9 +680,8 @@ ModelInfo huang2022_info() {
                                 "deg", "0", "degrees in (-45, 45)", &ModelParams::scale_tilt,
                                 [](double x) { return std::abs(x) < 45.0; });
   tilt.from_fiber = "fiber.scale_tilt";
-  ParamSpec ecc = eccentricity_param("a number in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; });
+  ParamSpec ecc = eccentricity_param();
   ecc.meaning = "minor/major axis ratio of the ellipse (Cycles' aspect ratio)";
-  ecc.default_value = "1";
   ParamSpec scale = list_param("lobe_scale", "factors of the R, TT, TRT lobes (Cycles' modulation; 1 = physical)",
                                "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &ModelParams::lobe_scale,
                                [](double x) { return x >= 0.0; });

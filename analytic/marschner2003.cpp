@@ -847,7 +847,6 @@ ModelInfo marschner2003_info() {
   ModelInfo m;
   m.name = "marschner2003";
   m.reference = "Marschner, Jensen, Cammarano, Worley, Hanrahan 2003, Light Scattering from Human Hair Fibers";
-  const auto nonneg = [](double x) { return x >= 0.0; };
   m.params = {
       eta_param(),
       sigma_a_param(),
@@ -855,7 +854,7 @@ ModelInfo marschner2003_info() {
       alpha_param("shift of theta_r per lobe p (Marschner's alpha_p, a shift of theta_h, is half)"),
       absorption_param("published"),
       lobes_param(),
-      eccentricity_param("a number in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; }),
+      eccentricity_param(),
       choice_param(
           "longitudinal", "variable of the Gaussian M: theta_h (published) or 2 theta_h (Zinke & Weber)",
           "theta_h", {"theta_h", "two_theta_h"}, [](ModelParams& p, int i) { p.two_theta_h = i == 1; },
@@ -864,14 +863,19 @@ ModelInfo marschner2003_info() {
           "roots", "roots of Phi(p, h) = phi: the cubic of Eq. 10 (published) or Eq. 3 exactly", "cubic",
           {"cubic", "exact"}, [](ModelParams& p, int i) { p.exact_roots = i == 1; },
           [](const ModelParams& p) { return p.exact_roots ? 1 : 0; }),
-      number_param("k_g", "glint scale factor k_G (Table 1: 0.5 to 5)", "", "0.5", "a number >= 0",
-                   &ModelParams::k_g, nonneg),
+      // Ranges: Table 1's, widened (k_g, delta_eta), or the variable's own
+      // (an azimuthal width up to a half turn, an impact parameter in [0, 1]).
+      number_param("k_g", "glint scale factor k_G (Table 1: 0.5 to 5)", "", "0.5", "a number in [0, 10]",
+                   &ModelParams::k_g, [](double x) { return x >= 0.0 && x <= 10.0; }),
       number_param("w_c", "azimuthal width of the caustic (Table 1: 10 to 25 deg); 0 = no caustic smoothing",
-                   "deg", "10", "degrees >= 0", &ModelParams::w_c, nonneg),
+                   "deg", "10", "degrees in [0, 180]", &ModelParams::w_c,
+                   [](double x) { return x >= 0.0 && x <= 180.0; }),
       number_param("delta_eta", "fade range of eta' past the caustic merge (Table 1: 0.2 to 0.4)", "", "0.3",
-                   "a number >= 0", &ModelParams::delta_eta, nonneg),
+                   "a number in [0, 10]", &ModelParams::delta_eta,
+                   [](double x) { return x >= 0.0 && x <= 10.0; }),
       number_param("delta_h_m", "caustic intensity limit Delta h_M (Table 1: 0.5)", "", "0.5",
-                   "a number >= 0", &ModelParams::delta_h_m, nonneg),
+                   "a number in [0, 1]", &ModelParams::delta_h_m,
+                   [](double x) { return x >= 0.0 && x <= 1.0; }),
   };
   m.make = make_marschner2003;
   m.approximations = marschner_approximations;

@@ -7,6 +7,7 @@
 #include <cstdlib>
 
 #include "common/error.h"
+#include "common/physical_limits.h"
 #include "common/units.h"
 
 namespace fiberlab::analytic {
@@ -53,13 +54,17 @@ ParamSpec number_param(std::string key, std::string meaning, std::string unit,
                        std::string default_value, std::string allowed, double ModelParams::*field,
                        std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || !ok(x)) fail(key, value, allowed);
     p.*field = x * scale;
   };
   s.show = [field, scale](const ModelParams& p) { return number_text(p.*field / scale); };
+  s.in_range = [field, ok, scale](const ModelParams& p) {
+    const double x = p.*field / scale;
+    return std::isfinite(x) && ok(x);
+  };
   s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", {p.*field}}; };
   s.get_number = [field, scale](const ModelParams& p) { return p.*field / scale; };
   s.set_number = [field, scale](ModelParams& p, double x) { p.*field = x * scale; };
@@ -77,7 +82,7 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
                      std::string default_value, std::string allowed,
                      std::vector<double> ModelParams::*field, std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     std::vector<double> out;
     std::size_t start = 0;
@@ -94,6 +99,12 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
     p.*field = out;
   };
   s.show = [field, scale](const ModelParams& p) { return list_text(p.*field, scale); };
+  s.in_range = [field, ok, scale](const ModelParams& p) {
+    if ((p.*field).empty()) return false;
+    for (double v : p.*field)
+      if (!std::isfinite(v / scale) || !ok(v / scale)) return false;
+    return true;
+  };
   s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", p.*field}; };
   return s;
 }
@@ -101,7 +112,7 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
 ParamSpec integer_param(std::string key, std::string meaning, std::string default_value,
                         int ModelParams::*field, int min_value) {
   const std::string allowed = fmt::format("an integer >= {}", min_value);
-  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
   s.set = [key, allowed, field, min_value](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || x != std::floor(x) || x < min_value || x > 1e6)
@@ -109,6 +120,7 @@ ParamSpec integer_param(std::string key, std::string meaning, std::string defaul
     p.*field = static_cast<int>(x);
   };
   s.show = [field](const ModelParams& p) { return std::to_string(p.*field); };
+  s.in_range = [field, min_value](const ModelParams& p) { return p.*field >= min_value && p.*field <= 1e6; };
   s.attribute = [key, field](const ModelParams& p) {
     return ParamAttribute{key, false, "", {static_cast<double>(p.*field)}};
   };
@@ -120,7 +132,7 @@ ParamSpec choice_param(std::string key, std::string meaning, std::string default
                        std::function<int(const ModelParams&)> get) {
   std::string allowed;
   for (const auto& c : choices) allowed += (allowed.empty() ? "" : " | ") + c;
-  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}, {}, {}};
+  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
   s.set = [key, allowed, choices, set](ModelParams& p, const std::string& value) {
     const std::string v = trim(value);
     for (std::size_t i = 0; i < choices.size(); ++i)
@@ -128,6 +140,9 @@ ParamSpec choice_param(std::string key, std::string meaning, std::string default
     fail(key, value, allowed);
   };
   s.show = [choices, get](const ModelParams& p) { return choices.at(get(p)); };
+  s.in_range = [n = choices.size(), get](const ModelParams& p) {
+    return get(p) >= 0 && static_cast<std::size_t>(get(p)) < n;
+  };
   s.attribute = [key, choices, get](const ModelParams& p) {
     return ParamAttribute{key, true, choices.at(get(p)), {}};
   };
@@ -137,10 +152,13 @@ ParamSpec choice_param(std::string key, std::string meaning, std::string default
 // ---- Shared parameters ----------------------------------------------------------
 
 ParamSpec eta_param() {
+  // The simulator's bound and its reason: common/physical_limits.h.
   ParamSpec s = number_param("eta", "refractive index of the fiber relative to the medium", "", "1.55",
-                             "a number > 1", &ModelParams::eta, [](double x) { return x > 1.0; });
+                             "a number in (1, 1e9]", &ModelParams::eta,
+                             [](double x) { return x > 1.0 && x <= kMaxEta; });
   s.from_fiber = "fiber.eta";
   s.fit_min = 1.0 + 1e-6;
+  s.fit_max = kMaxEta;
   return s;
 }
 
@@ -161,9 +179,11 @@ ParamSpec lobes_param() {
 }
 
 ParamSpec beta_long_param(std::string meaning) {
+  // The simulator's range of a roughness width (SPEC s11): a wider Gaussian
+  // spreads theta_r past the sphere of directions.
   ParamSpec s = list_param("beta_long", std::move(meaning), "deg", "0",
-                           "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_long,
-                           [](double x) { return x >= 0.0; });
+                           "a comma list of degrees in [0, 90], indexed by lobe p", &ModelParams::beta_long,
+                           [](double x) { return x >= 0.0 && x <= 90.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
   // A fit keeps widths >= 1 deg: the published models' azimuthal
   // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
@@ -173,9 +193,11 @@ ParamSpec beta_long_param(std::string meaning) {
 }
 
 ParamSpec beta_azim_param(std::string meaning) {
+  // The simulator's range of a roughness width (SPEC s11): a wider Gaussian
+  // spreads theta_r past the sphere of directions.
   ParamSpec s = list_param("beta_azim", std::move(meaning), "deg", "0",
-                           "a comma list of degrees >= 0, indexed by lobe p", &ModelParams::beta_azim,
-                           [](double x) { return x >= 0.0; });
+                           "a comma list of degrees in [0, 90], indexed by lobe p", &ModelParams::beta_azim,
+                           [](double x) { return x >= 0.0 && x <= 90.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
   // A fit keeps widths >= 1 deg: the published models' azimuthal
   // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
@@ -185,18 +207,22 @@ ParamSpec beta_azim_param(std::string meaning) {
 }
 
 ParamSpec alpha_param(std::string meaning) {
+  // A shift of theta_r in [-90, 90] degrees: theta_r's own range (larger
+  // shifts move every lobe off the sphere of directions).
   ParamSpec s = list_param("alpha", std::move(meaning), "deg", "0",
-                           "a comma list of degrees, indexed by lobe p", &ModelParams::alpha,
-                           [](double) { return true; });
+                           "a comma list of degrees in [-90, 90], indexed by lobe p", &ModelParams::alpha,
+                           [](double x) { return std::abs(x) <= 90.0; });
   s.from_fiber = "fiber.scale_tilt (SPEC s7: R -2a, TT +a, TRT +4a, p >= 3: 0)";
   // Free: a fit moves it through the physical tilt (fit key scale_tilt, the
   // shift rule), the range of the simulator's scale_tilt (SPEC s11).
   return fittable(s, -45.0 + 1e-6, 45.0 - 1e-6);
 }
 
-ParamSpec eccentricity_param(std::string allowed, std::function<bool(double)> ok) {
+ParamSpec eccentricity_param() {
+  // The simulator's range and its reason: common/physical_limits.h.
   ParamSpec s = number_param("eccentricity", "minor/major axis ratio of the cross-section", "", "1",
-                             std::move(allowed), &ModelParams::eccentricity, std::move(ok));
+                             "a number in [2.2250738585072014e-308, 1]", &ModelParams::eccentricity,
+                             [](double x) { return x >= kMinEccentricity && x <= 1.0; });
   s.from_fiber = "fiber.eccentricity";
   s.fit_min = 1e-3;
   s.fit_max = 1.0;
@@ -239,6 +265,13 @@ void apply_setting(const std::string& model_name, const ParamTable& table, Model
     throw Error(fmt::format("--set {}: model {} has no parameter '{}'; allowed keys: {}", key_value,
                             model_name, key, key_list(table)));
   spec->set(params, value);
+}
+
+void check_params(const std::string& model_name, const ParamTable& table, const ModelParams& params) {
+  for (const ParamSpec& spec : table)
+    if (spec.in_range && !spec.in_range(params))
+      throw Error(fmt::format("model {}: {} = {} is out of range; allowed: {}", model_name, spec.key,
+                              spec.show(params), spec.allowed));
 }
 
 ModelParams table_defaults(const ParamTable& table) {

@@ -39,6 +39,10 @@ struct ParamSpec {
   std::function<void(ModelParams&, const std::string& value)> set;
   // The current value, in command-line units (degrees), as text.
   std::function<std::string(const ModelParams&)> show;
+  // Whether the current value is in the allowed range: `set` checks text,
+  // this checks values that came another way (a simulation's fiber, a fit,
+  // an atlas config), in check_params().
+  std::function<bool(const ModelParams&)> in_range;
   // The current value for files (radians).
   std::function<ParamAttribute(const ModelParams&)> attribute;
   // Fitting (compare/fit.h). Scalar parameters (number_param) only: the
@@ -89,7 +93,8 @@ ParamSpec lobes_param();
 ParamSpec beta_long_param(std::string meaning);
 ParamSpec beta_azim_param(std::string meaning);
 ParamSpec alpha_param(std::string meaning);
-ParamSpec eccentricity_param(std::string allowed, std::function<bool(double)> ok);
+// eccentricity in [kMinEccentricity, 1] (common/physical_limits.h), as the simulator's.
+ParamSpec eccentricity_param();
 ParamSpec absorption_param(std::string default_value);
 
 // The spec of `key` in `table`, or nullptr.
@@ -99,6 +104,11 @@ const ParamSpec* find_param(const ParamTable& table, const std::string& key);
 // not in the table: fiberlab::Error naming the key, the model and its keys.
 void apply_setting(const std::string& model_name, const ParamTable& table, ModelParams& params,
                    const std::string& key_value);
+
+// Every parameter of `params` in its table's range; otherwise fiberlab::Error
+// "model NAME: KEY = VALUE is out of range; allowed: ...". make_model() calls
+// it, so that no model is built from a value --set would refuse.
+void check_params(const std::string& model_name, const ParamTable& table, const ModelParams& params);
 
 // The table's defaults applied to a ModelParams.
 ModelParams table_defaults(const ParamTable& table);

@@ -3,6 +3,8 @@
 #include <fmt/core.h>
 #include <fmt/ranges.h>
 
+#include <map>
+
 #include "common/error.h"
 
 namespace fiberlab::analytic {
@@ -49,11 +51,27 @@ void apply_setting(const std::string& name, ModelParams& params, const std::stri
 
 void apply_settings(const std::string& name, ModelParams& params,
                     const std::vector<std::string>& key_values) {
-  for (const std::string& kv : key_values) apply_setting(name, params, kv);
+  // Each key once: a repeated key would keep its last value silently.
+  std::map<std::string, std::string> seen;
+  for (const std::string& kv : key_values) {
+    const std::size_t eq = kv.find('=');
+    if (eq != std::string::npos) {
+      std::string key = kv.substr(0, eq);
+      key.erase(0, key.find_first_not_of(" \t"));
+      key.erase(key.find_last_not_of(" \t") + 1);
+      const auto [it, fresh] = seen.emplace(key, kv);
+      if (!fresh)
+        throw Error(fmt::format("--set {}: {} is already set by --set {} (give each key once)", kv,
+                                key, it->second));
+    }
+    apply_setting(name, params, kv);
+  }
 }
 
 std::unique_ptr<Model> make_model(const std::string& name, const ModelParams& params) {
-  return model_info(name).make(params);
+  const ModelInfo& m = model_info(name);
+  check_params(m.name, m.params, params);
+  return m.make(params);
 }
 
 std::string describe_params(const std::string& name, const ModelParams& params) {

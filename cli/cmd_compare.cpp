@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include "analytic/model_registry.h"
@@ -36,7 +37,8 @@ struct CompareOptions {
   std::string result, model, prediction, fit, report, fit_lobes;
   bool per_lobe = false;
   std::vector<std::string> settings;
-  double max_chi2 = 0.0;  // <= 0: the five-sigma rule of compare/verdict.h
+  std::optional<double> max_chi2;  // none: the five-sigma rule of compare/verdict.h
+  double max_chi2_value = 0.0;
   double min_effective = 30.0, model_error = 1e-4, min_energy = 1e-4;
   int channel = 0;
 };
@@ -69,7 +71,7 @@ Predicted predicted_by_model(const sim::ResultFile& result, const compare::Model
 }
 
 Predicted predicted_by_file(const sim::ResultFile& result, const CompareOptions& o) {
-  const compare::PredictionFile file = compare::read_prediction(o.prediction);
+  const compare::PredictionFile file = compare::read_prediction_for(o.prediction, result, o.result);
   Predicted p;
   p.label = fmt::format("{} (model {})", o.prediction, file.model.empty() ? "not named" : file.model);
   p.header = "prediction " + p.label + "\n";
@@ -113,8 +115,12 @@ std::string per_lobe_fits(const sim::ResultFile& result, const compare::ModelSpe
 }
 
 void compare_command(const CompareOptions& o) {
-  if (o.max_chi2 < 0.0) throw Error(fmt::format("--max-chi2 = {} must be > 0", o.max_chi2));
-  if (!(o.min_effective > 0.0)) throw Error("--min-effective must be > 0");
+  compare::Options copt;
+  copt.min_effective = o.min_effective;
+  copt.model_rel_error = o.model_error;
+  copt.min_lobe_energy = o.min_energy;
+  compare::check_options(copt, o.max_chi2, compare::OptionSpelling::CommandLine);
+  const double max_chi2 = o.max_chi2.value_or(0.0);  // 0: the five-sigma rule
   const bool from_file = !o.prediction.empty();
   if (from_file == !o.model.empty())
     throw Error("compare: give either --model NAME or --prediction PRED.h5 (exactly one)");
@@ -131,12 +137,8 @@ void compare_command(const CompareOptions& o) {
     spec = compare::parse_model_spec(o.model);
     params = compare::params_for(result.settings, spec, o.settings);
     analytic::make_model(spec.name, params);  // the model's own checks, before any output
-    for (const std::string& key : split_commas(o.fit)) compare::check_fit_key(spec.name, key);
+    compare::check_fit_keys(spec.name, split_commas(o.fit));
   }
-  compare::Options copt;
-  copt.min_effective = o.min_effective;
-  copt.model_rel_error = o.model_error;
-  copt.min_lobe_energy = o.min_energy;
   compare::Options fit_opt = copt;  // the lobes the fit judges and fits
   if (!o.fit_lobes.empty())
     fit_opt.lobes = compare::parse_fit_lobes(split_commas(o.fit_lobes), result.lobes, "--fit-lobes");
@@ -148,7 +150,7 @@ void compare_command(const CompareOptions& o) {
              result.configs(), result.lobes, result.channels, result.grid.n_theta(), result.grid.n_phi());
   Predicted current = from_file ? pred : predicted_by_model(result, spec, params);
   fmt::print("{}", current.header);
-  compare::Verdict v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), o.max_chi2);
+  compare::Verdict v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), max_chi2);
   fmt::print("{}", compare::verdict_table(v, result.lobes));
 
   std::string fit_json = "null", fit_md;
@@ -161,17 +163,21 @@ void compare_command(const CompareOptions& o) {
     params = fr.params;
     current = predicted_by_model(result, spec, params);
     const compare::Verdict before = v;
-    v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), o.max_chi2);
+    v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), max_chi2);
     fmt::print("{}", compare::fit_text(fr, before, v, result.lobes));
     fit_md = compare::fit_markdown(fr, before, v, result.lobes);
     fit_json = compare::fit_json(fr, before, v);
     fmt::print("\nafter the fit: {}", current.header);
     fmt::print("{}", compare::verdict_table(v, result.lobes));
-    if (o.per_lobe) fit_md += per_lobe_fits(result, spec, start, split_commas(o.fit), fit_opt, o.max_chi2, before);
+    if (o.per_lobe) fit_md += per_lobe_fits(result, spec, start, split_commas(o.fit), fit_opt, max_chi2, before);
   }
 
   fmt::print("\n{} of {} judged lobes accepted ({}); {:.1f} s\n", v.judged - v.rejected, v.judged, v.criterion,
              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  if (v.judged == 0)
+    fmt::print("no lobe was judged (each has energy below --min-energy = {:g} in both the result and "
+               "the prediction, or no compared bins): nothing is accepted, exit status 1\n",
+               o.min_energy);
 
   if (!o.report.empty()) {
     compare::CompareReport rep;
@@ -193,7 +199,8 @@ void compare_command(const CompareOptions& o) {
 void add_compare_command(CLI::App& app) {
   auto o = std::make_shared<CompareOptions>();
   CLI::App* cmd = app.add_subcommand(
-      "compare", "Validate a model against a result's histograms (exit 0 accepted, 1 rejected, 2 bad input)");
+      "compare", "Validate a model against a result's histograms (exit 0: every judged lobe accepted, "
+                 "at least one judged; 1: a lobe rejected, or none judged; 2: bad input)");
   cmd->add_option("result", o->result, "Result file (.h5)")->required();
   cmd->add_option("--model", o->model,
                   fmt::format("{}, optionally NAME:KEY=VALUE:... (per-model --set)",
@@ -212,16 +219,21 @@ void add_compare_command(CLI::App& app) {
                 "Also fit each lobe alone (its own beta_long[p], beta_azim[p], alpha[p] where the model has them), "
                 "after the joint fit");
   cmd->add_option("--report", o->report, "Write a report folder (report.md, metrics.csv/json, PNG plots)");
-  cmd->add_option("--max-chi2", o->max_chi2,
-                  "Accept a lobe when chi2/dof <= X (default: 1 + 5 sqrt(2/dof), five standard deviations)");
+  CLI::Option* max_chi2 = cmd->add_option("--max-chi2", o->max_chi2_value,
+                  "Accept a lobe when chi2/dof <= X, X > 0 (default: 1 + 5 sqrt(2/dof), five standard deviations)");
   cmd->add_option("--min-effective", o->min_effective, "Bins compared one by one need S1^2/S2 >= this (30)");
   cmd->add_option("--model-error", o->model_error,
-                  "Relative error assumed for the model's bin integrals (1e-4)");
-  cmd->add_option("--min-energy", o->min_energy, "Lobes below this energy (both sides) are not judged (1e-4)");
+                  "Relative error assumed for the model's bin integrals, in [0, 1] (1e-4)");
+  cmd->add_option("--min-energy", o->min_energy,
+                  "Lobes below this energy (both sides) are not judged, in [0, 1) (1e-4); when no lobe "
+                  "is judged nothing is accepted (exit 1)");
   cmd->add_option("--channel", o->channel, "Channel shown in the plots (0)");
   // Built when --help asks for it, not at every start (about 0.3 ms each).
   cmd->footer([] { return "\nModel parameters (--set KEY=VALUE):\n\n" + analytic::models_listing(); });
-  cmd->callback([o] { compare_command(*o); });
+  cmd->callback([o, max_chi2] {
+    if (max_chi2->count() > 0) o->max_chi2 = o->max_chi2_value;
+    compare_command(*o);
+  });
 }
 
 }  // namespace fiberlab::cli

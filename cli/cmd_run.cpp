@@ -20,6 +20,7 @@
 #include "sim/checkpoint.h"
 #include "sim/memory_budget.h"
 #include "sim/process_group.h"
+#include "sim/rank_agreement.h"
 #include "sim/result_file.h"
 #include "sim/result_stream.h"
 #include "sim/simulation.h"
@@ -46,6 +47,7 @@ void apply_run_flags(const RunOptions& o, sim::Settings& settings) {
   if (o.seed_given) settings.seed = sim::parse_integer_flag("--seed", o.seed, 0, kU64Max);
   if (o.output_given) {
     if (o.output.empty()) throw Error("command line: -o is empty (must be a file name)");
+    check_output_name(o.output);
     settings.output = o.output;
   }
   // photons x incident configurations must fit in uint64 (sim/settings.cpp
@@ -183,22 +185,30 @@ void run(const RunOptions& o) {
       threads = thread_count(o.threads_given, o.threads);
       job = set_up(o, group);
     });
+    // Every rank the same config and flags, before any tally is allocated.
+    on_all_ranks(group, [&] {
+      const std::string text = sim::run_agreement_text(job.settings, job.target_error,
+                                                       job.resumed ? &job.state : nullptr);
+      if (const auto disagreement = sim::ranks_disagree(group, text)) throw Error(*disagreement);
+    });
     std::optional<sim::Simulation> simulation;
     on_all_ranks(group, [&] {
-      simulation.emplace(job.settings);
-      if (!job.resumed) job.state = simulation->start();
-      if (!group.is_root()) job.state.tallies.clear();  // sums are kept on rank 0 only
-      // The output path and the memory, before spending time on photons.
+      // The output paths (OUT and OUT.checkpoint.h5) and the memory, before
+      // any tally is allocated.
       std::vector<std::string> inputs;
       for (const std::string& in : {o.config, o.resume})
         if (!in.empty()) inputs.push_back(in);
       if (group.is_root()) {
         check_output_target(job.settings.output, inputs);
+        check_output_name(sim::checkpoint_path(job.settings.output));
         // Temporaries of an earlier run killed while writing (SIGKILL): this
         // run may never write a checkpoint, whose writer would remove them.
         remove_stale_temporaries(sim::checkpoint_path(job.settings.output));
       }
       sim::check_memory_budget(job.settings, threads);
+      simulation.emplace(job.settings);
+      if (!job.resumed) job.state = simulation->start();
+      if (!group.is_root()) job.state.tallies.clear();  // sums are kept on rank 0 only
     });
     const std::string checkpoint = sim::checkpoint_path(job.settings.output);
     sim::RunControl control;

@@ -6,6 +6,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <climits>
 #include <cerrno>
 #include <csignal>
 #include <cstdio>
@@ -85,8 +86,34 @@ void fsync_path(const std::string& path, int flags, const std::string& target, c
 
 }  // namespace
 
+void check_output_name(const std::string& target) {
+  std::string shown;  // the path on one line: control characters as \xNN
+  bool control = false;
+  for (unsigned char c : target) {
+    control = control || c < 0x20 || c == 0x7f;
+    shown += c < 0x20 || c == 0x7f ? fmt::format("\\x{:02x}", c) : std::string(1, static_cast<char>(c));
+  }
+  if (control)
+    throw Error(fmt::format("output: {}: the path contains a control character (newline, tab, ...); "
+                            "give a name without control characters", shown));
+  // The longest name made from it: the temporary .NAME.tmp-PID, the PID up
+  // to 7 digits (Linux's pid_max is at most 2^22).
+  constexpr std::size_t kTempExtra = 1 + 5 + 7;  // ".", ".tmp-", PID
+  const std::string name = fs::path(target).filename().string();
+  long name_max = pathconf(folder_of(target).c_str(), _PC_NAME_MAX);
+  if (name_max <= 0) name_max = NAME_MAX;
+  if (name.size() + kTempExtra > static_cast<std::size_t>(name_max))
+    refuse(target, fmt::format("the file name is {} bytes; its temporary name .NAME.tmp-PID would exceed "
+                               "the folder's limit of {} bytes per name (NAME_MAX): give a name of at "
+                               "most {} bytes", name.size(), name_max, name_max - static_cast<long>(kTempExtra)));
+  if (target.size() + kTempExtra >= PATH_MAX)
+    refuse(target, fmt::format("the path is {} bytes; with its temporary name it would exceed the "
+                               "limit of {} bytes per path (PATH_MAX)", target.size(), PATH_MAX));
+}
+
 void check_output_target(const std::string& target, const std::vector<std::string>& inputs) {
   if (target.empty()) throw Error("output: the output path is empty (give a file name)");
+  check_output_name(target);
   const std::string dir = folder_of(target);
   struct stat st {};
   if (stat(dir.c_str(), &st) != 0 || !S_ISDIR(st.st_mode))

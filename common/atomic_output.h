@@ -49,6 +49,13 @@ class AtomicOutput {
 // checkpoint may finish before its next checkpoint).
 void remove_stale_temporaries(const std::string& target);
 
+// A name that every file made from it can have: no control characters (a
+// newline or tab in a name breaks the stored config and every listing), and
+// its temporary name within NAME_MAX and PATH_MAX. fiberlab::Error naming
+// the limit otherwise. Part of check_output_target; callers that derive
+// other names (OUT.checkpoint.h5) check those too.
+void check_output_name(const std::string& target);
+
 // The same checks as AtomicOutput's constructor, without creating anything.
 void check_output_target(const std::string& target, const std::vector<std::string>& inputs = {});
 

@@ -719,6 +719,16 @@ void File::write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRo
   }
 }
 
+void File::write_rows(const RowPlan& plan, hsize_t i, const PreparedRow& all) {
+  if (plan.direct) throw Error("internal error: write_rows of a direct plan (" + plan.name + ")");
+  if (plan.type == Type::Float64)
+    slab_io<double>(handle_.id(), path_, plan.name, {i}, nullptr, &all.doubles, H5T_NATIVE_DOUBLE);
+  else if (plan.type == Type::Int64)
+    slab_io<std::int64_t>(handle_.id(), path_, plan.name, {i}, nullptr, &all.signed_words, H5T_NATIVE_INT64);
+  else
+    slab_io<std::uint64_t>(handle_.id(), path_, plan.name, {i}, nullptr, &all.words, H5T_NATIVE_UINT64);
+}
+
 void File::end_rows(const RowPlan& plan) {
   if (!plan.direct) return;  // write_slab_row flushed
   errno = 0;

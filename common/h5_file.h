@@ -124,6 +124,12 @@ class File {
   static void prepare_row(const RowPlan& plan, const std::vector<std::int64_t>& values,
                           Deflater& z, PreparedRow& out);
   void write_row(const RowPlan& plan, hsize_t i, hsize_t j, const PreparedRow& row);
+  // Slab i of a plan that is not direct, every row at once (`all`'s vector
+  // of the plan's type, rows one after the other), in one write and one
+  // flush: row by row, each flush deflated again the whole chunk the row
+  // shares with its neighbours (up to 65536 cells), so writing L small rows
+  // took time quadratic in L.
+  void write_rows(const RowPlan& plan, hsize_t i, const PreparedRow& all);
   // After a plan's last row: flushes, so that a failed write is reported here.
   void end_rows(const RowPlan& plan);
   std::vector<double> read_slab_doubles(const std::string& name, hsize_t i) const;

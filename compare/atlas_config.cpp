@@ -13,6 +13,7 @@
 #include "common/error.h"
 #include "common/units.h"
 #include "compare/fit.h"
+#include "sim/yaml_keys.h"
 
 namespace fiberlab::compare {
 
@@ -199,6 +200,13 @@ std::map<std::string, std::vector<std::string>> read_model_parameters(const Read
     for (const auto& setting : kv.second) {
       const std::string key = setting.first.Scalar();
       const analytic::ParamSpec* spec = analytic::find_param(table, key);
+      // eta, sigma_a, lobes, eccentricity: each fiber's own (the atlas's eta,
+      // its absorption and eccentricity sweeps, its tally); a model told
+      // otherwise would predict another fiber or another tally shape, and
+      // fail only once the fibers are simulated.
+      if (spec->from_fiber.rfind("fiber.", 0) == 0 || spec->from_fiber.rfind("tally.", 0) == 0)
+        r.fail(fmt::format("{}.{} is each fiber's own ({}): the atlas sets it from its eta, tally and "
+                           "sweep, not per model", path, key, spec->from_fiber));
       std::string value;
       if (setting.second.IsScalar()) {
         value = setting.second.Scalar();
@@ -229,6 +237,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
     r.fail(fmt::format("malformed YAML at line {}: {}", e.mark.line + 1, e.msg));
   }
   if (!top.IsDefined() || top.IsNull()) r.fail("the config is empty (see configs/atlas_small.yaml)");
+  if (const auto key = sim::first_duplicate_key(top))
+    r.fail(fmt::format("duplicate key {} (each key may appear once)", *key));
   only_keys(r, top, "", {"photons", "seed", "eta", "tally", "sweep", "models", "model_parameters", "fit"});
   if (!top["photons"]) r.fail("photons is missing (photons per fiber and incident direction, an integer >= 1)");
   integer(r, top["photons"], "photons", 1, 1e12);

@@ -6,9 +6,25 @@
 #include <cmath>
 
 #include "analytic/model.h"
+#include "common/error.h"
 #include "common/file_schema.h"
 
 namespace fiberlab::compare {
+
+void check_options(const Options& o, std::optional<double> max_chi2, OptionSpelling spelling) {
+  auto check = [spelling](double x, const char* snake, const char* flag, bool ok, const char* allowed) {
+    if (std::isfinite(x) && ok) return;
+    throw Error(fmt::format("{} = {} is out of range (must be {})",
+                            spelling == OptionSpelling::Python ? snake : flag, x, allowed));
+  };
+  check(o.min_effective, "min_effective", "--min-effective", o.min_effective > 0.0, "a number > 0");
+  check(o.model_rel_error, "model_error", "--model-error",
+        o.model_rel_error >= 0.0 && o.model_rel_error <= 1.0, "a relative error in [0, 1]");
+  check(o.min_lobe_energy, "min_energy", "--min-energy",
+        o.min_lobe_energy >= 0.0 && o.min_lobe_energy < 1.0,
+        "in [0, 1): a fraction of the incident power; 1 or more would judge no lobe");
+  if (max_chi2) check(*max_chi2, "max_chi2", "--max-chi2", *max_chi2 > 0.0, "a number > 0");
+}
 
 std::string lobe_name(int lobe, int lobes) { return fiberlab::lobe_name(lobe, lobes); }
 

@@ -21,6 +21,7 @@
 //   predicted; the simulation's centroid with its standard error. The
 //   "measured shift" alpha_p + (centroid_sim - centroid_model) is the theta_r
 //   shift the model would need for its centroid to match (first order).
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -37,6 +38,16 @@ struct Options {
   // only these (`fit: {lobes: [...]}`, `compare --fit-lobes`).
   std::vector<int> lobes;
 };
+
+// How check_options names the options in its messages: the command line's
+// flags (--min-energy) or the Python keywords (min_energy).
+enum class OptionSpelling { CommandLine, Python };
+// Each option finite and in its range, max_chi2 (when given) too; otherwise
+// fiberlab::Error naming the option and the range: min_effective > 0,
+// model_rel_error in [0, 1] (a relative error), min_lobe_energy in [0, 1)
+// (a lobe's energy is a fraction of the incident power: 1 or more judges
+// nothing), max_chi2 > 0.
+void check_options(const Options& o, std::optional<double> max_chi2, OptionSpelling spelling);
 
 struct ChiSquare {
   double chi2 = 0.0;

@@ -1,6 +1,7 @@
 #include "compare/fit.h"
 
 #include <fmt/core.h>
+#include <fmt/ranges.h>
 
 #include <Eigen/Dense>
 #include <algorithm>
@@ -198,6 +199,22 @@ void check_fit_key(const std::string& model_name, const std::string& key) {
                             "alpha[p] per lobe (e.g. alpha[0],alpha[1]) or the physical scale_tilt"));
 }
 
+void check_fit_keys(const std::string& model_name, const std::vector<std::string>& keys) {
+  for (std::size_t i = 0; i < keys.size(); ++i) {
+    check_fit_key(model_name, keys[i]);
+    const Key b = parse_key(keys[i]);
+    for (std::size_t j = 0; j < i; ++j) {
+      const Key a = parse_key(keys[j]);
+      const bool same = a.name == b.name && (a.index == b.index || a.index < 0 || b.index < 0);
+      const bool both_alpha = (a.name == "scale_tilt" && b.name == "alpha") ||
+                              (a.name == "alpha" && b.name == "scale_tilt");
+      if (same || both_alpha)
+        throw Error(fmt::format("--fit {}: {} fits the same parameter as {} (give each parameter once)",
+                                fmt::join(keys, ","), keys[i], keys[j]));
+    }
+  }
+}
+
 std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what) {
   const std::vector<std::string> known = lobe_names(lobes);
   std::vector<int> out;
@@ -251,7 +268,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
                     const Options& options, int max_iterations,
                     const std::function<void(const std::string&)>& progress) {
   if (keys.empty()) throw Error("--fit: no parameters given");
-  for (const std::string& key : keys) check_fit_key(model_name, key);
+  check_fit_keys(model_name, keys);
   const int n = static_cast<int>(keys.size());
   FitResult fr;
   fr.keys = keys;

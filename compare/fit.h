@@ -90,6 +90,10 @@ std::pair<double, double> fit_range(const std::string& model_name, const std::st
 std::vector<std::string> free_fit_keys(const std::string& model_name);
 // Refuses (fiberlab::Error) a key that model `model_name` cannot fit.
 void check_fit_key(const std::string& model_name, const std::string& key);
+// Every key checked, and each parameter fitted once: a key repeated, a list
+// with one of its entries (beta_long and beta_long[0]), or scale_tilt with an
+// alpha[p] (both move alpha) is refused, naming both keys.
+void check_fit_keys(const std::string& model_name, const std::vector<std::string>& keys);
 
 // How a fit ended. Converged: a step changed chi2 by a negligible amount, or
 // moved every parameter by a negligible part of its error, or no downhill

@@ -92,9 +92,11 @@ bool is_prediction_file(const std::string& path) {
   }
 }
 
-PredictionFile read_prediction(const std::string& path) {
-  if (!is_hdf5_file(path)) throw Error(fmt::format("{}: not an HDF5 file", path));
-  const h5::File f = h5::File::open_read(path);
+namespace {
+
+// Everything but the probabilities, whose shape is taken from the dataset's
+// declaration (nothing allocated for it yet).
+PredictionFile read_header(const h5::File& f, const std::string& path, h5::Dims& dims) {
   if (!f.has_attr("/", "format") || f.attr_string("/", "format") != "fiber-prediction")
     throw Error(fmt::format("{}: not a prediction file (root attribute format is not \"fiber-prediction\")", path));
   for (const char* name : {"/bins/theta_edges", "/bins/phi_edges", "/source/theta_i", "/source/phi_i",
@@ -125,26 +127,28 @@ PredictionFile read_prediction(const std::string& path) {
   if (p.phi_i.size() != p.theta_i.size())
     throw Error(fmt::format("{}: /source/phi_i has {} entries, /source/theta_i {}", path, p.phi_i.size(),
                             p.theta_i.size()));
-  h5::Dims dims;
-  p.probability = f.read_doubles("/prediction/probability", &dims);
+  dims = f.shape("/prediction/probability");
   if (dims.size() != 5)
     throw Error(fmt::format("{}: /prediction/probability has {} dimensions; expected 5 "
                             "(K x lobes x n_theta x n_phi x channels)", path, dims.size()));
   const std::size_t nt = p.grid.theta_edges.size() - 1, np = p.grid.phi_edges.size() - 1;
-  if (dims[0] != p.theta_i.size() || dims[2] != nt || dims[3] != np || dims[1] < 1 || dims[4] < 1)
+  if (dims[0] != p.theta_i.size() || dims[2] != nt || dims[3] != np || dims[1] < 1 || dims[4] < 1 ||
+      dims[1] > 1000000 || dims[4] > 1000000)
     throw Error(fmt::format("{}: /prediction/probability is {} x {} x {} x {} x {}; expected {} (incident "
                             "directions) x lobes x {} x {} (bins) x channels",
                             path, dims[0], dims[1], dims[2], dims[3], dims[4], p.theta_i.size(), nt, np));
   p.lobes = static_cast<int>(dims[1]);
   p.channels = static_cast<int>(dims[4]);
-  for (std::size_t i = 0; i < p.probability.size(); ++i)
-    if (!std::isfinite(p.probability[i]))
-      throw Error(fmt::format("{}: /prediction/probability holds a non-finite value (flat index {})", path, i));
   return p;
 }
 
-std::vector<std::vector<double>> prediction_bins_for(const PredictionFile& p, const sim::ResultFile& r,
-                                                     const std::string& result_path) {
+void read_probabilities(const h5::File& f, PredictionFile& p, const h5::Dims& dims) {
+  p.probability = f.read_doubles("/prediction/probability", dims, "the file's own bins, directions, lobes and channels");
+  check_probabilities(p.probability.data(), p.probability.size(), p.path + ": /prediction/probability");
+}
+
+// The result's bins, incident directions, lobes and channels, or the first mismatch.
+void check_matches(const PredictionFile& p, const sim::ResultFile& r, const std::string& result_path) {
   auto mismatch = [&](const std::string& what) {
     return Error(fmt::format("{} does not match {}: {}", p.path, result_path, what));
   };
@@ -170,6 +174,40 @@ std::vector<std::vector<double>> prediction_bins_for(const PredictionFile& p, co
   if (p.lobes != r.lobes) throw mismatch(fmt::format("{} lobes, the result has {}", p.lobes, r.lobes));
   if (p.channels != r.channels)
     throw mismatch(fmt::format("{} channels, the result has {}", p.channels, r.channels));
+}
+
+}  // namespace
+
+void check_probabilities(const double* p, std::size_t n, const std::string& origin) {
+  for (std::size_t i = 0; i < n; ++i)
+    if (!(p[i] >= 0.0) || !std::isfinite(p[i]))
+      throw Error(fmt::format("{} holds {} at flat index {} (probabilities must be finite and >= 0)", origin,
+                              p[i], i));
+}
+
+PredictionFile read_prediction(const std::string& path) {
+  if (!is_hdf5_file(path)) throw Error(fmt::format("{}: not an HDF5 file", path));
+  const h5::File f = h5::File::open_read(path);
+  h5::Dims dims;
+  PredictionFile p = read_header(f, path, dims);
+  read_probabilities(f, p, dims);
+  return p;
+}
+
+PredictionFile read_prediction_for(const std::string& path, const sim::ResultFile& result,
+                                   const std::string& result_path) {
+  if (!is_hdf5_file(path)) throw Error(fmt::format("{}: not an HDF5 file", path));
+  const h5::File f = h5::File::open_read(path);
+  h5::Dims dims;
+  PredictionFile p = read_header(f, path, dims);
+  check_matches(p, result, result_path);
+  read_probabilities(f, p, dims);
+  return p;
+}
+
+std::vector<std::vector<double>> prediction_bins_for(const PredictionFile& p, const sim::ResultFile& r,
+                                                     const std::string& result_path) {
+  check_matches(p, r, result_path);
   std::vector<std::vector<double>> out(p.configs());
   const std::size_t n = p.per_config();
   for (std::size_t k = 0; k < p.configs(); ++k)

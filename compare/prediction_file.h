@@ -11,7 +11,7 @@
 //   /source/phi_i       K (NaN for a randomly rotated fiber)  (required)
 //   /prediction/probability  K x L x n_theta x n_phi x C, float64: the
 //       probability that a photon of incident direction k leaves in lobe l
-//       through bin (i, j), channel c (required; finite)
+//       through bin (i, j), channel c (required; finite, >= 0)
 //   /prediction attribute model (text, optional); `fiberlab predict` also
 //       writes the model's parameters and its approximations there.
 #include <string>
@@ -56,6 +56,16 @@ bool is_prediction_file(const std::string& path);
 // consistent, values finite. fiberlab::Error (exit 2) naming the file and
 // the offending name otherwise.
 PredictionFile read_prediction(const std::string& path);
+// The same for judging `result`: the file's declared shape is checked against
+// the result's (bins, directions, lobes, channels) before its probabilities
+// are read, so a small file declaring a huge array allocates nothing.
+PredictionFile read_prediction_for(const std::string& path, const sim::ResultFile& result,
+                                   const std::string& result_path);
+
+// Every probability finite and >= 0; otherwise fiberlab::Error "ORIGIN holds
+// -0.5 at flat index 3 (probabilities must be finite and >= 0)". The one
+// check of a prediction's values: files, and the Python module's arrays.
+void check_probabilities(const double* p, std::size_t n, const std::string& origin);
 
 // The prediction's bin probabilities per incident direction of `result`, in
 // the layout of compare(). Bins, incident directions (theta_i, phi_i, same

@@ -29,6 +29,7 @@ Verdict judge(std::vector<LobeComparison> rows, double max_chi2) {
     v.rejected += r.judged && !ok ? 1 : 0;
     v.all_accepted = v.all_accepted && ok;
   }
+  v.all_accepted = v.all_accepted && v.judged > 0;
   return v;
 }
 

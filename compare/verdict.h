@@ -4,7 +4,9 @@
 // (five standard deviations of chi2/dof above its mean 1 for a correct
 // model, SPEC s10), or <= a fixed limit (--max-chi2). Lobes with too little
 // energy (LobeComparison::judged false) are not judged. Exit status of the
-// command: 0 when every judged lobe is accepted, 1 otherwise.
+// command: 0 when every judged lobe is accepted and at least one lobe was
+// judged, 1 otherwise: a comparison that judged nothing accepts nothing (a
+// gate that passes without looking is no gate).
 #include <string>
 #include <vector>
 
@@ -21,7 +23,7 @@ struct Verdict {
   std::vector<bool> accepted;  // per row (true for rows not judged)
   std::vector<double> threshold;
   int judged = 0, rejected = 0;
-  bool all_accepted = true;
+  bool all_accepted = true;  // every judged lobe accepted, and judged > 0
   std::string criterion;
 };
 

@@ -69,8 +69,9 @@ void ProcessGroup::sum_to_root(std::vector<ExactTally::Word>& v) const {
   if (mpi_) mpi_->sum_u128_to_root(v.data(), v.size());
 }
 
-std::optional<std::string> ProcessGroup::agree_on_error(const std::optional<std::string>& mine) const {
-  if (!mpi_) return mine;
+std::optional<ProcessGroup::RankMessage> ProcessGroup::first_message(
+    const std::optional<std::string>& mine) const {
+  if (!mpi_) return mine ? std::optional<RankMessage>(RankMessage{rank_, *mine}) : std::nullopt;
   const int first = mpi_->min_int(mine ? rank_ : size_);
   if (first == size_) return std::nullopt;
   std::string message = rank_ == first ? *mine : std::string();
@@ -78,8 +79,14 @@ std::optional<std::string> ProcessGroup::agree_on_error(const std::optional<std:
   mpi_->broadcast(&length, sizeof length, first);
   message.resize(length);
   mpi_->broadcast(message.data(), length, first);
-  if (first != 0) message = fmt::format("rank {}: {}", first, message);
-  return message;
+  return RankMessage{first, std::move(message)};
+}
+
+std::optional<std::string> ProcessGroup::agree_on_error(const std::optional<std::string>& mine) const {
+  std::optional<RankMessage> m = first_message(mine);
+  if (!m) return std::nullopt;
+  if (m->rank != 0) return fmt::format("rank {}: {}", m->rank, m->text);
+  return std::move(m->text);
 }
 
 void ProcessGroup::broadcast(std::vector<std::uint64_t>& v) const {

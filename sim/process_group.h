@@ -41,6 +41,12 @@ class ProcessGroup {
   // When any rank passes a message, every rank gets the message of the lowest
   // such rank; nullopt when none failed.
   std::optional<std::string> agree_on_error(const std::optional<std::string>& mine) const;
+  // The same, with the rank it came from (unprefixed).
+  struct RankMessage {
+    int rank;
+    std::string text;
+  };
+  std::optional<RankMessage> first_message(const std::optional<std::string>& mine) const;
   // Sends rank 0's `v` (its size included) to every rank.
   void broadcast(std::vector<std::uint64_t>& v) const;
 

@@ -181,7 +181,20 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   static_assert(std::size(kLobeRows) == std::tuple_size_v<LobePlans>);
   for (std::size_t r = 0; r < plans.size(); ++r)
     plans[r] = create ? planned(kLobeRows[r]) : file_->plan_rows(kLobeRows[r]);
-  prepared_.resize(static_cast<std::size_t>(shape_.lobes));
+  bool any_direct = false;
+  for (const h5::File::RowPlan& plan : plans) any_direct = any_direct || plan.direct;
+  prepared_.resize(any_direct ? static_cast<std::size_t>(shape_.lobes) : 0);
+  // The slabs of the other plans, whole directions: rows 0-3 hold T x P x C
+  // cells per lobe, the counts T x P.
+  const std::size_t cells = static_cast<std::size_t>(shape_.n_theta) * shape_.n_phi;
+  const std::size_t L = static_cast<std::size_t>(shape_.lobes), C = static_cast<std::size_t>(shape_.channels);
+  for (std::size_t r = 0; r < plans.size(); ++r) {
+    h5::File::PreparedRow& slab = slabs_[r];
+    const std::size_t n = plans[r].direct ? 0 : L * cells * (r == 4 ? 1 : C);
+    if (r < 2) slab.doubles.resize(n);
+    else if (r < 4) slab.signed_words.resize(n);
+    else slab.words.resize(n);
+  }
   const int threads = std::clamp(threads_, 1, shape_.lobes);
   if (scratch_.size() < static_cast<std::size_t>(threads)) scratch_.resize(threads);
   std::exception_ptr failure;  // the first; the parts after it are skipped
@@ -206,7 +219,8 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
       const auto [l, part] = parts[i];
       if (failed) continue;
       try {
-        prepare_part(l, part, plans, bins, scratch_[omp_get_thread_num()], prepared_[l]);
+        Scratch& scratch = scratch_[omp_get_thread_num()];
+        prepare_part(l, part, plans, bins, scratch, any_direct ? prepared_[l] : scratch.unused);
       } catch (...) {
         record_failure();
       }
@@ -218,7 +232,9 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
     for (h5::File::RowPlan& plan : plans) f.attach(plan);
   for (int l = 0; l < shape_.lobes; ++l)
     for (std::size_t r = 0; r < plans.size(); ++r)
-      f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
+      if (plans[r].direct) f.write_row(plans[r], k, static_cast<hsize_t>(l), prepared_[l][r]);
+  for (std::size_t r = 0; r < plans.size(); ++r)
+    if (!plans[r].direct) f.write_rows(plans[r], k, slabs_[r]);
   for (const h5::File::RowPlan& plan : plans) f.end_rows(plan);
   f.start_writeback();
   f.write_slab("/ledger/exited", k, ExactTally::to_double(ledger.exited));
@@ -236,15 +252,21 @@ void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const B
   const auto deflater = [](const h5::File::RowPlan& plan) -> Deflater& {
     return thread_deflater(plan.direct ? plan.level : 1);  // (unused when not direct)
   };
+  // A direct plan's row deflated into out; another's values copied into its
+  // place in the direction's slab (lobe l's cells; threads fill disjoint parts).
+  const auto put = [&](std::size_t r, const auto& values, auto& slab) {
+    if (plans[r].direct) h5::File::prepare_row(plans[r], values, deflater(plans[r]), out[r]);
+    else std::copy(values.begin(), values.end(), slab.begin() + static_cast<std::ptrdiff_t>(l * values.size()));
+  };
   if (part == 2) {
     bins.counts(l, s.count);
-    h5::File::prepare_row(plans[4], s.count, deflater(plans[4]), out[4]);
+    put(4, s.count, slabs_[4].words);
     return;
   }
   // S1: rows 0 (values) and 2 (residuals); S2: rows 1 and 3.
   bins.sums(l, part == 0 ? BinSum::S1 : BinSum::S2, s.value, s.residual);
-  h5::File::prepare_row(plans[part], s.value, deflater(plans[part]), out[part]);
-  h5::File::prepare_row(plans[2 + part], s.residual, deflater(plans[2 + part]), out[2 + part]);
+  put(part, s.value, slabs_[part].doubles);
+  put(2 + part, s.residual, slabs_[2 + part].signed_words);
 }
 
 void ResultWriter::commit() {

@@ -75,6 +75,7 @@ class ResultWriter {
     std::vector<std::uint64_t> count;
     std::vector<double> value;
     std::vector<std::int64_t> residual;
+    std::array<h5::File::PreparedRow, 5> unused;  // out of a lobe whose datasets are all slabs_
   };
   // lobe_work[l]: lobe l's relative cost (the lobes are taken heaviest first).
   void write_direction(std::size_t k, const TallyShape& shape, const ExactLedger& ledger,
@@ -96,7 +97,13 @@ class ResultWriter {
   std::vector<std::uint64_t> photons_;
   TallyShape shape_;
   std::vector<Scratch> scratch_;   // [thread]
-  std::vector<std::array<h5::File::PreparedRow, 5>> prepared_;  // [lobe][dataset], until written
+  // [lobe][dataset], until written: rows deflated ahead (direct plans); empty
+  // when no plan is direct.
+  std::vector<std::array<h5::File::PreparedRow, 5>> prepared_;
+  // [dataset]: the other plans' values, the direction's lobes one after the
+  // other, written as one slab (a few bytes per lobe, not a PreparedRow of
+  // about 600 bytes: a million lobes of 1 x 1 bins took 0.7 GB).
+  std::array<h5::File::PreparedRow, 5> slabs_;
   int threads_ = 1;
 };
 

@@ -25,13 +25,16 @@
 #include <yaml-cpp/yaml.h>
 
 #include "common/error.h"
+#include "common/physical_limits.h"
 #include "common/units.h"
+#include "sim/yaml_keys.h"
 
 namespace fiberlab::sim {
 namespace {
 
 constexpr int kMaxChannels = 64;
 constexpr std::size_t kMaxRangeAngles = 100000;  // theta_i {from, to, step}
+constexpr std::size_t kMaxBetaEntries = 1024;      // roughness.beta_long/beta_azim lists (8 KiB each)
 constexpr double kMaxTallyBytes = 8.0 * 1024 * 1024 * 1024;
 constexpr std::uint64_t kIntMax = std::numeric_limits<int>::max();
 constexpr std::uint64_t kU64Max = std::numeric_limits<std::uint64_t>::max();
@@ -183,7 +186,10 @@ class Reader {
     }
     if (docs.size() > 1)
       fail(fmt::format("contains {} YAML documents (must be exactly one)", docs.size()));
-    return docs.empty() ? YAML::Node() : docs.front();
+    if (docs.empty()) return YAML::Node();
+    if (const auto key = first_duplicate_key(docs.front()))
+      fail(fmt::format("duplicate key {} (each key may appear once)", *key));
+    return docs.front();
   }
 
   // A section (`fiber:` ...): a mapping whose keys are all in `allowed`.
@@ -313,8 +319,12 @@ class Reader {
 
 // ---------------------------------------------------------------- rules
 
-const Rule kEta{"must be > 1", [](double x) { return x > 1.0; }};
-const Rule kEccentricity{"must be in (0, 1]", [](double x) { return x > 0.0 && x <= 1.0; }};
+// The bounds and why: common/physical_limits.h.
+const Rule kEta{"must be in (1, 1e9]: beyond 1e9 the Fresnel transmittance is lost in rounding",
+                [](double x) { return x > 1.0 && x <= kMaxEta; }};
+const Rule kEccentricity{"must be in [2.2250738585072014e-308, 1]: a smaller ratio is a subnormal "
+                         "double (fewer bits; its inverse overflows below 5.6e-309)",
+                         [](double x) { return x >= kMinEccentricity && x <= 1.0; }};
 const Rule kTilt{"must be in (-45, 45) degrees", [](double x) { return std::fabs(x) < 45.0; }};
 const Rule kNonNegative{"must be a finite number >= 0", [](double x) { return x >= 0.0; }};
 const Rule kSigmaA{"must be a finite number >= 0, or a list of 1 to 64 such numbers",
@@ -416,6 +426,15 @@ void read_roughness(const Reader& r, const YAML::Node& parent, RoughnessSettings
   g.beta_azim = n["beta_azim"]
                     ? to_radians(r.numbers(n["beta_azim"], "roughness.beta_azim", beta, lists))
                     : g.beta_long;
+  // Each list is stored in the result as an attribute of /roughness, and an
+  // HDF5 1.10 attribute holds at most 64 KiB: refused here, not after the run.
+  for (const char* key : {"beta_long", "beta_azim"}) {
+    const std::vector<double>& list = std::string(key) == "beta_long" ? g.beta_long : g.beta_azim;
+    if (list.size() > kMaxBetaEntries)
+      r.bad(std::string("roughness.") + key, n[key], fmt::format("has {} entries", list.size()),
+            fmt::format("must have at most {} (one per order p, the last for every larger p)",
+                        kMaxBetaEntries));
+  }
 }
 
 // theta_i: {from, to, step} in degrees, `to` included within 1e-9 of a step.

@@ -245,9 +245,15 @@ RunOutcome Simulation::Runner::run(RunStatistics* stats) {
   const std::size_t K = state_.next_photon.size();
   const std::uint64_t total = cap_ * K;
   std::uint64_t traced = 0;
-  std::uint64_t round_chunks = static_cast<std::uint64_t>(threads_) * group_.size();
+  // The first round's size must be the same on every rank (each takes its
+  // share of the same photons), and ranks may run different --threads: the
+  // largest, agreed. Later sizes are rank 0's proposals, agreed likewise.
+  std::vector<std::int64_t> most_threads{threads_};
+  group_.max(most_threads);
+  std::uint64_t round_chunks = static_cast<std::uint64_t>(most_threads[0]) * group_.size();
   auto last_checkpoint = Clock::now();
-  progress_done_ = photons_done();
+  std::uint64_t finished = photons_done();  // photons_done(), kept up to date
+  progress_done_ = finished;
   RunOutcome outcome = RunOutcome::Finished;
   {
     ProgressTicker ticker(group_.is_root() ? control_.progress : ProgressCallback{},
@@ -289,7 +295,11 @@ RunOutcome Simulation::Runner::run(RunStatistics* stats) {
         if (last || judged || checkpoint) flush(k);
         if (last) state_.done[k] = 1;
         else if (judged && target_reached(k)) state_.done[k] = 1;
-        progress_done_ = photons_done();
+        // Only direction k changed: its share, updated in O(1) (the sum over
+        // every direction at each round made a run of K directions, each at
+        // least one round, take time quadratic in K).
+        finished += (state_.done[k] ? cap_ : reached) - first;
+        progress_done_ = finished;
         if (checkpoint) {
           if (group_.is_root() && control_.checkpoint) control_.checkpoint(state_);
           last_checkpoint = Clock::now();

@@ -98,22 +98,15 @@ py::dict compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c
 
 }  // namespace
 
-// The checks of `fiberlab compare`'s flags (cli/cmd_compare.cpp), with
+// The checks of `fiberlab compare`'s flags (compare::check_options), with
 // Python's keyword names.
 compare::Options comparison_options(std::optional<double> max_chi2, double min_effective, double model_error,
                                     double min_energy) {
-  if (max_chi2 && !(*max_chi2 > 0.0 && std::isfinite(*max_chi2)))
-    throw Error("max_chi2 = " + std::to_string(*max_chi2) + ": must be a finite number > 0 (or None: 1 + 5 sqrt(2/dof))");
-  if (!(min_effective > 0.0 && std::isfinite(min_effective)))
-    throw Error("min_effective must be a finite number > 0");
-  if (!(model_error >= 0.0 && std::isfinite(model_error)))
-    throw Error("model_error must be a finite number >= 0 (a relative error)");
-  if (!(min_energy >= 0.0 && min_energy < 1.0))
-    throw Error("min_energy must be a number in [0, 1) (a fraction of the launched weight)");
   compare::Options o;
   o.min_effective = min_effective;
   o.model_rel_error = model_error;
   o.min_lobe_energy = min_energy;
+  compare::check_options(o, max_chi2, compare::OptionSpelling::Python);
   return o;
 }
 

@@ -88,7 +88,7 @@ def test_run_is_reproducible_for_any_thread_count():
 
 
 @pytest.mark.parametrize("config, words", [
-    ({"fiber": {"eta": 0.5}}, ["fiber.eta", "must be > 1"]),
+    ({"fiber": {"eta": 0.5}}, ["fiber.eta", "must be in (1, 1e9]"]),
     ({"fibre": {}}, ["unknown key fibre"]),
     ({"source": {"theta_i": [95]}}, ["source.theta_i"]),
 ])

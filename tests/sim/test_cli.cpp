@@ -100,7 +100,7 @@ TEST_F(Cli, MalformedYaml) {
 
 TEST_F(Cli, OutOfRangeValueNamesFieldAndRange) {
   write("bad.yaml", "photons: 100\nfiber: {eta: 0.9}\n");
-  expect_refused("run " + path("bad.yaml") + " -o " + path("x.h5"), {"fiber.eta", "0.9", "> 1"});
+  expect_refused("run " + path("bad.yaml") + " -o " + path("x.h5"), {"fiber.eta", "0.9", "(1, 1e9]"});
 }
 
 TEST_F(Cli, WrongType) {

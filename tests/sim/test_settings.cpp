@@ -266,7 +266,7 @@ TEST(Settings, ToYamlRoundTripsExactly) {
 
 TEST(SettingsErrors, TheExampleMessage) {
   EXPECT_EQ(error_of("fiber:\n  eta: 0.9\n"),
-            "configs/x.yaml: fiber.eta = 0.9 is out of range (must be > 1)");
+            "configs/x.yaml: fiber.eta = 0.9 is out of range (must be in (1, 1e9]: beyond 1e9 the Fresnel transmittance is lost in rounding)");
 }
 
 TEST(SettingsErrors, MalformedYamlReportsLineAndColumn) {
@@ -276,10 +276,10 @@ TEST(SettingsErrors, MalformedYamlReportsLineAndColumn) {
 }
 
 TEST(SettingsErrors, WrongTypes) {
-  expect_error("fiber: {eta: abc}\n", {"fiber.eta", "abc", "not a number", "must be > 1"});
-  expect_error("fiber: {eta: \"1.5\"}\n", {"fiber.eta", "not a number", "must be > 1"});
-  expect_error("fiber: {eta: [1, 2]}\n", {"fiber.eta", "is a list", "must be > 1"});
-  expect_error("fiber: {eta: }\n", {"fiber.eta", "no value", "must be > 1"});
+  expect_error("fiber: {eta: abc}\n", {"fiber.eta", "abc", "not a number", "must be in (1, 1e9]"});
+  expect_error("fiber: {eta: \"1.5\"}\n", {"fiber.eta", "not a number", "must be in (1, 1e9]"});
+  expect_error("fiber: {eta: [1, 2]}\n", {"fiber.eta", "is a list", "must be in (1, 1e9]"});
+  expect_error("fiber: {eta: }\n", {"fiber.eta", "no value", "must be in (1, 1e9]"});
   expect_error("fiber: 3\n", {"fiber = 3", "mapping", "eta, eccentricity"});
   expect_error("photons: 1.5\n", {"photons = 1.5", "not an integer", "integer >= 1"});
   expect_error("photons: lots\n", {"photons = lots", "not an integer", "integer >= 1"});
@@ -299,10 +299,10 @@ TEST(SettingsErrors, OutOfRange) {
   expect_error("photons: -5\n", {"photons = -5", "out of range", "integer >= 1"});
   expect_error("seed: -1\n", {"seed = -1", "out of range", "integer >= 0"});
   expect_error("output: ''\n", {"output", "empty", "non-empty"});
-  expect_error("fiber: {eta: 1}\n", {"fiber.eta = 1", "out of range", "> 1"});
-  expect_error("fiber: {eta: .nan}\n", {"fiber.eta", "finite", "> 1"});
-  expect_error("fiber: {eccentricity: 0}\n", {"fiber.eccentricity = 0", "(0, 1]"});
-  expect_error("fiber: {eccentricity: 1.2}\n", {"fiber.eccentricity = 1.2", "(0, 1]"});
+  expect_error("fiber: {eta: 1}\n", {"fiber.eta = 1", "out of range", "(1, 1e9]"});
+  expect_error("fiber: {eta: .nan}\n", {"fiber.eta", "finite", "(1, 1e9]"});
+  expect_error("fiber: {eccentricity: 0}\n", {"fiber.eccentricity = 0", "[2.2250738585072014e-308, 1]"});
+  expect_error("fiber: {eccentricity: 1.2}\n", {"fiber.eccentricity = 1.2", "[2.2250738585072014e-308, 1]"});
   expect_error("fiber: {scale_tilt: -45}\n", {"fiber.scale_tilt = -45", "(-45, 45)"});
   expect_error("fiber: {sigma_a: [0.1, -0.2]}\n", {"fiber.sigma_a[1] = -0.2", ">= 0"});
   expect_error("fiber: {sigma_a: [0.1, .inf]}\n", {"fiber.sigma_a[1]", "finite", ">= 0"});
@@ -400,7 +400,7 @@ TEST(SettingsErrors, LoadSettingsNamesTheFile) {
     load_settings(file.string());
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_EQ(std::string(e.what()), file.string() + ": fiber.eta = 0.9 is out of range (must be > 1)");
+    EXPECT_EQ(std::string(e.what()), file.string() + ": fiber.eta = 0.9 is out of range (must be in (1, 1e9]: beyond 1e9 the Fresnel transmittance is lost in rounding)");
   }
   fs::remove(file);
 }

@@ -1,0 +1,83 @@
+// Every model parameter has a meaningful range in its table, checked in one
+// place (analytic::check_params, called by make_model) whatever way the value
+// came: --set text, a simulation's fiber, a fit, an atlas config.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "analytic/model_registry.h"
+#include "common/error.h"
+#include "common/physical_limits.h"
+#include "common/units.h"
+
+namespace fiberlab::analytic {
+namespace {
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(ParamRanges, EveryParameterHasARangeAndItsDefaultIsInIt) {
+  for (const ModelInfo& m : registered_models()) {
+    const ModelParams p = table_defaults(m.params);
+    for (const ParamSpec& s : m.params) {
+      ASSERT_TRUE(s.in_range) << m.name << " " << s.key;
+      EXPECT_TRUE(s.in_range(p)) << m.name << " " << s.key << " default " << s.default_value;
+    }
+    EXPECT_NO_THROW(check_params(m.name, m.params, p)) << m.name;
+  }
+}
+
+TEST(ParamRanges, ValuesSetWithoutTextAreCheckedBeforeAModelIsBuilt) {
+  // d'Eon's beta_long = 1e300 degrees once gave energy 0 silently.
+  ModelParams p = default_params("deon2011");
+  p.beta_long = {deg_to_rad(1e300)};
+  const std::string e = error_of([&] { make_model("deon2011", p); });
+  EXPECT_NE(e.find("model deon2011: beta_long = 1e+300 is out of range; allowed: a comma list of degrees in [0, 90]"),
+            std::string::npos)
+      << e;
+  // The fiber's eta, from a result, at and beyond the simulator's bound.
+  ModelParams q = default_params("exact");
+  q.eta = kMaxEta;
+  EXPECT_NO_THROW(check_params("exact", model_info("exact").params, q));
+  q.eta = std::nextafter(kMaxEta, INFINITY);
+  EXPECT_NE(error_of([&] { make_model("exact", q); }).find("eta = 1e+09 is out of range; allowed: a number in (1, 1e9]"),
+            std::string::npos);
+  q.eta = NAN;
+  EXPECT_NE(error_of([&] { make_model("exact", q); }).find("eta = nan is out of range"), std::string::npos);
+  ModelParams r = default_params("marschner2003");
+  r.eccentricity = 1e-310;
+  EXPECT_NE(error_of([&] { make_model("marschner2003", r); }).find("eccentricity"), std::string::npos);
+  r = default_params("marschner2003");
+  r.k_g = 1e300;
+  EXPECT_NE(error_of([&] { make_model("marschner2003", r); }).find("k_g = 1e+300 is out of range"), std::string::npos);
+}
+
+TEST(ParamRanges, SetTextAtAndBeyondTheBounds) {
+  ModelParams p = default_params("deon2011");
+  EXPECT_NO_THROW(apply_setting("deon2011", p, "beta_long=90"));
+  EXPECT_THROW(apply_setting("deon2011", p, "beta_long=90.000001"), Error);
+  EXPECT_NO_THROW(apply_setting("deon2011", p, "alpha=-90,90"));
+  EXPECT_THROW(apply_setting("deon2011", p, "alpha=-90.5"), Error);
+  EXPECT_NO_THROW(apply_setting("deon2011", p, "eta=1e9"));
+  EXPECT_THROW(apply_setting("deon2011", p, "eta=1.000001e9"), Error);
+  ModelParams m = default_params("huang2022");
+  EXPECT_NO_THROW(apply_setting("huang2022", m, "eccentricity=2.2250738585072014e-308"));
+  EXPECT_THROW(apply_setting("huang2022", m, "eccentricity=2.2e-308"), Error);
+}
+
+TEST(ParamRanges, ARepeatedSetKeyIsRefused) {
+  ModelParams p = default_params("deon2011");
+  EXPECT_NO_THROW(apply_settings("deon2011", p, {"beta_long=2", "beta_azim=3"}));
+  const std::string e = error_of([&] { apply_settings("deon2011", p, {"beta_long=2", " beta_long =3"}); });
+  EXPECT_NE(e.find("--set  beta_long =3: beta_long is already set by --set beta_long=2"), std::string::npos) << e;
+}
+
+}  // namespace
+}  // namespace fiberlab::analytic
