@@ -180,9 +180,10 @@ void check_matches(const PredictionFile& p, const sim::ResultFile& r, const std:
 
 void check_probabilities(const double* p, std::size_t n, const std::string& origin) {
   for (std::size_t i = 0; i < n; ++i)
-    if (!(p[i] >= 0.0) || !std::isfinite(p[i]))
-      throw Error(fmt::format("{} holds {} at flat index {} (probabilities must be finite and >= 0)", origin,
-                              p[i], i));
+    if (!(p[i] >= -kProbabilityRounding) || !std::isfinite(p[i]))
+      throw Error(fmt::format("{} holds {} at flat index {} (probabilities must be finite and >= 0; "
+                              "down to -{:g} is taken as rounding)",
+                              origin, p[i], i, kProbabilityRounding));
 }
 
 PredictionFile read_prediction(const std::string& path) {

@@ -62,9 +62,18 @@ PredictionFile read_prediction(const std::string& path);
 PredictionFile read_prediction_for(const std::string& path, const sim::ResultFile& result,
                                    const std::string& result_path);
 
-// Every probability finite and >= 0; otherwise fiberlab::Error "ORIGIN holds
-// -0.5 at flat index 3 (probabilities must be finite and >= 0)". The one
-// check of a prediction's values: files, and the Python module's arrays.
+// A bin probability a model computes as a sum of quadrature terms of both
+// signs (marschner2003's TRT glint correction, s5.2.2) can land a rounding
+// below zero: fiberlab's own marschner2003 bins reach about -1e-11. Values
+// down to -kProbabilityRounding are taken as they are (no bin's statistics
+// can resolve them: a bin's standard error is at least 1/N of its photons);
+// anything more negative is not a probability.
+inline constexpr double kProbabilityRounding = 1e-9;
+
+// Every probability finite and >= -kProbabilityRounding; otherwise
+// fiberlab::Error "ORIGIN holds -0.5 at flat index 3 (probabilities must be
+// finite and >= 0; ...)". The one check of a prediction's values: files, and
+// the Python module's arrays.
 void check_probabilities(const double* p, std::size_t n, const std::string& origin);
 
 // The prediction's bin probabilities per incident direction of `result`, in

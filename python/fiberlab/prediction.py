@@ -72,8 +72,10 @@ class Prediction:
         # A probability of your own must not be negative (as a --prediction
         # file's); an analytic model's bins are taken as the model gives them,
         # as `fiberlab compare --model` does.
-        if not _from_model and np.any(probability < 0):
-            raise _fiberlab.Error("probability holds a negative value (a bin's probability is >= 0)")
+        # Down to -probability_rounding is rounding (compare/prediction_file.h).
+        if not _from_model and np.any(probability < -_fiberlab.probability_rounding):
+            raise _fiberlab.Error("probability holds a negative value (a bin's probability is >= 0; down to "
+                                  "-%g is taken as rounding)" % _fiberlab.probability_rounding)
         self.probability = probability
         self.model = model
         self.params = dict(params or {})

@@ -11,6 +11,7 @@
 #include "common/error.h"
 #include "common/units.h"
 #include "compare/comparison.h"
+#include "compare/prediction_file.h"
 #include "compare/verdict.h"
 #include "sim/result_file.h"
 
@@ -128,6 +129,7 @@ void bind_comparison(py::module_& m) {
         py::arg("min_energy") = 1e-4,
         "compare::compare's statistics per (k, lobe, channel) and compare::judge's verdict");
   m.def("model_names", &analytic::model_names);
+  m.attr("probability_rounding") = compare::kProbabilityRounding;  // compare/prediction_file.h
 }
 
 }  // namespace fiberlab::python

@@ -65,9 +65,10 @@ TEST(JudgingOptions, NothingJudgedIsNotAccepted) {
 }
 
 TEST(JudgingOptions, ProbabilitiesFiniteAndNonNegative) {
-  const std::vector<double> ok{0.0, 0.5, 1e-300};
+  // -1e-11: the rounding of fiberlab's own marschner2003 bins (accepted).
+  const std::vector<double> ok{0.0, 0.5, 1e-300, -1e-300, -1e-11};
   EXPECT_NO_THROW(check_probabilities(ok.data(), ok.size(), "p"));
-  for (double bad : {-1e-300, -0.0 - 1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
+  for (double bad : {-1e-8, -0.0 - 1.0, std::nan(""), std::numeric_limits<double>::infinity()}) {
     const std::vector<double> v{0.1, bad};
     const std::string e = error_of([&] { check_probabilities(v.data(), v.size(), "pred.h5: /prediction/probability"); });
     EXPECT_NE(e.find("pred.h5: /prediction/probability holds"), std::string::npos) << e;
