@@ -158,7 +158,9 @@ ParamSpec eta_param() {
                              [](double x) { return x > 1.0 && x <= kMaxEta; });
   s.from_fiber = "fiber.eta";
   s.fit_min = 1.0 + 1e-6;
-  s.fit_max = kMaxEta;
+  // No upper end for a fit: compare/fit.h sizes its derivative steps from a
+  // finite range, and (1, kMaxEta] is a bound of the arithmetic, not of the
+  // fibers a fit explores.
   return s;
 }
 

@@ -179,12 +179,12 @@ cp "$work/saved.h5" "$work/d.checkpoint.h5"
 damaged "lobe index out of range" "(k, lobe, channel) = (0, 7, 0) is outside the fiber's 1 x 4 x 1"
 cp "$work/saved.h5" "$work/d.checkpoint.h5"
 "$py" -c 'import sys, h5py; del h5py.File(sys.argv[1], "r+")["sim_energy"]' "$work/d.checkpoint.h5"
-damaged "missing dataset" "sim_energy"
+damaged "missing dataset" "\(sim_energy\|attribute_digest\)"
 cp "$work/saved.h5" "$work/d.checkpoint.h5"
 "$py" -c 'import sys, h5py
 f = h5py.File(sys.argv[1], "r+")
 f.move("sim_energy", "x"); f.move("sim_error", "sim_energy"); f.move("x", "sim_error")' "$work/d.checkpoint.h5"
-damaged "sim_energy and sim_error swapped (issue 32)" "\(dataset sim_energy does not hold the values written\|attribute_digest\)"
+damaged "sim_energy and sim_error swapped" "\(dataset sim_energy does not hold the values written\|attribute_digest\)"
 
 # 7. SIGTERM before any fiber is finished: nothing to keep.
 set -m
