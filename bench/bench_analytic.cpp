@@ -57,7 +57,7 @@ void BM_FullPredict(benchmark::State& state) {
 BENCHMARK(BM_FullPredict)->DenseRange(0, 2)->Unit(benchmark::kMillisecond)->Iterations(2);
 
 // huang2022's push-forward (its cost is linear in quadrature_points) beside
-// the exact model on the same 18 x 36 grid (issue 35's comparison): one
+// the exact model on the same 18 x 36 grid: one
 // incidence, 2^18 points, the atlas's white ggx 0.3 fiber with a 3 deg tilt.
 void BM_Huang2022Bins(benchmark::State& state) {
   ModelParams p = typical();

@@ -1,4 +1,4 @@
-// compare's judging options and inputs (issue 32, item 6): each option
+// compare's judging options and inputs: each option
 // finite and in its range, a comparison that judges no lobe accepts nothing,
 // a prediction's probabilities finite and >= 0, each fitted parameter once.
 #include <gtest/gtest.h>

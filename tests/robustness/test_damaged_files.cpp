@@ -1,4 +1,4 @@
-// Issue 32, items 1, 3, 4 and 5 (hostile inputs, second round): report
+// Hostile inputs: report
 // folders never written through a planted link and never left half-written;
 // checkpoints accepted only when their config, attributes and sums agree;
 // damaged files (a flipped bit anywhere) give one line and exit 2, never a

@@ -1,4 +1,4 @@
-// Issue 32, items 6 and 7: silent wrong physics and verdicts, and late or
+// Hostile inputs: silent wrong physics and verdicts, and late or
 // wrong refusals. Each hostile input gives exit status 2, one line naming the
 // field, flag or file and what is allowed, and no file; each legitimate
 // input at the edge of its range gives the right answer.

@@ -1,4 +1,4 @@
-// Issue 32, item 2: MPI ranks started with different command lines
+// Hostile inputs: MPI ranks started with different command lines
 // (`mpirun -np 1 fiberlab run A.yaml : -np 1 fiberlab run B.yaml`) must agree
 // on the resolved config and every flag that changes the output before any
 // photon: otherwise exit 2 on every rank, one line (from rank 0) naming the
