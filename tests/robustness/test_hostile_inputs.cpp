@@ -20,21 +20,15 @@
 #include <string>
 #include <thread>
 
+#include "tests/robustness/command_outcome.h"
+
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int status;
-  std::string out, err;
-};
+using fiberlab::robustness::Outcome;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using fiberlab::robustness::slurp;
 
 class Hostile : public ::testing::Test {
  protected:

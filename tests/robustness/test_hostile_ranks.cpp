@@ -18,23 +18,16 @@
 #include <sstream>
 #include <string>
 
+#include "tests/robustness/command_outcome.h"
 #include "tests/unique_temp_dir.h"
 
 namespace {
 
 namespace fs = std::filesystem;
 
-struct Outcome {
-  int status;
-  std::string out, err;
-};
+using fiberlab::robustness::Outcome;
 
-std::string slurp(const fs::path& p) {
-  std::ifstream f(p);
-  std::stringstream s;
-  s << f.rdbuf();
-  return s.str();
-}
+using fiberlab::robustness::slurp;
 
 constexpr const char* kBase =
     "photons: 3000\nseed: 7\nfiber: {eta: 1.55, sigma_a: [0.1, 0.2]}\n"
