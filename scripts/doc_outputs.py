@@ -31,7 +31,7 @@ names exists in the repository.
 --check also checks that README.md has at most 200 lines and that no file
 tells development history (sessions, rounds of work, issue numbers).
 
-Usage: doc_outputs.py [--fiberlab build/cli/fiberlab] (--check | --write) [--long] [NAME ...]
+Usage: doc_outputs.py [--fiberlab build/cli/fiberlab] (--check | --write) [--long] [--from DIR] [NAME ...]
 """
 import argparse
 import difflib
@@ -56,8 +56,9 @@ MEASURED_END = "<!-- END measured -->"
 class Runner:
     """Runs fiberlab in a scratch folder (so that printed file names are short)."""
 
-    def __init__(self, fiberlab):
+    def __init__(self, fiberlab, reuse=None):
         self.fiberlab = os.path.abspath(fiberlab)
+        self.reuse = reuse  # a folder holding atlas runs already made (--from)
         self.work = tempfile.mkdtemp(prefix="fiberlab-docs-")
         # The atlas's report figures are not part of any doc's text: skip the plotting.
         self.env = dict(os.environ, FIBERLAB_PYTHON="/bin/false")
@@ -115,9 +116,13 @@ def gen_model_names(run):
 
 
 def atlas_tables(run, config, name):
-    """The atlas report's two tables (OUT_report/atlas_tables.md), one block each."""
-    run("atlas", run.config(config), "-o", f"{name}.h5", "--threads", "2", "--quiet")
-    text = open(os.path.join(run.work, f"{name}_report", "atlas_tables.md")).read()
+    """The atlas report's two tables (OUT_report/atlas_tables.md), one block each.
+    With --from DIR, the tables of a run already made in DIR (`fiberlab atlas
+    configs/CONFIG -o NAME.h5` there, which also draws the report's figures)."""
+    folder = run.reuse or run.work
+    if not run.reuse:
+        run("atlas", run.config(config), "-o", f"{name}.h5", "--threads", "2", "--quiet")
+    text = open(os.path.join(folder, f"{name}_report", "atlas_tables.md")).read()
     headline, fibers = text.split("## Per fiber\n\n")
     headline = headline.replace("## Per model and lobe (median over fibers)\n\n", "")
     return {f"{name}:headline": headline.strip() + "\n", f"{name}:fibers": fibers.strip() + "\n"}
@@ -195,6 +200,8 @@ def main():
     mode.add_argument("--check", action="store_true")
     mode.add_argument("--write", action="store_true")
     ap.add_argument("--long", action="store_true", help="also regenerate the long blocks (with --write)")
+    ap.add_argument("--from", dest="reuse", metavar="DIR",
+                    help="take the atlases' tables from runs already made in DIR (NAME_report/atlas_tables.md)")
     ap.add_argument("names", nargs="*", help="only these generators")
     args = ap.parse_args()
 
@@ -205,7 +212,7 @@ def main():
             sys.exit(f"doc_outputs: unknown generator(s) {sorted(unknown)}; known: {sorted(QUICK) + sorted(LONG)}")
         generators = {n: g for n, g in dict(QUICK, **LONG).items() if n in args.names}
 
-    run = Runner(args.fiberlab)
+    run = Runner(args.fiberlab, args.reuse)
     outputs, problems, rewritten = {}, [], []
     readme_lines = open(os.path.join(ROOT, "README.md"), encoding="utf-8").read().count("\n")
     if readme_lines > 200:
