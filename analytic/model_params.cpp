@@ -209,11 +209,14 @@ ParamSpec beta_azim_param(std::string meaning) {
 }
 
 ParamSpec alpha_param(std::string meaning) {
-  // A shift of theta_r in [-90, 90] degrees: theta_r's own range (larger
-  // shifts move every lobe off the sphere of directions).
+  // A shift of theta_r in [-180, 180] degrees: SPEC s7's rule gives TRT the
+  // shift 4a, and a fit of scale_tilt explores the simulator's tilts
+  // (-45, 45) (SPEC s11). Shifts beyond 90 deg move the lobe off the sphere
+  // of directions: the model then predicts (almost) nothing there, which a
+  // fit sees as a poor match, not an error.
   ParamSpec s = list_param("alpha", std::move(meaning), "deg", "0",
-                           "a comma list of degrees in [-90, 90], indexed by lobe p", &ModelParams::alpha,
-                           [](double x) { return std::abs(x) <= 90.0; });
+                           "a comma list of degrees in [-180, 180], indexed by lobe p", &ModelParams::alpha,
+                           [](double x) { return std::abs(x) <= 180.0; });
   s.from_fiber = "fiber.scale_tilt (SPEC s7: R -2a, TT +a, TRT +4a, p >= 3: 0)";
   // Free: a fit moves it through the physical tilt (fit key scale_tilt, the
   // shift rule), the range of the simulator's scale_tilt (SPEC s11).

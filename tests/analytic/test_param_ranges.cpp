@@ -63,13 +63,25 @@ TEST(ParamRanges, SetTextAtAndBeyondTheBounds) {
   ModelParams p = default_params("deon2011");
   EXPECT_NO_THROW(apply_setting("deon2011", p, "beta_long=90"));
   EXPECT_THROW(apply_setting("deon2011", p, "beta_long=90.000001"), Error);
-  EXPECT_NO_THROW(apply_setting("deon2011", p, "alpha=-90,90"));
-  EXPECT_THROW(apply_setting("deon2011", p, "alpha=-90.5"), Error);
+  EXPECT_NO_THROW(apply_setting("deon2011", p, "alpha=-180,180"));
+  EXPECT_THROW(apply_setting("deon2011", p, "alpha=-180.5"), Error);
   EXPECT_NO_THROW(apply_setting("deon2011", p, "eta=1e9"));
   EXPECT_THROW(apply_setting("deon2011", p, "eta=1.000001e9"), Error);
   ModelParams m = default_params("huang2022");
   EXPECT_NO_THROW(apply_setting("huang2022", m, "eccentricity=2.2250738585072014e-308"));
   EXPECT_THROW(apply_setting("huang2022", m, "eccentricity=2.2e-308"), Error);
+}
+
+// SPEC s7's shift rule (R -2a, TT +a, TRT +4a, p >= 3: 0) at the ends of the
+// simulator's tilt range (-45, 45) (SPEC s11), where a fit of scale_tilt can
+// go: every model with per-lobe shifts accepts the shifts it gives.
+TEST(ParamRanges, ShiftsOfEverySimulatorTiltAreInRange) {
+  for (const char* model : {"deon2011", "marschner2003"})
+    for (double a : {-45.0 + 1e-6, 45.0 - 1e-6}) {
+      ModelParams p = default_params(model);
+      p.alpha = {-2.0 * a, a, 4.0 * a, 0.0};
+      EXPECT_NO_THROW(make_model(model, p)) << model << " at tilt " << a;
+    }
 }
 
 TEST(ParamRanges, ARepeatedSetKeyIsRefused) {

@@ -185,7 +185,7 @@ TEST_F(HostileRanges, ModelParametersOutOfTheirRanges) {
   const std::string p = "predict " + shared("good.h5") + " -o " + path("p.h5") + " --model ";
   expect_refused(p + "deon2011 --set beta_long=1e300", {"--set beta_long=1e300", "degrees in [0, 90]"});
   expect_refused(p + "deon2011 --set beta_azim=91", {"--set beta_azim=91", "degrees in [0, 90]"});
-  expect_refused(p + "deon2011 --set alpha=-1e200", {"--set alpha=-1e200", "[-90, 90]"});
+  expect_refused(p + "deon2011 --set alpha=-1e200", {"--set alpha=-1e200", "[-180, 180]"});
   expect_refused(p + "marschner2003 --set k_g=1e300", {"--set k_g=1e300", "[0, 10]"});
   expect_refused(p + "marschner2003 --set delta_h_m=2", {"--set delta_h_m=2", "[0, 1]"});
   expect_refused(p + "marschner2003 --set w_c=1e9", {"--set w_c=1e9", "[0, 180]"});
