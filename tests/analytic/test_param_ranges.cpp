@@ -77,7 +77,7 @@ TEST(ParamRanges, SetTextAtAndBeyondTheBounds) {
 // go: every model with per-lobe shifts accepts the shifts it gives.
 TEST(ParamRanges, ShiftsOfEverySimulatorTiltAreInRange) {
   for (const char* model : {"deon2011", "marschner2003"})
-    for (double a : {-45.0 + 1e-6, 45.0 - 1e-6}) {
+    for (double a : {deg_to_rad(-45.0 + 1e-6), deg_to_rad(45.0 - 1e-6)}) {  // ModelParams hold radians
       ModelParams p = default_params(model);
       p.alpha = {-2.0 * a, a, 4.0 * a, 0.0};
       EXPECT_NO_THROW(make_model(model, p)) << model << " at tilt " << a;
