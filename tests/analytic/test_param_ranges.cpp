@@ -79,6 +79,7 @@ TEST(ParamRanges, ShiftsOfEverySimulatorTiltAreInRange) {
   for (const char* model : {"deon2011", "marschner2003"})
     for (double a : {deg_to_rad(-45.0 + 1e-6), deg_to_rad(45.0 - 1e-6)}) {  // ModelParams hold radians
       ModelParams p = default_params(model);
+      p.beta_long = {deg_to_rad(5.0)};  // marschner2003 needs a width > 0
       p.alpha = {-2.0 * a, a, 4.0 * a, 0.0};
       EXPECT_NO_THROW(make_model(model, p)) << model << " at tilt " << a;
     }
