@@ -36,7 +36,7 @@ std::once_flag g_installed;
 std::atomic<bool> g_host_owns_signals{false};     // leave_signals_to_host() was called
 
 // The signals that stop fiberlab: interrupt, terminate, and a hang-up (a
-// closed terminal or ssh session), which the command treats as SIGTERM.
+// closed terminal or ssh connection), which the command treats as SIGTERM.
 constexpr int kSignals[] = {SIGINT, SIGTERM, SIGHUP};
 constexpr int kSignalCount = sizeof(kSignals) / sizeof(kSignals[0]);
 

@@ -13,7 +13,7 @@
 //   a half-written temporary must not be left behind.
 // Without either (handlers never installed and no guard alive), the signals
 // keep their default action (the process ends at once). SIGHUP (a closed
-// terminal or ssh session) is treated as SIGTERM.
+// terminal or ssh connection) is treated as SIGTERM.
 //
 // In a host program that owns its signal dispositions (the Python module:
 // Python's own SIGINT handler raises KeyboardInterrupt), after

@@ -10,18 +10,10 @@
 #include "common/error.h"
 #include "common/physical_limits.h"
 #include "common/units.h"
+#include "tests/error_text.h"
 
 namespace fiberlab::analytic {
 namespace {
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(ParamRanges, EveryParameterHasARangeAndItsDefaultIsInIt) {
   for (const ModelInfo& m : registered_models()) {

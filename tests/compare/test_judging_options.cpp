@@ -11,18 +11,10 @@
 #include "compare/fit.h"
 #include "compare/prediction_file.h"
 #include "compare/verdict.h"
+#include "tests/error_text.h"
 
 namespace fiberlab::compare {
 namespace {
-
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "";
-}
 
 TEST(JudgingOptions, RangesNamedInTheCallersSpelling) {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::nan("");
