@@ -21,10 +21,10 @@
 #include <unistd.h>
 
 #include "common/units.h"
-#include "sim/checkpoint.h"
-#include "sim/result_stream.h"
-#include "sim/simulation.h"
-#include "sim/source.h"
+#include "sim/store/checkpoint.h"
+#include "sim/store/result_stream.h"
+#include "sim/run/simulation.h"
+#include "sim/life/source.h"
 
 namespace {
 
@@ -62,7 +62,7 @@ Settings bench_case(char which) {
 
 // `batch`: photons per call of the tracer (0: 65536, 2048 for case d). Each
 // call ends with its lane pool draining; `run` makes one call per thread and
-// round, fed runs of chunks of 4096 (sim/photon_feed.h), so it drains less
+// round, fed runs of chunks of 4096 (sim/life/photon_feed.h), so it drains less
 // often than here; trace_per_chunk shows one chunk per call.
 void trace(benchmark::State& state, char which, std::uint64_t batch = 0) {
   const Simulation sim(bench_case(which));

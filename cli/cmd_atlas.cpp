@@ -24,9 +24,9 @@
 #include "compare/atlas_config.h"
 #include "compare/atlas_file.h"
 #include "compare/atlas_report.h"
-#include "sim/checkpoint.h"
-#include "sim/memory_budget.h"
-#include "sim/settings.h"
+#include "sim/store/checkpoint.h"
+#include "sim/run/memory_budget.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::cli {
 

@@ -27,7 +27,7 @@
 #include "compare/verdict.h"
 #include "compare/report.h"
 #include "compare/verdict_tables.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::cli {
 

@@ -28,10 +28,10 @@
 #include "compare/models.h"
 #include "compare/report.h"
 #include "compare/report_folder.h"
-#include "sim/memory_budget.h"
-#include "sim/result_file.h"
-#include "sim/settings.h"
-#include "sim/simulation.h"
+#include "sim/run/memory_budget.h"
+#include "sim/store/result_file.h"
+#include "sim/run/settings.h"
+#include "sim/run/simulation.h"
 
 namespace fiberlab::cli {
 

@@ -16,8 +16,8 @@
 #include "compare/atlas_file.h"
 #include "compare/prediction_file.h"
 #include "compare/report.h"
-#include "sim/checkpoint.h"
-#include "sim/result_file.h"
+#include "sim/store/checkpoint.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::cli {
 

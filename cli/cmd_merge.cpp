@@ -1,13 +1,13 @@
 // `fiberlab merge A.h5 B.h5 ... -o C.h5`: adds runs of one config made with
 // different seeds and joins runs of different incident directions (how a run
-// is split over machines or a job array); see sim/merge.h for the rules.
+// is split over machines or a job array); see sim/store/merge.h for the rules.
 #include <fmt/core.h>
 
 #include <memory>
 
 #include "cli/commands.h"
 #include "common/atomic_output.h"
-#include "sim/merge.h"
+#include "sim/store/merge.h"
 
 namespace fiberlab::cli {
 

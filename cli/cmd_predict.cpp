@@ -13,8 +13,8 @@
 #include "common/atomic_output.h"
 #include "compare/models.h"
 #include "compare/prediction_file.h"
-#include "sim/result_file.h"
-#include "sim/settings.h"
+#include "sim/store/result_file.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::cli {
 

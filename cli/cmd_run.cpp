@@ -17,13 +17,13 @@
 #include "common/atomic_output.h"
 #include "common/error.h"
 #include "common/interrupt.h"
-#include "sim/checkpoint.h"
-#include "sim/memory_budget.h"
-#include "sim/process_group.h"
-#include "sim/rank_agreement.h"
-#include "sim/result_file.h"
-#include "sim/result_stream.h"
-#include "sim/simulation.h"
+#include "sim/store/checkpoint.h"
+#include "sim/run/memory_budget.h"
+#include "sim/run/process_group.h"
+#include "sim/run/rank_agreement.h"
+#include "sim/store/result_file.h"
+#include "sim/store/result_stream.h"
+#include "sim/run/simulation.h"
 
 namespace fiberlab::cli {
 
@@ -50,7 +50,7 @@ void apply_run_flags(const RunOptions& o, sim::Settings& settings) {
     check_output_name(o.output);
     settings.output = o.output;
   }
-  // photons x incident configurations must fit in uint64 (sim/settings.cpp
+  // photons x incident configurations must fit in uint64 (sim/run/settings.cpp
   // checks the config; a flag can raise photons past it).
   const std::uint64_t k = settings.incidences().size();
   if (settings.photons > kU64Max / k)

@@ -4,7 +4,7 @@
 // truncated fractions.
 #include <cstdio>
 
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::cli {
 

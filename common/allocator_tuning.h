@@ -18,7 +18,7 @@
 // threads share the one heap (glibc would give threads arenas of their own,
 // mapped apart), which grows 64 MiB at a time and is advised as transparent
 // huge pages (where the kernel allows them: "madvise" or "always"): about
-// 1,700 faults per run with the tallies' own huge pages (sim/zeroed_memory.h).
+// 1,700 faults per run with the tallies' own huge pages (sim/store/zeroed_memory.h).
 // Peak memory grows by what the last huge pages hold beyond what is used (a
 // few MiB).
 namespace fiberlab {

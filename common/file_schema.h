@@ -56,13 +56,13 @@ struct AxisPaths {
 void describe_bins_and_source(h5::File& f, const AxisPaths& at = {});
 
 // Dimension labels, units and descriptions of a result file's /tally and
-// /ledger datasets (sim/result_file.h writes them), but /tally/photons:
-// describe_tally_photons, since the streaming writer (sim/result_stream.h)
+// /ledger datasets (sim/store/result_file.h writes them), but /tally/photons:
+// describe_tally_photons, since the streaming writer (sim/store/result_stream.h)
 // describes the others when it creates them and writes the photons last.
 void describe_result_datasets(h5::File& f);
 void describe_tally_photons(h5::File& f);
 
-// The same for its exact sums, /exact (sim/result_stream.h writes them): the
+// The same for its exact sums, /exact (sim/store/result_stream.h writes them): the
 // trailing axis `word` of the 128-bit sums holds (high, low).
 void describe_exact_datasets(h5::File& f);
 

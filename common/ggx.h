@@ -2,7 +2,7 @@
 // The GGX (Trowbridge-Reitz) microfacet distribution, in a local frame whose
 // z axis is the mean (meso) normal: its normal distribution D, Smith's Lambda
 // and the exact sampling map of its distribution of visible normals (VNDF).
-// Shared by the simulator's `roughness: {model: ggx}` (sim/microfacet_distribution)
+// Shared by the simulator's `roughness: {model: ggx}` (sim/roughness/microfacet_distribution)
 // and the analytic model of Huang et al. 2022 (analytic/huang2022), so the
 // formulas exist once.
 //

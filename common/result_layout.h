@@ -11,7 +11,7 @@
 namespace fiberlab {
 
 // 2: a result file's exact bin sums are residuals against the float64 sums
-// (sim/result_stream.h); 1 stored them as (high, low) pairs.
+// (sim/store/result_stream.h); 1 stored them as (high, low) pairs.
 inline constexpr int kFormatVersion = 2;
 
 // The current time as ISO 8601 UTC, e.g. 2026-11-22T10:30:00Z.

@@ -10,8 +10,8 @@
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "compare/models.h"
-#include "sim/result_file.h"
-#include "sim/simulation.h"
+#include "sim/store/result_file.h"
+#include "sim/run/simulation.h"
 
 namespace fiberlab::compare {
 

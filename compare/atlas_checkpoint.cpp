@@ -19,7 +19,7 @@
 #include "common/result_layout.h"
 #include "compare/atlas_file.h"
 #include "compare/fit.h"
-#include "sim/settings.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::compare {
 

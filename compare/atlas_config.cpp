@@ -13,7 +13,7 @@
 #include "common/error.h"
 #include "common/units.h"
 #include "compare/fit.h"
-#include "sim/yaml_keys.h"
+#include "sim/run/yaml_keys.h"
 
 namespace fiberlab::compare {
 

@@ -39,7 +39,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/settings.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::compare {
 

@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "compare/verdict.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

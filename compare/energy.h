@@ -10,7 +10,7 @@
 
 #include "analytic/model.h"
 #include "compare/models.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

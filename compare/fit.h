@@ -63,7 +63,7 @@
 
 #include "analytic/model.h"
 #include "compare/comparison.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

@@ -11,7 +11,7 @@
 
 #include "analytic/model.h"
 #include "analytic/physical_defaults.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

@@ -19,7 +19,7 @@
 
 #include "analytic/model_params.h"
 #include "common/bin_grid.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

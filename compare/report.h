@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
 

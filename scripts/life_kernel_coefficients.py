@@ -1,5 +1,5 @@
-"""The coefficients of the photon life's kernels: sim/life_trig.h's sine and
-cosine for |x| <= pi/4 and sim/life_log.h's logarithm.
+"""The coefficients of the photon life's kernels: sim/simd/life_trig.h's sine and
+cosine for |x| <= pi/4 and sim/simd/life_log.h's logarithm.
 
 In z = x^2, with 60-digit decimal arithmetic (Python's decimal module, no
 other dependency):
@@ -84,7 +84,7 @@ for name, g, deg in (("sin", g_sin, 6), ("cos", g_cos, 5)):
         worst = max(worst, err)
     print(name, "worst relative error of the polynomial (coefficients rounded):", float(worst), "=", float(worst / D(2) ** -53), "ulp-ish (2^-53)")
 
-# The logarithm's kernel (sim/life_log.h): log(1 + f) = f - f^2/2 + s (f^2/2 + z P(z)),
+# The logarithm's kernel (sim/simd/life_log.h): log(1 + f) = f - f^2/2 + s (f^2/2 + z P(z)),
 # s = f / (2 + f), z = s^2, for 1 + f in [sqrt(2)/2, sqrt(2)): |s| <= (sqrt 2 - 1) / (sqrt 2 + 1).
 # P of degree 6 ~ sum_{k>=1} 2 z^(k-1) / (2k + 1) (the series of log((1+s)/(1-s)) = 2s + s z P(z)).
 def g_log(z):

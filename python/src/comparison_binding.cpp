@@ -13,7 +13,7 @@
 #include "compare/comparison.h"
 #include "compare/prediction_file.h"
 #include "compare/verdict.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::python {
 

@@ -17,7 +17,7 @@
 #include "common/error.h"
 #include "compare/fit.h"
 #include "compare/models.h"
-#include "sim/result_file.h"
+#include "sim/store/result_file.h"
 
 namespace fiberlab::python {
 

@@ -11,7 +11,7 @@
 #include "bindings.h"
 #include "common/units.h"
 #include "compare/models.h"
-#include "sim/settings.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::python {
 

@@ -1,4 +1,4 @@
-// A simulation's result (sim/result_file.h) as seen from Python: the raw
+// A simulation's result (sim/store/result_file.h) as seen from Python: the raw
 // sums, the estimators of SPEC section 6 (computed by sim::bin_estimate and
 // sim::lobe_energy, not here), the energy ledger, and file I/O.
 #include <pybind11/stl.h>
@@ -11,8 +11,8 @@
 #include "common/error.h"
 #include "common/file_schema.h"
 #include "compare/energy.h"
-#include "sim/result_file.h"
-#include "sim/settings.h"
+#include "sim/store/result_file.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::python {
 
@@ -129,7 +129,7 @@ py::dict energy(const Result& r) {
 }  // namespace
 
 void bind_result(py::module_& m) {
-  py::class_<sim::Settings>(m, "Settings", "A resolved simulation configuration (sim/settings.h)")
+  py::class_<sim::Settings>(m, "Settings", "A resolved simulation configuration (sim/run/settings.h)")
       .def_property_readonly("yaml", [](const sim::Settings& s) { return sim::to_yaml(s); })
       .def_property_readonly("config", [](const sim::Settings& s) { return yaml_to_python(YAML::Load(sim::to_yaml(s))); })
       .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally.lobes; })
@@ -141,7 +141,7 @@ void bind_result(py::module_& m) {
         py::arg("path"),
         "The settings of a YAML config or of a result file's config_yaml");
 
-  py::class_<Result, std::shared_ptr<Result>>(m, "ResultFile", "A result file's contents (sim/result_file.h)")
+  py::class_<Result, std::shared_ptr<Result>>(m, "ResultFile", "A result file's contents (sim/store/result_file.h)")
       .def_property_readonly("settings", [](const Result& r) { return r.settings; })
       .def_property_readonly("config_yaml", [](const Result& r) { return r.config_yaml; })
       .def_property_readonly("seeds", [](const Result& r) { return r.seeds; })

@@ -1,6 +1,6 @@
 // fiberlab.run from Python: sim::Simulation on resolved Settings, with the
 // GIL released while photons are traced and an optional Python progress
-// callable (called about twice a second, sim/simulation.h).
+// callable (called about twice a second, sim/run/simulation.h).
 //
 // Signals (common/interrupt.h): while photons are traced, SIGINT, SIGTERM
 // and SIGHUP only set the flag the simulation polls (a ScopedInterruptPolling
@@ -21,9 +21,9 @@
 #include "bindings.h"
 #include "common/error.h"
 #include "common/interrupt.h"
-#include "sim/memory_budget.h"
-#include "sim/result_file.h"
-#include "sim/simulation.h"
+#include "sim/run/memory_budget.h"
+#include "sim/store/result_file.h"
+#include "sim/run/simulation.h"
 
 namespace fiberlab::python {
 
@@ -78,7 +78,7 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
                                      std::optional<std::uint64_t> seed, int threads, py::object progress) {
   if (photons) settings.photons = *photons;
   if (seed) settings.seed = *seed;
-  // The CLI's rule (cli/cmd_run.cpp, sim/memory_budget.h): 1 to kMaxThreads, every core by default.
+  // The CLI's rule (cli/cmd_run.cpp, sim/run/memory_budget.h): 1 to kMaxThreads, every core by default.
   if (threads > sim::kMaxThreads)
     throw Error("threads = " + std::to_string(threads) + ": must be an integer from 1 to " +
                 std::to_string(sim::kMaxThreads) + " (as fiberlab run --threads)");

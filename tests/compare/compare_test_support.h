@@ -8,9 +8,9 @@
 #include "common/units.h"
 #include "compare/comparison.h"
 #include "compare/models.h"
-#include "sim/result_file.h"
-#include "sim/settings.h"
-#include "sim/simulation.h"
+#include "sim/store/result_file.h"
+#include "sim/run/settings.h"
+#include "sim/run/simulation.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::compare::testing {

@@ -26,9 +26,9 @@
 
 #include "common/atomic_output.h"
 #include "common/error.h"
-#include "sim/checkpoint.h"
-#include "sim/settings.h"
-#include "sim/simulation.h"
+#include "sim/store/checkpoint.h"
+#include "sim/run/settings.h"
+#include "sim/run/simulation.h"
 
 namespace {
 

@@ -235,7 +235,7 @@ TEST_F(Hostile, LargestSeedRoundTripsExactly) {
 }
 
 // Format 2 stores the exact bin sums as residuals against the float64 sums
-// (sim/exact_tally.h): merge, which adds the exact sums, refuses a residual
+// (sim/store/exact_tally.h): merge, which adds the exact sums, refuses a residual
 // that does not belong to its float64 value.
 TEST_F(Hostile, ExactResidualThatDisagreesWithItsFloatSum) {
   const auto f = crafted("residual.h5",

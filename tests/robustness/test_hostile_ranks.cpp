@@ -4,7 +4,7 @@
 // photon: otherwise exit 2 on every rank, one line (from rank 0) naming the
 // differing rank and field, no file written, no hang, no heap corruption.
 // Ranks may differ in --threads only, and then the file is the one a single
-// process writes (the sums are exact: sim/simulation.h).
+// process writes (the sums are exact: sim/run/simulation.h).
 // Labelled "sanitize" (tests/CMakeLists.txt): the sanitizer job runs these.
 #include <gtest/gtest.h>
 #include <sys/wait.h>

@@ -4,9 +4,9 @@
 #include <vector>
 
 #include "common/units.h"
-#include "sim/result_file.h"
-#include "sim/settings.h"
-#include "sim/simulation.h"
+#include "sim/store/result_file.h"
+#include "sim/run/settings.h"
+#include "sim/run/simulation.h"
 
 namespace fiberlab::sim::testing {
 

@@ -3,15 +3,15 @@
 // so paths agree to rounding (1e-7 allows the drift of light-guided photons
 // over a hundred segments), except where the two round differently in the
 // last bit and that flips a random decision (rare: the sampler's sin, cos
-// and log are one code for both, sim/life_trig.h and sim/life_log.h, but the
+// and log are one code for both, sim/simd/life_trig.h and sim/simd/life_log.h, but the
 // compiler may fuse a product into a sum in one form and not the other).
 #include <gtest/gtest.h>
 
 #include <cstdio>
 #include <map>
 
-#include "sim/batch_tracer.h"
-#include "sim/source.h"
+#include "sim/life/batch_tracer.h"
+#include "sim/life/source.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {

@@ -1,6 +1,6 @@
 // Format 2 stores a bin's exact sum E (a 128-bit integer, value E / 2^60) as
 // its float64 value v and the residual r = E - v 2^60 (ExactTally::split and
-// join, sim/exact_tally.h). The oracle is the definition of correct rounding,
+// join, sim/store/exact_tally.h). The oracle is the definition of correct rounding,
 // checked on integers: v 2^60 + r == E, |r| <= half an ulp of v 2^60, and on
 // a tie the even neighbour (so v is the one nearest double, ties to even).
 #include <gtest/gtest.h>
@@ -11,7 +11,7 @@
 #include <vector>
 
 #include "common/error.h"
-#include "sim/exact_tally.h"
+#include "sim/store/exact_tally.h"
 
 namespace fiberlab::sim {
 namespace {

@@ -10,7 +10,7 @@
 
 #include "common/bin_grid.h"
 #include "common/units.h"
-#include "sim/exit_scoring.h"
+#include "sim/life/exit_scoring.h"
 
 namespace fiberlab::sim {
 namespace {

@@ -1,4 +1,4 @@
-// The gaussian sampler's envelopes (sim/gaussian_envelope.h) bound the
+// The gaussian sampler's envelopes (sim/roughness/gaussian_envelope.h) bound the
 // visibility max(0, v.m) of every offset: for random frames (tilt up to 40
 // deg, either side), photon directions (many near grazing and facing away),
 // unequal betas from 0.05 to 40 deg and offsets from the centre to far
@@ -15,7 +15,7 @@
 #include <random>
 
 #include "common/units.h"
-#include "sim/gaussian_envelope.h"
+#include "sim/roughness/gaussian_envelope.h"
 
 namespace fiberlab::sim {
 namespace {

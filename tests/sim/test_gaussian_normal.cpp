@@ -10,13 +10,13 @@
 #include <vector>
 
 #include "common/units.h"
-#include "sim/roughness_gaussian.h"
+#include "sim/roughness/roughness_gaussian.h"
 #include "tests/sim/normal_samples_chi2.h"
 
 namespace fiberlab::sim {
 namespace {
 
-// The definition, written out independently of sim/microfacet_normal.cpp.
+// The definition, written out independently of sim/roughness/microfacet_normal.cpp.
 Vec3 reference_normal(const Vec3& d, const Vec3& nf, double bl, double ba, PhotonRandom& rng) {
   const double theta_n = std::asin(nf.x());
   const Vec3 perp = Vec3(0.0, nf.y(), nf.z()).normalized();
@@ -123,7 +123,7 @@ TEST(GaussianNormal, FarTailNeverReachesTheCap) {
   }
 }
 
-// sim/roughness_model.h's contract, which the photon life relies on (its
+// sim/roughness/roughness_model.h's contract, which the photon life relies on (its
 // event acts on `ready` lanes alone): a draw that gives up is never also
 // ready. One candidate a call, from one try short of the cap, so that every
 // call ends ready or failed; about a fifth are accepted here.

@@ -1,4 +1,4 @@
-// sim/lane_packing.h: for every mask of a vector's lanes, lane_bits gives
+// sim/simd/lane_packing.h: for every mask of a vector's lanes, lane_bits gives
 // its bits and pack_store writes exactly the selected lanes, lowest first,
 // leaving what lies past the vector's room untouched.
 #include <gtest/gtest.h>
@@ -8,8 +8,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/lane_pair.h"
-#include "sim/lane_packing.h"
+#include "sim/simd/lane_pair.h"
+#include "sim/simd/lane_packing.h"
 
 namespace fiberlab::sim::life {
 namespace {
@@ -55,7 +55,7 @@ TEST(LanePacking, PackStoreWritesTheSelectedLanesInOrder) {
   }
 }
 
-// A Pair of vectors (sim/lane_pair.h) packs as one vector of 2 W lanes.
+// A Pair of vectors (sim/simd/lane_pair.h) packs as one vector of 2 W lanes.
 TEST(LanePacking, APairPacksAsOneVectorOfTwiceTheLanes) {
   constexpr int W2 = NumberTraits<Batch2>::kWidth;
   alignas(64) double v[W2];

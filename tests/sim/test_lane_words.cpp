@@ -1,10 +1,10 @@
 // The vector forms of 64-bit word operations that AVX2 lacks and the tracer
-// builds from other instructions: life::to_bits (sim/lanes.h: a whole number
-// in [0, 2^52) as a word, through 2^52) and life::times (sim/random.h: a word
+// builds from other instructions: life::to_bits (sim/simd/lanes.h: a whole number
+// in [0, 2^52) as a word, through 2^52) and life::times (sim/life/random.h: a word
 // times a constant modulo 2^64, built from 32-bit products on AVX2, which has
 // no 64-bit multiply). Each lane must equal the scalar C++ operation, at the
 // edges and on random words. Also the two operations xsimd 8.1 gets wrong
-// with AVX-512 (sim/lanes.h): fma, which must fuse as std::fma does, and a
+// with AVX-512 (sim/simd/lanes.h): fma, which must fuse as std::fma does, and a
 // mask's exclusive or, written a != b. And mask_not, the inline ! the
 // photon life uses (built from the mask register's bits with AVX-512).
 #include <gtest/gtest.h>
@@ -13,7 +13,7 @@
 #include <random>
 #include <vector>
 
-#include "sim/random.h"
+#include "sim/life/random.h"
 
 namespace fiberlab::sim::life {
 namespace {

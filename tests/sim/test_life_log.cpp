@@ -1,4 +1,4 @@
-// sim/life_log.h against the C library's log (the oracle) on the arguments
+// sim/simd/life_log.h against the C library's log (the oracle) on the arguments
 // the sampler gives it (uniforms, products of two, their extremes, and both
 // sides of the reduction's sqrt(2) threshold), and its scalar and vector
 // forms against each other (the two tracers must draw the same bits).
@@ -7,8 +7,8 @@
 #include <cmath>
 #include <vector>
 
-#include "sim/life_log.h"
-#include "sim/random.h"
+#include "sim/simd/life_log.h"
+#include "sim/life/random.h"
 
 namespace fiberlab::sim::life {
 namespace {

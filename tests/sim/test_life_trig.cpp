@@ -1,4 +1,4 @@
-// sim/life_trig.h against the C library's sin and cos (the oracle), and its
+// sim/simd/life_trig.h against the C library's sin and cos (the oracle), and its
 // scalar and vector forms against each other (the photon-by-photon
 // equivalence of the two tracers rests on them giving the same bits).
 #include <gtest/gtest.h>
@@ -8,7 +8,7 @@
 #include <random>
 #include <vector>
 
-#include "sim/life_trig.h"
+#include "sim/simd/life_trig.h"
 
 namespace fiberlab::sim::life {
 namespace {

@@ -1,4 +1,4 @@
-// Microfacet distributions (sim/microfacet_distribution.h) against their
+// Microfacet distributions (sim/roughness/microfacet_distribution.h) against their
 // definitions: D's projected-area normalisation, Smith's G1 as the
 // normalisation of the VNDF (G1(w) = w.n / integral max(0, w.m) D(m) dm),
 // and the sampled normals against the VNDF by chi-square on a histogram
@@ -12,8 +12,8 @@
 
 #include "common/error.h"
 #include "common/units.h"
-#include "sim/microfacet_distribution.h"
-#include "sim/random.h"
+#include "sim/roughness/microfacet_distribution.h"
+#include "sim/life/random.h"
 
 using namespace fiberlab;
 using namespace fiberlab::sim;

@@ -27,9 +27,9 @@
 #include <string>
 
 #include "common/error.h"
-#include "sim/checkpoint.h"
-#include "sim/result_stream.h"
-#include "sim/tally.h"
+#include "sim/store/checkpoint.h"
+#include "sim/store/result_stream.h"
+#include "sim/store/tally.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {

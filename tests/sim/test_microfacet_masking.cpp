@@ -45,8 +45,8 @@
 
 #include "common/fresnel.h"
 #include "common/units.h"
-#include "sim/source.h"
-#include "sim/tracer.h"
+#include "sim/life/source.h"
+#include "sim/life/tracer.h"
 
 namespace fiberlab::sim {
 namespace {

@@ -1,5 +1,5 @@
 // The normals the simulator draws for `roughness: {model: beckmann | ggx}`
-// (sim/microfacet_roughness.h: the mean normal of the event, the
+// (sim/roughness/microfacet_roughness.h: the mean normal of the event, the
 // frame about it, alpha_long along the fiber and alpha_azim about it, the
 // VNDF sampler) against the definition of the distribution of visible
 // normals, written out here independently: D_w(m) ~ max(0, w.m) D(m) about
@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "common/units.h"
-#include "sim/microfacet_roughness.h"
+#include "sim/roughness/microfacet_roughness.h"
 #include "tests/sim/normal_samples_chi2.h"
 
 namespace fiberlab::sim {

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "common/error.h"
-#include "sim/settings.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::sim {
 namespace {

@@ -1,4 +1,4 @@
-// Runs of photons from a feed (sim/photon_feed.h): the batched tracer keeps
+// Runs of photons from a feed (sim/life/photon_feed.h): the batched tracer keeps
 // its pool across runs, so it must trace every photon of every run exactly
 // once, whatever the runs' sizes and order, and each photon exactly as it
 // would alone (its path depends on its index only). Runs here are odd-sized,
@@ -9,9 +9,9 @@
 #include <numeric>
 #include <vector>
 
-#include "sim/batch_tracer.h"
-#include "sim/photon_feed.h"
-#include "sim/source.h"
+#include "sim/life/batch_tracer.h"
+#include "sim/life/photon_feed.h"
+#include "sim/life/source.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {

@@ -14,8 +14,8 @@
 #include "common/error.h"
 #include "common/fresnel.h"
 #include "common/physical_limits.h"
-#include "sim/ellipse_cross_section.h"
-#include "sim/settings.h"
+#include "sim/life/ellipse_cross_section.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab {
 namespace {

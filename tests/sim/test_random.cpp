@@ -1,4 +1,4 @@
-// The photon streams (sim/random.h) against the generators' published
+// The photon streams (sim/life/random.h) against the generators' published
 // definitions: SplitMix64 (Steele, Lea & Flood 2014) for seeding and
 // xoshiro256+ (Blackman & Vigna, ACM TOMS 2021) for the stream, written here
 // again in plain 64-bit arithmetic; a uniform is the output's top 52 bits
@@ -12,8 +12,8 @@
 #include <cstdint>
 #include <vector>
 
-#include "sim/lane_pair.h"
-#include "sim/random.h"
+#include "sim/simd/lane_pair.h"
+#include "sim/life/random.h"
 
 namespace fiberlab::sim {
 namespace {

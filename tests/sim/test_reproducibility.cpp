@@ -5,9 +5,9 @@
 #include <filesystem>
 
 #include "common/error.h"
-#include "sim/checkpoint.h"
-#include "sim/merge.h"
-#include "sim/result_stream.h"
+#include "sim/store/checkpoint.h"
+#include "sim/store/merge.h"
+#include "sim/store/result_stream.h"
 
 #include "tests/sim/sim_test_support.h"
 #include "tests/unique_temp_dir.h"

@@ -12,7 +12,7 @@
 
 #include "common/error.h"
 #include "common/units.h"
-#include "sim/settings.h"
+#include "sim/run/settings.h"
 
 namespace fiberlab::sim {
 namespace {

@@ -1,4 +1,4 @@
-// Stratified impact parameters (sim/source.h, SPEC section 5; opt-in with
+// Stratified impact parameters (sim/life/source.h, SPEC section 5; opt-in with
 // `source.h_sampling: stratified`): which stratum each photon's h falls in,
 // that photons outside full blocks and runs with `source.h_sampling:
 // independent` (the default) draw h exactly as 2u - 1, that the batched
@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "common/error.h"
-#include "sim/batch_tracer.h"
-#include "sim/source.h"
+#include "sim/life/batch_tracer.h"
+#include "sim/life/source.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {

@@ -1,6 +1,6 @@
-// Tally (sim/tally.h) keeps its sums on lazily zeroed pages and visits only
+// Tally (sim/store/tally.h) keeps its sums on lazily zeroed pages and visits only
 // the pages it wrote when adding, clearing, copying and exporting, and the
-// result writer (sim/result_stream.h) reads it in place, a lobe at a time.
+// result writer (sim/store/result_stream.h) reads it in place, a lobe at a time.
 // Oracle: the same sums kept densely by this test, in plain 128-bit integers.
 #include <gtest/gtest.h>
 
@@ -8,9 +8,9 @@
 #include <random>
 #include <vector>
 
-#include "sim/checkpoint.h"
-#include "sim/result_stream.h"
-#include "sim/tally.h"
+#include "sim/store/checkpoint.h"
+#include "sim/store/result_stream.h"
+#include "sim/store/tally.h"
 
 #include "tests/sim/sim_test_support.h"
 #include "tests/unique_temp_dir.h"

@@ -1,0 +1,301 @@
+#include "sim/life/batch_tracer.h"
+
+#include <algorithm>
+#include <bit>
+#include <memory>
+
+#include "common/error.h"
+#include "sim/simd/lane_packing.h"
+#include "sim/life/source.h"
+
+namespace fiberlab::sim {
+
+namespace {
+
+using life::load;
+using life::load_bits;
+using life::MaskOf;
+// The number type the pool is stepped in: two SIMD vectors (sim/simd/lane_pair.h).
+using Lanes = life::Batch2;
+constexpr int W = life::NumberTraits<Lanes>::kWidth;
+constexpr int kPoolLanes = 16 * W;  // photons in flight per thread
+
+// A vector of lanes draws at most this many rounds of candidate normals per
+// step, a round after the first only while a lane whose candidates are
+// seldom accepted still waits (life::another_round); lanes still without a
+// normal go on at the next step (see sim/roughness/roughness_model.h).
+constexpr int kRoundsPerStep = 8;
+
+// The photons in flight, structure of arrays: one column per number of
+// PhotonState (the Stokes columns used by polarised light only).
+struct Pool {
+  enum Column {
+    kPx, kPy, kDx, kDy, kDz, kInside, kPath, kSegments, kEventsHere, kTries, kWeight, kCode,
+    kPhiI, kScalarColumns,
+    kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
+  };
+  enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
+  // W spare lanes past the end: new photons, and the photons in flight
+  // packed to the front, are written a whole vector at a time from any lane
+  // (BatchTracer::trace_with).
+  static constexpr int kLanes = kPoolLanes + W;
+  alignas(64) double col[kColumns][kLanes];
+  alignas(64) std::uint64_t bits[kBitColumns][kLanes];
+
+  template <class T, class Light>
+  life::PhotonState<T, Light> load_state(int o) const {
+    life::PhotonState<T, Light> s;
+    s.px = load<T>(col[kPx] + o);
+    s.py = load<T>(col[kPy] + o);
+    s.d = {load<T>(col[kDx] + o), load<T>(col[kDy] + o), load<T>(col[kDz] + o)};
+    s.inside = load<T>(col[kInside] + o);
+    s.path = load<T>(col[kPath] + o);
+    s.segments = load<T>(col[kSegments] + o);
+    s.events_here = load<T>(col[kEventsHere] + o);
+    s.tries = load<T>(col[kTries] + o);
+    s.weight = load<T>(col[kWeight] + o);
+    s.code = load<T>(col[kCode] + o);
+    s.rng = {load_bits<T>(bits[kS0] + o), load_bits<T>(bits[kS1] + o),
+             load_bits<T>(bits[kS2] + o), load_bits<T>(bits[kS3] + o)};
+    if constexpr (Light::kPolarized) {
+      s.light.q = load<T>(col[kQ] + o);
+      s.light.u = load<T>(col[kU] + o);
+      s.light.v = load<T>(col[kV] + o);
+      s.light.e1 = {load<T>(col[kE1x] + o), load<T>(col[kE1y] + o), load<T>(col[kE1z] + o)};
+    }
+    return s;
+  }
+
+  // Writes a photon state through put(value, column): one lane, or a vector
+  // of lanes wherever `put` places them.
+  template <class T, class Light, class Put>
+  void put_state(const life::PhotonState<T, Light>& s, Put&& put) {
+    put(s.px, col[kPx]);
+    put(s.py, col[kPy]);
+    put(s.d.x, col[kDx]);
+    put(s.d.y, col[kDy]);
+    put(s.d.z, col[kDz]);
+    put(s.inside, col[kInside]);
+    put(s.path, col[kPath]);
+    put(s.segments, col[kSegments]);
+    put(s.events_here, col[kEventsHere]);
+    put(s.tries, col[kTries]);
+    put(s.weight, col[kWeight]);
+    put(s.code, col[kCode]);
+    for (int k = 0; k < 4; ++k) put(s.rng.word(k), bits[kS0 + k]);
+    if constexpr (Light::kPolarized) {
+      put(s.light.q, col[kQ]);
+      put(s.light.u, col[kU]);
+      put(s.light.v, col[kV]);
+      put(s.light.e1.x, col[kE1x]);
+      put(s.light.e1.y, col[kE1y]);
+      put(s.light.e1.z, col[kE1z]);
+    }
+  }
+};
+
+// 0, 1, ..., W - 1 as stream words.
+life::BitsOf<Lanes> lane_photon_offsets() {
+  alignas(64) std::uint64_t idx[W];
+  for (int i = 0; i < W; ++i) idx[i] = static_cast<std::uint64_t>(i);
+  return life::BitsOf<Lanes>::load_aligned(idx);
+}
+
+Lanes lane_index() {
+  alignas(64) double idx[W];
+  for (int i = 0; i < W; ++i) idx[i] = i;
+  return Lanes::load_aligned(idx);
+}
+
+// inclination() and azimuth() of the exit directions of a block, vectorised
+// (truncated photons get angles too; they are not used).
+void exit_angles(FinishedPhotons& f) {
+  for (int i = 0; i < f.n; i += kBatchWidth) {
+    const Batch x = Batch::load_aligned(f.dx + i), y = Batch::load_aligned(f.dy + i),
+                z = Batch::load_aligned(f.dz + i);
+    xsimd::asin(xsimd::min(Batch(1.0), xsimd::max(Batch(-1.0), x))).store_aligned(f.theta + i);
+    xsimd::atan2(z, y).store_aligned(f.phi + i);
+  }
+}
+
+// The photons of a vector whose lanes `lanes` finished this step, appended
+// to the block f (which has room for W more past them: sim/simd/lane_packing.h).
+// Their fates and exit directions as finished_outcome (sim/life/tracer.h) gives
+// them; a model's exit_direction needs each photon's own stream.
+template <class Model, class Light>
+void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, const Lanes& phi_i,
+               const life::BitsOf<Lanes>& photon, std::uint64_t lanes, FinishedPhotons& f) {
+  using life::pack_store;
+  if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
+  const int n = f.n, k = std::popcount(lanes);
+  pack_store(s.d.x, lanes, f.dx + n);
+  pack_store(s.d.y, lanes, f.dy + n);
+  pack_store(s.d.z, lanes, f.dz + n);
+  pack_store(s.path, lanes, f.path + n);
+  pack_store(s.weight, lanes, f.weight + n);
+  pack_store(phi_i, lanes, f.phi_i + n);
+  pack_store(photon, lanes, f.photon + n);
+  // Fates as fate_of (sim/life/tracer.h) gives them, from the code's mask bits.
+  const std::uint64_t exited =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
+  const std::uint64_t truncated =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kTruncated))), lanes);
+  const std::uint64_t lost = ~(exited | truncated);
+  alignas(64) double segments[W];
+  pack_store(s.segments, lanes, segments);
+  for (int j = 0; j < k; ++j) {
+    f.segments[n + j] = static_cast<int>(segments[j]);
+    f.exited[n + j] = (exited >> j) & 1;
+    f.lost[n + j] = (lost >> j) & 1;
+  }
+  // No exit direction for a photon that did not exit.
+  for (std::uint64_t rest = ~exited & ((std::uint64_t{1} << k) - 1); rest != 0; rest &= rest - 1) {
+    const int j = n + std::countr_zero(rest);
+    f.dx[j] = f.dy[j] = f.dz[j] = 0.0;
+  }
+  if constexpr (HasExitHook<Model>) {
+    alignas(64) std::uint64_t w[4][W];
+    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
+    for (int j = 0; j < k; ++j) {
+      if (!f.exited[n + j]) continue;
+      PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
+      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                       f.segments[n + j], rng);
+      f.dx[n + j] = d.x();
+      f.dy[n + j] = d.y();
+      f.dz[n + j] = d.z();
+    }
+  }
+  f.n = n + k;
+}
+
+}  // namespace
+
+BatchTracer::BatchTracer(const Settings& s)
+    : settings_(s), config_(s), roughness_(make_roughness(s)) {}
+
+void BatchTracer::trace(double theta_i, double phi_i, const PhotonFeed& feed, const Sink& sink,
+                        TracerCounters& counters) const {
+  std::visit(
+      [&](const auto& model) {
+        using Model = std::decay_t<decltype(model)>;
+        if constexpr (requires { Model::kScalarOnly; }) {
+          throw Error("internal error: this roughness model runs on the reference tracer only");
+        } else if (settings_.polarization == Polarization::Stokes)
+          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
+        else
+          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
+      },
+      roughness_);
+}
+
+template <class Light, class Model>
+void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
+                             const PhotonFeed& feed, const Sink& sink,
+                             TracerCounters& counters) const {
+  using OneLight = typename Light::template Rebind<double>;  // the same light, one photon
+  auto pool_owner = std::make_unique<Pool>();
+  Pool& pool = *pool_owner;
+  auto done = std::make_unique<FinishedPhotons>();
+  const Source source(settings_, theta_i, phi_i);
+  const EllipseCrossSection& ellipse = config_.ellipse;
+  const Eigen::Vector2d beam = ellipse.beam_direction(-direction_from_angles(theta_i, phi_i));
+  const Lanes iota = lane_index();
+  life::LifeCounts<Lanes> counts;
+
+  // New photons into lanes [o, o + W), photons first, first + 1, ...: the
+  // Source's streams and impact parameters and the life's start, a vector at
+  // a time (a fixed incident direction). Lanes past the photons wanted are
+  // free lanes (or the pool's spare ones): what is written there is never read.
+  const bool vector_launch = source.fixed_direction();
+  const Vec3 d_fixed = -direction_from_angles(theta_i, phi_i);
+  const life::Vec3Of<Lanes> d_lanes{Lanes(d_fixed.x()), Lanes(d_fixed.y()), Lanes(d_fixed.z())};
+  auto launch_vector = [&](int o, std::uint64_t first_photon) {
+    const life::BitsOf<Lanes> photon = life::BitsOf<Lanes>(first_photon) + lane_photon_offsets();
+    const auto lanes = source.template launch_lanes<Lanes>(photon);
+    Lanes pv, pw;
+    ellipse.entry_point_in_beam(beam, lanes.h, pv, pw);
+    pool.put_state(life::start_photon<Light>(pv, pw, d_lanes, lanes.rng),
+                   [o](const auto& x, auto* column) { life::store_unaligned(x, column + o); });
+    photon.store_unaligned(pool.bits[Pool::kPhoton] + o);
+  };
+  // A new photon into lane i: the Source's launch, the life's start.
+  auto launch = [&](int i, std::uint64_t photon) {
+    const LaunchedPhoton p = source.launch(photon);
+    const Vec3 d = -p.wi;
+    const Point2 entry = ellipse.entry_point_in_beam(
+        source.fixed_direction() ? beam : ellipse.beam_direction(d), p.h);
+    pool.put_state(life::start_photon<OneLight>(entry, d, p.rng.core()),
+                   [i](const auto& x, auto* column) { column[i] = x; });
+    pool.col[Pool::kPhiI][i] = p.phi_i;
+    pool.bits[Pool::kPhoton][i] = photon;
+  };
+  auto flush = [&] {
+    done->clear_tail();
+    exit_angles(*done);
+    sink(*done);
+    done->n = 0;
+  };
+  // A pass over the pool appends at most every lane it holds, and a vector's
+  // worth of scratch past them (sim/simd/lane_packing.h).
+  constexpr int kFlushAbove = FinishedPhotons::kCapacity - (kPoolLanes + W);
+  static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
+
+  // Photons [next, end) of the current run are still to launch.
+  std::uint64_t next = 0, end = 0;
+  bool fed_out = false;
+  auto more_to_launch = [&] {
+    while (next == end && !fed_out) {
+      const PhotonRun run = feed();
+      fed_out = run.n == 0;
+      next = run.first;
+      end = run.first + run.n;
+    }
+    return next < end;
+  };
+  int n_active = 0;
+  while (true) {
+    if (vector_launch) {
+      while (n_active < kPoolLanes && more_to_launch()) {
+        launch_vector(n_active, next);
+        const int n = static_cast<int>(std::min<std::uint64_t>(
+            std::min(W, kPoolLanes - n_active), end - next));
+        n_active += n;
+        next += n;
+      }
+    } else {
+      while (n_active < kPoolLanes && more_to_launch()) launch(n_active++, next++);
+    }
+    if (n_active == 0) break;
+    if (done->n > kFlushAbove) flush();
+    // One step for every photon in flight, a vector at a time. The finished
+    // ones go to the block; the others are packed to the front of the pool as
+    // the pass goes (`kept` never passes the vector being stepped, which is
+    // already loaded). The order of photons in the pool does not matter:
+    // tallies are exact integer sums.
+    int kept = 0;
+    for (int o = 0; o < n_active; o += W) {
+      const MaskOf<Lanes> live = (iota + Lanes(o)) < Lanes(n_active);
+      auto s = pool.load_state<Lanes, Light>(o);
+      // A fixed incident direction keeps phi_i out of the pool.
+      const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
+      const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
+      life::step(config_, model, s, live, counts, kRoundsPerStep);
+      const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
+      const std::uint64_t finished = life::lane_bits(live & !at_boundary);
+      const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
+      if (finished != 0) hand_over(model, s, phi_lanes, photon, finished, *done);
+      pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
+      if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
+      life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
+      kept += std::popcount(in_flight);
+    }
+    n_active = kept;
+  }
+  if (done->n > 0) flush();
+  counters.events += static_cast<long>(life::lane_sum(counts.events));
+  counters.normal_draws += static_cast<long>(life::lane_sum(counts.normal_draws));
+  counters.sampler_caps += static_cast<long>(life::lane_sum(counts.sampler_caps));
+}
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,164 @@
+#include "sim/life/exit_scoring.h"
+
+#include <xsimd/xsimd.hpp>
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/units.h"
+#include "common/bin_grid.h"
+
+namespace fiberlab::sim {
+
+namespace {
+
+using Batch = xsimd::batch<double>;
+using Index = xsimd::batch<std::int64_t>;
+
+// A bin index (a whole number below 2^52) as an integer (sim/simd/lanes.h).
+Index to_index(const Batch& x) { return xsimd::bitwise_cast<Index>(life::to_bits(x)); }
+
+// The closed-form fraction of a uniformly binned value: (v + offset) /
+// period, in [0, 1) inside the grid. One formula for the values' bins and for
+// the check of the edges below (edges_at_closed_form relies on it being the
+// same operations).
+template <class T>
+T uniform_fraction(const T& v, double offset, double period) {
+  return (v + T(offset)) / T(period);
+}
+
+// How far from a whole number (in bins) the closed-form position x n of a
+// value must be for the settle step below to be skipped (see settled_bin).
+constexpr double kSettleMargin = 0x1.0p-20;
+
+// Whether every edge's own closed-form position, computed as block_bins
+// computes a value's, lies within half the margin of its index. The
+// positions are monotone in the value (each operation rounds monotonically),
+// so then a value whose position is at least the margin away from every
+// whole number lies strictly between the edges of its closed-form bin, and
+// the settle step would not move it.
+bool edges_at_closed_form(const std::vector<double>& edges, double offset, double period) {
+  const int n = static_cast<int>(edges.size()) - 1;
+  for (int i = 0; i <= n; ++i)
+    if (!(std::abs(uniform_fraction(edges[i], offset, period) * n - i) <= kSettleMargin / 2))
+      return false;
+  return true;
+}
+
+// BinGrid::theta_bin / phi_bin (common/bin_grid.cpp, the definition) for a
+// vector of values: the closed-form index, clamped, then settled on the
+// grid's own edges, so the result is the scalar one exactly (a test compares
+// them at and next to every edge, and at random values). When the edges are
+// at their closed-form positions (`closed_form`, edges_at_closed_form) and
+// every lane's position is at least kSettleMargin inside its bin, the index
+// is already settled: nearly every vector, which then needs no gather of
+// edges. A NaN fraction gives bin 0 (max(NaN, 0) is 0); such photons did not
+// exit and their bins are never read.
+Index settled_bin(const Batch& v, const Batch& fraction, int n, const std::vector<double>& edges,
+                  bool closed_form) {
+  const Batch position = fraction * Batch(n);
+  Batch i = xsimd::min(xsimd::max(xsimd::floor(position), Batch(0.0)), Batch(n - 1));
+  if (closed_form) {
+    const Batch inside = position - i;  // exact (Sterbenz) where it matters: 0 <= i <= position
+    if (xsimd::all((inside >= Batch(kSettleMargin)) & (inside <= Batch(1.0 - kSettleMargin))))
+      return to_index(i);
+  }
+  const Index k = to_index(i);
+  const Batch lo = Batch::gather(edges.data(), k), hi = Batch::gather(edges.data(), k + Index(1));
+  const auto down = (i > Batch(0.0)) & (v < lo);
+  const auto up = (!down) & (i < Batch(n - 1)) & (v >= hi);
+  i = i - xsimd::select(down, Batch(1.0), Batch(0.0)) + xsimd::select(up, Batch(1.0), Batch(0.0));
+  return to_index(i);
+}
+
+// wrap_angle(a) (common/units.h) where a + pi lies in (-2 pi, 4 pi): there
+// fmod(a + pi, 2 pi) is a + pi, or a + pi - 2 pi computed exactly (Sterbenz),
+// so this is the same number. `in_range` is false where it does not apply.
+Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
+  Batch t = a + Batch(kPi);
+  in_range = (t > Batch(-kTwoPi)) & (t < Batch(2.0 * kTwoPi));
+  t = xsimd::select(t >= Batch(kTwoPi), t - Batch(kTwoPi), t);
+  t = xsimd::select(t < Batch(0.0), t + Batch(kTwoPi), t);
+  const Batch w = t - Batch(kPi);
+  return xsimd::select(w >= Batch(kPi), Batch(-kPi), w);
+}
+
+}  // namespace
+
+ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
+    : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
+      weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
+      kept_(sigma_a_.size()),
+      // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
+      theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
+                         edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
+      phi_closed_form_(edges_at_closed_form(grid.phi_edges, kPi, kTwoPi)) {}
+
+void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, std::int64_t* phi_bin) const {
+  constexpr int W = static_cast<int>(Batch::size);
+  const int n_theta = grid_.n_theta(), n_phi = grid_.n_phi();
+  const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
+  for (int i = 0; i < f.n; i += W) {
+    const Batch theta = Batch::load_aligned(f.theta + i);
+    const Batch theta_fraction = uniform ? uniform_fraction(theta, kPi / 2, kPi)
+                                         : Batch(0.5) * (xsimd::sin(theta) + Batch(1.0));
+    settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges, theta_closed_form_)
+        .store_aligned(theta_bin + i);
+    Batch::batch_bool_type in_range;
+    const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
+    settled_bin(phi, uniform_fraction(phi, kPi, kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
+        .store_aligned(phi_bin + i);
+    // Lanes out of the vector wrap's range take the scalar one. Photons that
+    // did not exit (truncated) have no direction (NaN): their bins are never
+    // read, and a NaN must not reach phi_bin's conversion to int.
+    if (!xsimd::all(in_range))
+      for (int k = i; k < std::min(i + W, f.n); ++k)
+        phi_bin[k] = f.exited[k] ? grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k])) : 0;
+  }
+}
+
+void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
+  constexpr int W = static_cast<int>(Batch::size);
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const int channels = static_cast<int>(sigma_a_.size());
+  for (int c = 0; c < channels; ++c) {
+    const Batch minus_sigma(-sigma_a_[c]);
+    double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
+    for (int i = 0; i < f.n; i += W)
+      (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
+          .store_unaligned(w + i);
+  }
+  alignas(64) std::int64_t theta_bin[kCap], phi_bin[kCap];
+  block_bins(f, theta_bin, phi_bin);
+  std::size_t bin[kCap];
+  for (int i = 0; i < f.n; ++i) {
+    if (!f.exited[i]) continue;
+    bin[i] = tally.bin_index(std::min(f.segments[i], last_lobe_), static_cast<int>(theta_bin[i]),
+                             static_cast<int>(phi_bin[i]));
+    tally.prefetch(bin[i]);
+  }
+  double* weight = one_photon_.data();
+  for (int i = 0; i < f.n; ++i) {
+    if (f.exited[i]) {
+      tally.score_exit(bin[i], weights_.data() + i, kCap);
+    } else if (!f.lost[i]) {
+      for (int c = 0; c < channels; ++c) weight[c] = weights_[static_cast<std::size_t>(c) * kCap + i];
+      tally.score_truncated(weight);
+    }
+  }
+  // Masking's removals, each absorbed along the path up to it,
+  // summed per photon (a photon's removals are consecutive in f.losses).
+  double* kept = kept_.data();
+  for (std::size_t j = 0; j < f.losses.size();) {
+    const int slot = f.losses[j].slot;
+    std::fill(weight, weight + channels, 0.0);
+    for (; j < f.losses.size() && f.losses[j].slot == slot; ++j) {
+      const WeightLoss& l = f.losses[j].loss;
+      for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
+    }
+    for (int c = 0; c < channels; ++c) kept[c] = weights_[static_cast<std::size_t>(c) * kCap + slot];
+    tally.score_lost(weight, kept);
+  }
+}
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,75 @@
+#pragma once
+// Photons that a tracer has finished, handed to the scorer a block at a time
+// (structure of arrays), so that weights are computed vectorised and the
+// tally's cells fetched ahead, instead of one call per photon.
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include "sim/life/tracer.h"
+
+namespace fiberlab::sim {
+
+struct FinishedPhotons {
+  static constexpr int kCapacity = 512;  // a multiple of every SIMD width
+  static_assert(kCapacity % kBatchWidth == 0);
+  int n = 0;
+  alignas(64) double path[kCapacity] = {};  // internal 3D path length
+  alignas(64) double weight[kCapacity] = {};  // throughput before absorption (PhotonOutcome::weight)
+  alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
+  alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
+  std::uint64_t photon[kCapacity];
+  int segments[kCapacity];
+  bool exited[kCapacity];
+  bool lost[kCapacity];  // killed by masking (its weight is in `losses`)
+  // Weight removed by masking from the block's photons (empty
+  // without masking): photon slot, weight, path length at the removal.
+  struct Loss {
+    int slot;
+    WeightLoss loss;
+  };
+  std::vector<Loss> losses;
+
+  bool full() const { return n == kCapacity; }
+  // Zeroes the numbers of slots [n, the end of n's SIMD vector): the scorer's
+  // vectorised loops read a whole vector, and a batched tracer appends whole
+  // vectors, whose lanes past its photons hold scratch (any bits, possibly a
+  // value that would overflow a conversion to an integer).
+  void clear_tail() {
+    const int end = (n + kBatchWidth - 1) / kBatchWidth * kBatchWidth;
+    for (double* column : {path, weight, phi_i, dx, dy, dz})
+      std::fill(column + n, column + end, 0.0);
+  }
+  void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
+    if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
+    for (const WeightLoss& l : o.losses) losses.push_back({n, l});
+    weight[n] = o.weight;
+    lost[n] = o.fate == PhotonFate::Lost;
+    photon[n] = index;
+    phi_i[n] = incident_phi;
+    path[n] = o.path_length;
+    segments[n] = o.segments;
+    exited[n] = o.fate == PhotonFate::Exited;
+    theta[n] = o.theta;
+    phi[n] = o.phi;
+    dx[n] = o.direction.x();
+    dy[n] = o.direction.y();
+    dz[n] = o.direction.z();
+    ++n;
+  }
+  PhotonOutcome outcome(int i) const {
+    PhotonOutcome o;
+    o.fate = exited[i] ? PhotonFate::Exited : lost[i] ? PhotonFate::Lost : PhotonFate::Truncated;
+    o.weight = weight[i];
+    for (const Loss& l : losses)
+      if (l.slot == i) o.losses.push_back(l.loss);
+    o.direction = Vec3(dx[i], dy[i], dz[i]);
+    o.segments = segments[i];
+    o.path_length = path[i];
+    o.theta = theta[i];
+    o.phi = phi[i];
+    return o;
+  }
+};
+
+}  // namespace fiberlab::sim

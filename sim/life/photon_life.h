@@ -1,0 +1,164 @@
+#pragma once
+// A photon's life (SPEC sections 3-5), written once for its number type T
+// (sim/simd/lanes.h): enter the fiber at an impact parameter, meet the boundary,
+// reflect or refract about a normal drawn by the roughness model, run straight
+// segments inside, until it leaves, is truncated or (a model's choice) lost.
+//
+// T = double traces one photon: sim/life/tracer.cpp runs step() until the photon
+// is done, the readable reference. T = xsimd::batch<double> traces a SIMD
+// vector of photons, and T = Pair<Batch> (sim/simd/lane_pair.h) two of them:
+// sim/life/batch_tracer.cpp keeps a pool of photons in lanes, runs step() on each
+// Pair of vectors of lanes, refills the lanes whose photon is done.
+// A photon draws the same random numbers in the same order either way (every
+// draw is masked to the lanes that make it), so both give the same path up to
+// the last bits of the vectorised log/sin/cos (tests/sim/test_batch_tracer.cpp).
+//
+// Branches that depend on the photon are masks: code says what each lane's
+// photon does next. The path does not depend on the colour channel, so the
+// life returns the total internal path length and the scorer turns it into a
+// Beer-Lambert weight per channel; `weight` is the model's throughput factor
+// (1 unless a roughness model's event_weight says otherwise).
+#include <type_traits>
+
+#include "sim/life/ellipse_cross_section.h"
+#include "sim/life/interface_event.h"
+#include "sim/roughness/roughness_model.h"
+#include "sim/run/settings.h"
+
+namespace fiberlab::sim::life {
+
+// What a photon does next.
+enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kLost = 4 };
+
+// The fixed parts of one configuration.
+struct LifeConfig {
+  explicit LifeConfig(const Settings& s)
+      : ellipse(s.fiber.eccentricity), eta(s.fiber.eta), cos_tilt(std::cos(s.fiber.scale_tilt)),
+        sin_tilt(std::sin(s.fiber.scale_tilt)), max_segments(s.max_segments),
+        max_events(s.max_events_per_point) {}
+  EllipseCrossSection ellipse;
+  double eta;
+  double cos_tilt, sin_tilt;  // cuticle tilt towards the root (SPEC section 2)
+  int max_segments, max_events;
+};
+
+template <class T, class Light>
+struct PhotonState {
+  T px, py;        // boundary point (v, w)
+  Vec3Of<T> d;     // direction
+  T inside;        // 1 inside the fiber, 0 outside
+  T path;          // internal 3D path length
+  T segments;      // internal straight segments: the lobe index p
+  T events_here;   // interface events at the current boundary point
+  T tries;         // candidate normals drawn for the pending event
+  T weight;        // throughput factor of the roughness model
+  T code;          // LaneCode
+  LaneRandom<T> rng;
+  Light light;
+  LossRecord<T> losses;  // weight removed by the model's event weights
+};
+
+// Photons arriving along d at the entry points (pv, pw), with their streams.
+template <class Light, class T>
+PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
+                                   const LaneRandom<T>& rng) {
+  const T zero(0.0);
+  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {}};
+}
+template <class Light>
+PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
+                                        const LaneRandom<double>& rng) {
+  return start_photon<Light, double>(p.x(), p.y(), Vec3Of<double>(d), rng);
+}
+
+template <class Model, class T>
+concept HasEventWeight = requires(const Model& m, const EventGeometry<T>& e, const MaskOf<T>& a,
+                                  LaneRandom<T>& r) {
+  { m.event_weight(e, a, r) } -> std::same_as<EventWeight<T>>;
+};
+
+// One interface event for the photons in `live` at a boundary point (SPEC
+// section 3): draw the normal, reflect or refract, apply the consistency
+// rule (the new direction must leave the boundary on the photon's new side,
+// judged with the untilted normal; otherwise another event at the same
+// point, at most max_events).
+template <class T, class Model, class Light>
+void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
+                     const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
+  const MaskOf<T> inside = s.inside != T(0.0);
+  const Vec3Of<T> n0 = c.ellipse.normal_at(s.px, s.py);
+  // The tilted normal n_s = cos(alpha) n0 - sin(alpha) u, on the photon's side.
+  const T side = select(inside, T(-1.0), T(1.0));
+  const T sin_n = side * T(-c.sin_tilt);
+  const BoundaryFrame<T> frame{
+      Vec3Of<T>(sin_n, side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z), side * n0,
+      sin_n, T(c.cos_tilt)};
+  const FacetDraw<T> f = model.draw_normal(s.d, frame, live, s.rng, s.tries, counts, rounds);
+  const MaskOf<T> act = f.ready;  // never failed too (sim/roughness/roughness_model.h)
+  const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
+                                select(inside, T(c.eta), T(1.0 / c.eta))};
+  const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng);
+  const Vec3Of<T> d = select(act, r.direction, s.d);
+  MaskOf<T> lost(false);
+  if constexpr (HasEventWeight<Model, T>) {
+    const EventWeight<T> w =
+        model.event_weight(EventGeometry<T>{s.d, d, f.m, frame, r.refracted}, act, s.rng);
+    s.losses.add(act & (w.factor < T(1.0)), s.weight * (T(1.0) - w.factor), s.path);
+    lost = act & w.lost;
+    s.weight = select(act, select(lost, T(0.0), s.weight * w.factor), s.weight);
+  }
+  const MaskOf<T> flip = act & r.refracted;
+  // != is exclusive or on masks (not ^: xsimd 8.1's ^ of AVX-512 masks is an
+  // or; sim/simd/lanes.h).
+  const MaskOf<T> now_inside = flip != inside;
+  const T dn = d.dot(n0);
+  const MaskOf<T> consistent = (now_inside & (dn < T(0.0))) | ((!now_inside) & (dn > T(0.0)));
+  T code = select(consistent, select(now_inside, T(kTravel), T(kExited)), T(kAtBoundary));
+  code = select(f.failed, T(kTruncated), code);
+  code = select(lost, T(kLost), code);
+  code = select(act | f.failed, code, s.code);
+  s.d = d;
+  s.inside = ones<T>(now_inside);
+  s.events_here = s.events_here + ones<T>(act);
+  // Still undecided after max_events events at this point: truncated.
+  const MaskOf<T> stuck = act & !consistent & !lost & (s.events_here >= T(c.max_events));
+  s.code = select(stuck, T(kTruncated), code);
+  counts.events = counts.events + ones<T>(act);
+}
+
+// One internal segment for the photons about to cross the fiber (SPEC
+// sections 2 and 4). A photon that did not leave at the boundary ending its
+// last allowed segment is truncated (SPEC section 5), and so is one running
+// exactly along the axis (guided for ever). Always inline: GCC left it out
+// of line, passing the state through memory (bench_sim b +10%, c +6% inline).
+template <class T, class Light>
+[[gnu::always_inline]] inline void travel(const LifeConfig& c, PhotonState<T, Light>& s,
+                                          const MaskOf<T>& live) {
+  const MaskOf<T> at_limit = live & (s.code == T(kTravel)) & (s.segments >= T(c.max_segments));
+  s.code = select(at_limit, T(kTruncated), s.code);
+  const MaskOf<T> go = live & (s.code == T(kTravel));
+  if (!any(go)) return;
+  MaskOf<T> along_axis(false);
+  const T t = select(go, c.ellipse.distance_to_boundary(s.px, s.py, s.d.y, s.d.z, along_axis),
+                     T(0.0));
+  const MaskOf<T> moved = go & !along_axis;
+  T pv = s.px, pw = s.py;
+  c.ellipse.advance(pv, pw, s.d.y, s.d.z, t);
+  s.px = select(moved, pv, s.px);
+  s.py = select(moved, pw, s.py);
+  s.path = s.path + t;
+  s.segments = s.segments + ones<T>(moved);
+  s.events_here = select(moved, T(0.0), s.events_here);
+  s.code = select(moved, T(kAtBoundary), select(go & along_axis, T(kTruncated), s.code));
+}
+
+// One step of the life for the photons in `live`, all at a boundary point:
+// an interface event, then the next segment for those that go on inside.
+template <class T, class Model, class Light>
+void step(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
+          const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
+  interface_event(c, model, s, live, counts, rounds);
+  travel(c, s, live);
+}
+
+}  // namespace fiberlab::sim::life

@@ -1,0 +1,38 @@
+#include "sim/life/tracer.h"
+
+namespace fiberlab::sim {
+
+Tracer::Tracer(const Settings& s)
+    : config_(s), roughness_(make_roughness(s)), polarization_(s.polarization) {}
+
+PhotonOutcome Tracer::trace(const Vec3& wi, double h, PhotonRandom& rng,
+                            TracerCounters* counters) const {
+  return std::visit(
+      [&](const auto& model) {
+        return polarization_ == Polarization::Stokes
+                   ? trace_with<life::StokesLight<double>>(model, wi, h, rng, counters)
+                   : trace_with<life::ScalarLight<double>>(model, wi, h, rng, counters);
+      },
+      roughness_);
+}
+
+template <class Light, class Model>
+PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, PhotonRandom& rng,
+                                 TracerCounters* counters) const {
+  const Vec3 d = -wi;
+  auto s = life::start_photon<Light>(config_.ellipse.entry_point(d, h), d, rng.core());
+  life::LifeCounts<double> counts;
+  while (s.code == static_cast<double>(life::kAtBoundary)) step(config_, model, s, true, counts, kMaxNormalTries);
+  rng.core() = s.rng;
+  if (counters) counters->add(counts);
+  PhotonOutcome out = finished_outcome(model, static_cast<int>(s.code), s.d.to_vec3(),
+                                       static_cast<int>(s.segments), s.path, s.weight, rng);
+  out.losses = std::move(s.losses.list);
+  if (out.fate == PhotonFate::Exited) {
+    out.theta = inclination(out.direction);
+    out.phi = azimuth(out.direction);
+  }
+  return out;
+}
+
+}  // namespace fiberlab::sim

@@ -1,0 +1,105 @@
+#pragma once
+// The reference tracer: one photon's life (sim/life/photon_life.h) at a time, the
+// scalar instantiation of the same steps the batched tracer runs on SIMD
+// vectors of photons (sim/life/batch_tracer.h).
+#include <concepts>
+#include <vector>
+
+#include "common/fiber_frame.h"
+#include "sim/life/photon_life.h"
+#include "sim/life/random.h"
+#include "sim/roughness/roughness_models.h"
+#include "sim/run/settings.h"
+
+namespace fiberlab::sim {
+
+// Lost: a roughness model ended the path (its weight is booked as lost).
+enum class PhotonFate { Exited, Truncated, Lost };
+
+struct PhotonOutcome {
+  PhotonFate fate = PhotonFate::Exited;
+  Vec3 direction = Vec3::Zero();  // exit direction wr (when Exited)
+  int segments = 0;               // internal straight segments: the lobe index p
+  double path_length = 0.0;       // total 3D length inside, in units of R
+  double theta = 0.0, phi = 0.0;  // inclination and azimuth of `direction` (when Exited)
+  // The throughput before absorption: the product of the masking factors (1
+  // without masking, 0 when Lost). Channel c carries weight exp(-sigma_a[c] l).
+  double weight = 1.0;
+  std::vector<WeightLoss> losses;  // what masking removed, in order (empty without masking)
+};
+
+// Work counters, for benchmarks and notes.
+struct TracerCounters {
+  long events = 0;          // interface events
+  long normal_draws = 0;    // candidate microfacet normals drawn
+  long sampler_caps = 0;    // photons truncated because no visible normal was drawn in
+                            // kMaxNormalTries candidates (SPEC section 3: should be none)
+  void add(const TracerCounters& o) {
+    events += o.events;
+    normal_draws += o.normal_draws;
+    sampler_caps += o.sampler_caps;
+  }
+  void add(const life::LifeCounts<double>& c) {
+    events += static_cast<long>(c.events);
+    normal_draws += static_cast<long>(c.normal_draws);
+    sampler_caps += static_cast<long>(c.sampler_caps);
+  }
+};
+
+// The fate of a photon whose life ended with `code` (life::LaneCode).
+inline PhotonFate fate_of(int code) {
+  return code == life::kExited      ? PhotonFate::Exited
+         : code == life::kTruncated ? PhotonFate::Truncated
+                                    : PhotonFate::Lost;
+}
+
+// A roughness model with an exit hook (exit_blur): the direction a photon
+// leaves along is drawn from its own stream when it exits.
+template <class Model>
+concept HasExitHook = requires(const Model& m, const Vec3& d, int segments, PhotonRandom& rng) {
+  { m.exit_direction(d, segments, rng) } -> std::same_as<Vec3>;
+};
+
+// The direction of a photon that exited along d after `segments` segments.
+template <class Model>
+Vec3 exit_direction_of(const Model& model, const Vec3& d, int segments, PhotonRandom& rng) {
+  if constexpr (HasExitHook<Model>) return model.exit_direction(d, segments, rng);
+  else return d;
+}
+
+// The outcome of a photon whose life ended with `code`.
+template <class Model>
+PhotonOutcome finished_outcome(const Model& model, int code, const Vec3& d, int segments,
+                               double path, double weight, PhotonRandom& rng) {
+  PhotonOutcome out;
+  out.fate = fate_of(code);
+  out.segments = segments;
+  out.path_length = path;
+  out.weight = weight;
+  if (out.fate == PhotonFate::Exited) out.direction = exit_direction_of(model, d, segments, rng);
+  return out;
+}
+
+class Tracer {
+ public:
+  explicit Tracer(const Settings& settings);
+
+  // Traces one photon arriving along -wi. h in (-1, 1) is its impact
+  // parameter across the projected width.
+  PhotonOutcome trace(const Vec3& wi, double h, PhotonRandom& rng,
+                      TracerCounters* counters = nullptr) const;
+
+  // Cap on candidate normals per event (SPEC section 3: at least 10,000).
+  static constexpr int kMaxNormalTries = life::kMaxNormalTries;
+
+ private:
+  template <class Light, class Model>
+  PhotonOutcome trace_with(const Model& model, const Vec3& wi, double h, PhotonRandom& rng,
+                           TracerCounters* counters) const;
+
+  life::LifeConfig config_;
+  AnyRoughness roughness_;
+  Polarization polarization_;
+};
+
+}  // namespace fiberlab::sim

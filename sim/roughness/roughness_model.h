@@ -1,0 +1,138 @@
+#pragma once
+// What a roughness model is to the photon life (sim/life/photon_life.h), and how
+// to add one.
+//
+// A roughness model decides the facet normal m that each interface event
+// reflects or refracts about (SPEC section 3). It is a class, written once
+// for both number types of the life (a scalar double, or an
+// xsimd::batch<double> of photons: sim/simd/lanes.h), with
+//
+//   explicit Model(const Settings&);
+//   template <class T>
+//   FacetDraw<T> draw_normal(const Vec3Of<T>& d, const BoundaryFrame<T>& frame,
+//                            const MaskOf<T>& live, LaneRandom<T>& rng, T& tries,
+//                            LifeCounts<T>& counts, int rounds) const;
+//
+// and optionally
+//
+//   // A throughput factor per event, and lanes whose path ends here (fate
+//   // Lost; e.g. Smith G1 masking of the outgoing direction).
+//   template <class T>
+//   EventWeight<T> event_weight(const EventGeometry<T>& e, const MaskOf<T>& act,
+//                               LaneRandom<T>& rng) const;
+//   // The exit direction (once per exiting photon, scalar).
+//   Vec3 exit_direction(const Vec3& d, int segments, PhotonRandom& rng) const;
+//
+// draw_normal rules, for every lane in `live` (leave the other lanes' random
+// streams untouched: draw with rng.uniform(mask) masks within `live`):
+// - return m with d.m < 0 in the lanes of `ready`; lanes whose sampler gave
+//   up go in `failed` (the photon is truncated: SPEC section 3 wants none),
+//   never both;
+// - a rejection sampler draws at most `rounds` candidates per call, and a
+//   round after the first only while another_round(pending, slow): lanes
+//   neither ready nor failed are called again with the same inputs and
+//   continue from their own stream (count candidates in `tries`, reset it
+//   to 0 in ready or failed lanes). The scalar tracer passes rounds =
+//   kMaxNormalTries, the batched one a few, so that a vector of lanes is not
+//   held up by its slowest lane; both draw the same numbers for a photon.
+// - count candidates in counts.normal_draws and failures in
+//   counts.sampler_caps.
+//
+// To add a model: write it in one header (sim/roughness_<name>.h; see
+// sim/roughness/roughness_gaussian.h for a rejection sampler, sim/roughness/roughness_smooth.h
+// for the simplest), add its settings (sim/run/settings.*), and register it in
+// sim/roughness/roughness_models.h (the variant and make_roughness). Both tracers, the
+// batched one's lane management, Fresnel, Stokes light, tilt, the
+// consistency rule and truncation then apply to it unchanged.
+#include <vector>
+
+#include "sim/simd/lane_pair.h"
+#include "sim/simd/lanes.h"
+#include "sim/life/random.h"
+
+namespace fiberlab::sim {
+// Weight removed from a photon by a roughness model's event weight (masking),
+// and the internal path length it had travelled then: channel c lost weight *
+// exp(-sigma_a[c] * path_length).
+struct WeightLoss {
+  double weight, path_length;
+};
+}  // namespace fiberlab::sim
+
+namespace fiberlab::sim::life {
+
+// Cap on candidate normals per event (SPEC section 3: at least 10,000).
+inline constexpr int kMaxNormalTries = 100000;
+
+// Whether a rejection sampler draws another round of candidates in this
+// call: one photon until it has its normal; a vector while a lane whose
+// candidates are seldom accepted (`slow`, the model's judgement) still
+// waits. A lane that is usually accepted at the next candidate is cheaper
+// to carry to the next step, whose other lanes move on, than a round for all.
+inline bool another_round(bool pending, bool /*slow*/) { return pending; }
+inline bool another_round(const MaskOf<Batch>& pending, const MaskOf<Batch>& slow) {
+  return xsimd::any(pending & slow);
+}
+template <class M>
+bool another_round(const Pair<M>& pending, const Pair<M>& slow) {
+  return any(pending & slow);
+}
+
+// The macro normals of the boundary point as the photon sees them.
+template <class T>
+struct BoundaryFrame {
+  Vec3Of<T> facing;           // n_f: the tilted normal facing the photon's side
+  Vec3Of<T> untilted_facing;  // n0 (or -n0 inside): the smooth model's fallback
+  // n_f = sin_n u + cos_n untilted_facing (cos_n > 0: |tilt| < 45 deg).
+  T sin_n, cos_n;
+
+  // The frame of a facing normal alone (untilted_facing: its part in the normal plane).
+  static BoundaryFrame from_facing(const Vec3Of<T>& f) {
+    const T cos_n = sqrt(f.y * f.y + f.z * f.z);
+    const T inv = T(1.0) / cos_n;
+    return {f, Vec3Of<T>(T(0.0), f.y * inv, f.z * inv), f.x, cos_n};
+  }
+};
+
+template <class T>
+struct FacetDraw {
+  Vec3Of<T> m;
+  MaskOf<T> ready;   // lanes with a normal for this event
+  MaskOf<T> failed;  // lanes that gave up: truncated (never ready)
+};
+
+// One event as the optional event_weight hook sees it.
+template <class T>
+struct EventGeometry {
+  Vec3Of<T> d_in, d_out, m;
+  BoundaryFrame<T> frame;
+  MaskOf<T> refracted;
+};
+
+template <class T>
+struct EventWeight {
+  T factor;        // multiplies the photon's throughput weight
+  MaskOf<T> lost;  // the path ends here (fate Lost, its weight booked as lost)
+};
+
+// The losses a photon records (one photon: a list; a vector of lanes: none,
+// the batched life runs no model with event weights yet).
+template <class T>
+struct LossRecord {
+  void add(const MaskOf<T>&, const T&, const T&) {}
+};
+template <>
+struct LossRecord<double> {
+  std::vector<WeightLoss> list;
+  void add(bool m, double weight, double path) {
+    if (m) list.push_back({weight, path});
+  }
+};
+
+// Work counters of the life, per lane (summed at the end).
+template <class T>
+struct LifeCounts {
+  T events = T(0.0), normal_draws = T(0.0), sampler_caps = T(0.0);
+};
+
+}  // namespace fiberlab::sim::life

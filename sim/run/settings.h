@@ -1,0 +1,125 @@
+#pragma once
+// What to run: the resolved simulation configuration (SPEC section 11).
+// All angles here are in radians; the YAML file has degrees.
+#include <algorithm>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/bin_grid.h"
+
+namespace fiberlab::sim {
+
+// Beckmann and GGX: microfacet distributions of normals about the tilted
+// normal, sampled as visible normals (sim/roughness/microfacet_roughness.h).
+enum class RoughnessModel { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
+// `roughness.masking` of the microfacet models: `smith_g1` multiplies the
+// photon's weight by Smith's G1 of each scattered direction and kills paths
+// that leave on the wrong side of the mean surface (Huang et al. 2022's
+// ground truth); the removed weight is the ledger's `lost`.
+enum class Masking { None, SmithG1 };
+enum class Polarization { Scalar, Stokes };
+
+struct FiberSettings {
+  double eta = 1.55;           // relative index, > 1
+  double eccentricity = 1.0;   // minor/major, (0, 1]
+  double scale_tilt = 0.0;     // alpha, radians, towards the root
+  std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
+  // Set when the config gave melanin instead of sigma_a (sigma_a is then derived).
+  std::optional<double> eumelanin, pheomelanin;
+
+  friend bool operator==(const FiberSettings&, const FiberSettings&) = default;
+};
+
+struct RoughnessSettings {
+  RoughnessModel model = RoughnessModel::Gaussian;
+  // Radians. gaussian: one entry. exit_blur: indexed by p, the last entry
+  // applying to every larger p. smooth: ignored (kept as given).
+  std::vector<double> beta_long{0.0};
+  std::vector<double> beta_azim{0.0};
+  // beckmann / ggx (0 for the other models): the microfacet roughness alpha
+  // along the fiber axis (longitudinal) and about it (azimuthal), each > 0.
+  double alpha_long = 0.0, alpha_azim = 0.0;
+  Masking masking = Masking::None;  // beckmann / ggx only
+
+  bool microfacet() const { return model == RoughnessModel::Beckmann || model == RoughnessModel::GGX; }
+
+  // beta for lobe p of a list indexed by p (last entry for larger p).
+  static double for_lobe(const std::vector<double>& betas, int p) {
+    return betas[std::min<std::size_t>(static_cast<std::size_t>(p), betas.size() - 1)];
+  }
+
+  friend bool operator==(const RoughnessSettings&, const RoughnessSettings&) = default;
+};
+
+struct SourceSettings {
+  std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
+  bool phi_i_uniform = false;        // a randomly rotated fiber
+  std::vector<double> phi_i{0.0};    // radians (unused when uniform)
+  // Impact parameters h stratified by photon index (sim/life/source.h), or each
+  // photon's h independent (the default: stratification measured no gain,
+  // README "Stratified impact parameters"). Either way every h is uniform in [-1, 1).
+  bool h_stratified = false;
+
+  friend bool operator==(const SourceSettings&, const SourceSettings&) = default;
+};
+
+struct TallySettings {
+  int n_theta = 90;
+  int n_phi = 180;
+  ThetaBinning theta_bins = ThetaBinning::Uniform;
+  int lobes = 4;
+
+  friend bool operator==(const TallySettings&, const TallySettings&) = default;
+};
+
+struct Settings {
+  std::uint64_t photons = 1000000;  // per incident configuration
+  std::uint64_t seed = 1;
+  std::string output = "out.h5";
+  FiberSettings fiber;
+  RoughnessSettings roughness;
+  SourceSettings source;
+  TallySettings tally;
+  int max_segments = 1000;
+  int max_events_per_point = 1000;  // consistency-rule bound (SPEC section 5)
+  Polarization polarization = Polarization::Scalar;
+
+  // The incident configurations: every theta_i combined with every phi_i
+  // (theta-major order). phi_i is NaN when uniform.
+  struct Incidence {
+    double theta_i, phi_i;
+  };
+  std::vector<Incidence> incidences() const;
+
+  // Field-by-field equality (exact doubles): to_yaml -> parse_settings_yaml
+  // gives back an equal Settings.
+  friend bool operator==(const Settings&, const Settings&) = default;
+};
+
+// Parses a YAML config. `origin` names the source in error messages (a file
+// path). Throws fiberlab::Error with one line naming the field, the value and
+// the allowed range.
+Settings parse_settings_yaml(const std::string& yaml_text, const std::string& origin);
+Settings load_settings(const std::string& path);
+
+// A command-line integer (--photons, --seed, --threads) read by the config's
+// rules: 100000 or an exactly integral 1e5; not -1, 1.5, nan or anything
+// outside [lo, hi]. Throws fiberlab::Error: "command line: --photons = -1 is
+// out of range (must be an integer >= 1)".
+std::uint64_t parse_integer_flag(const std::string& flag, const std::string& text,
+                                 std::uint64_t lo, std::uint64_t hi);
+
+// The resolved configuration as YAML (degrees, every key explicit): stored in
+// result files as `config_yaml` and parseable again by parse_settings_yaml.
+std::string to_yaml(const Settings& s);
+
+// Derived sigma_a from melanin concentrations, d'Eon 2011 section 6.1.
+std::vector<double> sigma_a_from_melanin(double eumelanin, double pheomelanin);
+
+std::string to_string(RoughnessModel m);
+std::string to_string(Masking m);
+std::string to_string(Polarization p);
+
+}  // namespace fiberlab::sim

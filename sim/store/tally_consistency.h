@@ -1,0 +1,23 @@
+#pragma once
+// The identities every exact tally satisfies, whatever photons, threads,
+// ranks, checkpoints or merges made it (sim/store/tally.h, SPEC section 4), used
+// to refuse a file whose sums were damaged or edited:
+//  - the ledger balances exactly: for every channel,
+//    sum over lobes of exited + absorbed + truncated + lost = photons x 2^60;
+//  - each lobe's exited is the exact sum of its bins' S1 (Tally::exact_ledger);
+//  - no bin counts more photons than were launched, nor do all bins together
+//    (a photon exits at most once);
+//  - each exit weighs at most 1 (2^60 in fixed point) and w^2 <= w, so a
+//    bin's S1 <= count x 2^60 and S2 <= S1 for every channel.
+#include <string>
+
+#include "sim/store/exact_tally.h"
+
+namespace fiberlab::sim {
+
+// "" when `t` satisfies every identity above; otherwise the first one that
+// fails, in words naming the lobe, bin or channel (for an error line that
+// names the file and direction).
+std::string tally_inconsistency(const ExactTally& t);
+
+}  // namespace fiberlab::sim
