@@ -36,24 +36,24 @@
 #include <memory>
 #include <vector>
 
+#include "analytic/azimuthal_lobes.h"
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model.h"
 
 namespace fiberlab::analytic {
 
 namespace deon2011 {
 
-// log I0(x), x >= 0: power series below 30, the asymptotic expansion
-// e^x / sqrt(2 pi x) (1 + 1/(8x) + 9/(2 (8x)^2) + ...) above (relative error
-// < 1e-15 of I0 everywhere; the asymptotic terms shrink until k ~ 2x).
-double log_I0(double x);
-// log csch(x) for x > 0: log 2 - x - log1p(-exp(-2x)).
-double log_csch(double x);
-// Eq. 7: log M_p(v, theta_i, theta_r) =
+// Eq. 7, M_p and its parts (longitudinal_lobes.h): log M_p(v, theta_i, theta_r) =
 //   log csch(1/v) - log(2v) - sin(theta_i) sin(theta_r)/v + log I0(cos(theta_i) cos(theta_r)/v).
-double log_M_p(double v, double theta_i, double theta_r);
-double M_p(double v, double theta_i, double theta_r);
-// Eq. 11: the Gaussian detector, unit-integral over one period.
-double D_p(double beta, double phi);
+using longitudinal::log_csch;
+using longitudinal::log_I0;
+inline double log_M_p(double v, double theta_i, double theta_r) {
+  return longitudinal::vmf_log_M_p(v, theta_i, theta_r);
+}
+inline double M_p(double v, double theta_i, double theta_r) { return longitudinal::vmf_M_p(v, theta_i, theta_r); }
+// Eq. 11: the Gaussian detector, unit-integral over one period (azimuthal_lobes.h).
+inline double D_p(double beta, double phi) { return azimuthal::wrapped_gaussian(beta, phi); }
 // Eq. 10 by Gauss-Legendre of `order` points over h (paper: 35), per channel.
 // r_half_angle: the R order uses Eq. 12 with the exit direction given by
 // (theta_i, theta_r, phi) (theta_d = (theta_r - theta_i) / 2).

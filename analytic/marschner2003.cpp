@@ -68,19 +68,6 @@ double at_p(const std::vector<T>& v, int p, const char* name) {
 
 }  // namespace
 
-// ---- M (section 5.1) ---------------------------------------------------------
-
-double g(double beta, double x) {
-  return std::exp(-0.5 * (x / beta) * (x / beta)) / (std::sqrt(kTwoPi) * beta);
-}
-
-double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bool two_theta_h) {
-  const double theta_h = 0.5 * (theta_i + theta_r);
-  // Marschner's alpha_p shifts theta_h, half of the theta_r shift (SPEC s7).
-  if (two_theta_h) return g(beta, 2.0 * theta_h - alpha_theta_r);  // Zinke & Weber
-  return g(beta, theta_h - 0.5 * alpha_theta_r);                     // as published
-}
-
 // ---- Appendix B ---------------------------------------------------------------
 
 double eta_prime(double eta, double theta) { return cylinder::eta_prime(eta, theta); }
