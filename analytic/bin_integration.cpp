@@ -215,7 +215,7 @@ void GaussianFourierBins::add(const FourierSums& sums, int n_max, double beta, d
                               std::vector<double>& nb) {
   const double dphi = kTwoPi / np;
   // F_n = sum over nodes of mass e^{-i n Phi}, real and imaginary parts apart
-  // (plain arithmetic: std::complex's NaN-checking products are 3x slower).
+  // (plain arithmetic: std::complex's products check for NaN on every call).
   f_re_.assign(static_cast<std::size_t>(n_max + 1) * C, 0.0);
   f_im_.assign(f_re_.size(), 0.0);
   // tail[n] = sum_{n' > n} g_n' min(dphi, 2 / n'): the truncation bound.

@@ -86,7 +86,7 @@ class Deon2011 : public Model {
   // min(4 beta_p, 1). The Fourier series stops, per order p, at the term
   // beyond which the rest provably changes no bin by more than 1e-13 (the
   // order's energy times the tail of the coefficients, see FourierSums in
-  // the .cpp). The R lobe's azimuthal shape under Eq. 12,
+  // bin_integration.h). The R lobe's azimuthal shape under Eq. 12,
   // G_0 = D_0 * |cos(psi/2)| / 4, is its closed Fourier series (beta >= 0.005
   // rad; truncated where the terms are below 1e-17) or a quadrature below.
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
@@ -102,10 +102,8 @@ class Deon2011 : public Model {
   // Zero roughness reproduces the exact smooth cylinder bin for bin.
   // Tested against a slow direct evaluation of Eqs. 7 and 10-12 at 64 bins
   // of the four lobes (beta_azim 5 and 2 deg): within 1e-11 absolute.
-  // Speed (docs/PERFORMANCE.md): ~20 ms per incidence on 90 x 180 bins x 4
-  // lobes x 3 channels with beta_azim = 5 deg (Fourier deposit); narrower
-  // detectors (erfc deposit: beta_azim below ~3.9 deg at 180 phi bins) and
-  // white fibers (many orders) take 0.1 s to a few s.
+  // Its cost grows for narrow detectors (the erfc deposit) and for white
+  // fibers (many orders): docs/PERFORMANCE.md.
   //
   // Multiplies every node density of bin_probabilities() (Chebyshev nodes,
   // h panels, M panels) by `factor`, to measure convergence (tests).
