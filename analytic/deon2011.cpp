@@ -61,29 +61,12 @@ constexpr double kResidualTol = 1e-6;  // energy left to the uniform residual
 // terms left out (see FourierSums, bin_integration.h).
 constexpr double kFourierTol = 1e-13;
 
-// Energy of every order p > P per channel, (1/2) int sum_{p>P} A dh, by
-// 64-point Gauss-Legendre over gamma_i (the closed-form sum is smooth in gamma).
-void residual_energy(const cylinder::Attenuation& att, int P, std::vector<double>& out) {
-  const int C = att.channels();
-  out.assign(C, 0.0);
-  const GaussLegendre& gl = gauss_legendre(64);
-  std::vector<double> buf(C);
-  for (int q = 0; q < 64; ++q) {
-    const double g = 0.5 * kPi * gl.x[q];
-    att.A_beyond(P, g, buf.data());
-    for (int c = 0; c < C; ++c) out[c] += 0.25 * kPi * gl.w[q] * std::cos(g) * buf[c];
-  }
-}
-
-// The first order P >= p_first after which the energy left, judged at exit
-// inclination theta_r, is below kResidualTol in every channel, or max_order.
+// The last order traced explicitly when judged at exit inclination theta_r
+// (cylinder::last_order with kResidualTol).
 int last_explicit_order(const ModelParams& params, double theta_i, double theta_r, int p_first, int max_order) {
   std::vector<double> res;
   const cylinder::Attenuation att(params.eta, 0.5 * (theta_r - theta_i), params.sigma_a, params.absorption);
-  for (int P = p_first;; ++P) {
-    residual_energy(att, P, res);
-    if (*std::max_element(res.begin(), res.end()) <= kResidualTol || P >= max_order) return P;
-  }
+  return cylinder::last_order(att, p_first, kResidualTol, max_order, res);
 }
 
 // One group of orders sharing M_p and the detector: a single p, or (open)
@@ -216,7 +199,7 @@ class AzimuthalBins {
     if (n_fourier > 0)
       fourier_bins_.add(fourier_, n_fourier, t.beta, kFourierTol / (refine_ * refine_), np_, C_, nb);
     if (t.residual) {
-      residual_energy(att, t.p1, res_);
+      cylinder::energy_beyond(att, t.p1, res_);
       for (int j = 0; j < np_; ++j)
         for (int c = 0; c < C_; ++c) nb[static_cast<std::size_t>(j) * C_ + c] += res_[c] / np_;
     }
@@ -362,10 +345,7 @@ void Deon2011::density(int lobe, double theta_i, double, double theta_r, double 
   if (lobe >= L - 1) {
     const cylinder::Attenuation att(params_.eta, 0.5 * (theta_rn - theta_i), params_.sigma_a,
                                     params_.absorption);
-    for (p_end = lobe;; ++p_end) {
-      residual_energy(att, p_end, res);
-      if (*std::max_element(res.begin(), res.end()) <= kResidualTol || p_end >= max_order_) break;
-    }
+    p_end = cylinder::last_order(att, lobe, kResidualTol, max_order_, res);
   }
   std::vector<double> n;
   for (int p = lobe; p <= p_end; ++p) {
