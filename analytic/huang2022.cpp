@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "analytic/deon2011.h"
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
 #include "analytic/physical_defaults.h"
@@ -428,7 +428,7 @@ std::vector<double> residual_theta_masses(const BinGrid& grid, double theta_i, d
     for (int k = 0; k < panels; ++k)
       for (std::size_t q = 0; q < gl.x.size(); ++q) {
         const double t = a + h * (k + 0.5 * (1.0 + gl.x[q]));
-        mass[i] += 0.5 * h * gl.w[q] * std::exp(deon2011::log_M_p(v, theta_i, t)) * std::cos(t);
+        mass[i] += 0.5 * h * gl.w[q] * std::exp(longitudinal::vmf_log_M_p(v, theta_i, t)) * std::cos(t);
       }
   }
   return mass;
@@ -618,7 +618,7 @@ void Huang2022::density(int lobe, double theta_i, double phi_i, double theta_r, 
       HuangEnergies e;
       EnergySink sink(paths, e);
       integrate(paths, density_points_, sink);
-      const double m = std::exp(deon2011::log_M_p(4.0 * q.roughness, theta_i, theta_r)) / kTwoPi;
+      const double m = std::exp(longitudinal::vmf_log_M_p(4.0 * q.roughness, theta_i, theta_r)) / kTwoPi;
       for (int c = 0; c < C; ++c) s[c] = e.lobe[static_cast<std::size_t>(lobe) * C + c] * m;
     }
     const double scale = paths.scale(p) * std::cos(theta_r);
