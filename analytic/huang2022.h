@@ -91,7 +91,9 @@
 //   drops it where the second interface's reflection leaves on the wrong side
 //   and the exit direction lies in that reflection's refraction cone; here
 //   it is kept for every exit direction (an over-count of that cone's share
-//   of such paths). Only the residual: Cycles' eval()'s TT and TRT (its inner
+//   of such paths); where the second interface's mesonormal faces away from
+//   the arriving light (tilted fibers only) Cycles still samples a normal,
+//   here the path ends without a residual. Only the residual: Cycles' eval()'s TT and TRT (its inner
 //   mesonormal cosine ratios, its TT without the exit-side test) are not
 //   variants here.
 // - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
