@@ -240,7 +240,10 @@ class Paths {
  public:
   Paths(const Huang2022Params& p, double theta_i, double phi_i)
       : p_(p), fiber_(p.eccentricity, p.tilt), surface_(p.roughness, p.masking),
-        wi_(direction_from_angles(theta_i, phi_i)), C_(static_cast<int>(p.sigma_a.size())) {}
+        wi_(direction_from_angles(theta_i, phi_i)), cycles_residual_(p.residual == HuangResidual::CyclesEval),
+        cos_i_(std::cos(theta_i)),
+        cycles_width_(fiber_.projected_width(wi_.y(), wi_.z()) * std::sqrt(p.eccentricity)),
+        C_(static_cast<int>(p.sigma_a.size())) {}
 
   const Fiber& fiber() const { return fiber_; }
   const Surface& surface() const { return surface_; }
@@ -274,8 +277,12 @@ class Paths {
     // T: into the fiber.
     Vec3 t;
     if (!refract(d0, m, p_.eta, t)) return;
+    // Cycles' eval() residual: this point's share of its arc integral,
+    // (2 / pi) dgamma / (cos theta_i W), W the projected width with the
+    // major axis 1 (Cycles' 2r), dgamma = pi base.
+    const Entry entry{1.0 - F, 2.0 * base / (cos_i_ * cycles_width_)};
     branch(0, d0, t, h, -1, 1.0 - F, w, sink, [&](const Vec3& dt, const double* wt) {
-      inside(pt, 1, h, dt, wt, sink, nullptr, 1.0);
+      inside(pt, 1, h, dt, wt, sink, nullptr, 1.0, entry);
     });
   }
 
@@ -306,11 +313,17 @@ class Paths {
     if (prob > 0.0) next(o, wo.c);
   }
 
+  // What Cycles' eval() residual takes from the entry: the Fresnel
+  // transmittance T1 and the point's weight in its arc integral.
+  struct Entry {
+    double t1, weight;
+  };
+
   // Segment k (1 or 2) from `from` along d with weight w, then the event at
   // its end. For k = 2: a1 the first segment's transmittance, t2 the Fresnel
   // transmittance of interface 2 (both for the residual).
   void inside(const Point& pt, int k, const Hit& from, const Vec3& d, const double* w, Sink& sink,
-              const Weights* a1, double t2) const {
+              const Weights* a1, double t2, const Entry& entry) const {
     Hit h;
     double len;
     Weights wa, a;
@@ -336,10 +349,17 @@ class Paths {
     // Internal reflection: order k + 1 and beyond.
     const Vec3 r = reflect(d, m);
     if (k == 1) {
+      if (cycles_residual_) cycles_eval_residual(pt, entry, F, a, sink);
       branch(1, d, r, h, +1, F, wa, sink, [&](const Vec3& dr, const double* wr) {
-        inside(pt, 2, h, dr, wr, sink, &a, 1.0 - F);
+        inside(pt, 2, h, dr, wr, sink, &a, 1.0 - F, entry);
       });
       return;
+    }
+    if (cycles_residual_) {
+      // The TRT path's reflection here carries no residual in this form.
+      Weights gone;
+      for (int c = 0; c < C_; ++c) gone.c[c] = wa.c[c] * F;
+      return sink.lost(false, gone.c);
     }
     // k == 2: Cycles' residual for every p >= 3 from the weight reflected
     // here: the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)).
@@ -354,10 +374,32 @@ class Paths {
     });
   }
 
+  // Cycles' eval() residual (bsdf_hair_huang_eval_trrt): at the second
+  // interface, with R2 its Fresnel reflectance at the sampled normal and A
+  // the first chord's transmittance, T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)),
+  // T_avg = max(1 - R2, 1e-5), weighted by the point's share of the arc
+  // integral (Entry), without masking or the light's flux onto the arc.
+  // Cycles drops it where the reflection at this interface leaves on the
+  // wrong side (and the exit direction lies inside that reflected
+  // direction's refraction cone); here it is kept for every exit direction.
+  // None when the TRT factor is 0 (Cycles evaluates it in the TRT branch).
+  void cycles_eval_residual(const Point& pt, const Entry& entry, double r2, const Weights& a, Sink& sink) const {
+    if (!(for_lobe(p_.lobe_scale, 2) > 0.0)) return;
+    const double t_avg = std::max(1.0 - r2, 1e-5);
+    Weights e;
+    for (int c = 0; c < C_; ++c) {
+      const double A = a.c[c];
+      e.c[c] = entry.weight * entry.t1 * r2 * r2 * t_avg * A * A * A / (1.0 - A * (1.0 - t_avg));
+    }
+    sink.residual(e.c, pt.u[7], pt.u[8]);
+  }
+
   const Huang2022Params& p_;
   Fiber fiber_;
   Surface surface_;
   Vec3 wi_;
+  bool cycles_residual_;
+  double cos_i_, cycles_width_;
   int C_;
 };
 
@@ -640,6 +682,7 @@ std::unique_ptr<Model> make_huang2022(const ModelParams& mp) {
   p.lobe_scale = mp.lobe_scale;
   p.masking = static_cast<HuangMasking>(mp.huang_masking);
   p.mesonormal_flux = mp.mesonormal_flux;
+  p.residual = static_cast<HuangResidual>(mp.huang_residual);
   p.lobes = mp.lobes;
   p.quadrature_points = static_cast<long>(mp.quadrature_points);
   return std::make_unique<Huang2022>(p);
@@ -651,9 +694,14 @@ std::vector<std::string> huang_approximations(const ModelParams& p) {
   std::vector<std::string> a = {
       "far field: Cycles' wi read as our wi (the light); S normalised by the light's projected width",
       "TT, TRT: the paper's sampled microfacet normals as a fixed Halton point set (deterministic quadrature)",
-      "p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, uniform "
-      "in phi), not Cycles' eval()'s",
       "no GGX glass albedo correction (Cycles' energy_scale table)"};
+  if (p.huang_residual == static_cast<int>(HuangResidual::CyclesEval))
+    a.push_back("p >= 3: the residual of Cycles' eval() (T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second "
+                "interface, uniform over the arc angle; kept for every exit direction where Cycles drops it inside a "
+                "refraction cone when the second reflection leaves its side), M_p with v = 4 alpha, uniform in phi");
+  else
+    a.push_back("p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, "
+                "uniform in phi), not Cycles' eval()'s");
   if (p.mesonormal_flux)
     a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
         "also rescales at the inner interfaces, not done here)");
@@ -697,6 +745,12 @@ ModelInfo huang2022_info() {
       "mesonormal", {"mesonormal", "macro"},
       [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
       [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });
+  ParamSpec residual = choice_param(
+      "residual",
+      "p >= 3: sampler (Cycles' sampler: the series from the TRT path's third interface) or cycles_eval (Cycles' "
+      "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
+      "sampler", {"sampler", "cycles_eval"},
+      [](ModelParams& p, int i) { p.huang_residual = i; }, [](const ModelParams& p) { return p.huang_residual; });
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
                                   "integer", "4194304", "an integer in [1024, 1073741824]",
                                   &ModelParams::quadrature_points, [](double x) {
@@ -705,7 +759,7 @@ ModelInfo huang2022_info() {
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param(),   sigma_a_param(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
               ecc,           scale,           masking,
-              flux,          lobes_param(),   points};
+              flux,          residual,        lobes_param(),   points};
   m.make = [](const ModelParams& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
   m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
