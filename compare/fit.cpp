@@ -55,8 +55,10 @@ const analytic::ParamSpec* spec_of(const std::string& model_name, const Key& k) 
       if (!s.whole_fit_key.empty() && s.whole_fit_key == k.name) return &s;
   return analytic::find_param(table, k.name);
 }
-bool is_list(const analytic::ParamSpec& spec) { return spec.get_entry && spec.set_entry; }
-bool is_scalar(const analytic::ParamSpec& spec) { return spec.get_number && spec.set_number; }
+// A fit moves real numbers: integers (lobes, quadrature_points) and choices stay as set.
+bool is_real(const analytic::ParamSpec& spec) { return spec.unit != "integer" && spec.unit != "choice"; }
+bool is_list(const analytic::ParamSpec& spec) { return spec.get_entry && spec.set_entry && is_real(spec); }
+bool is_scalar(const analytic::ParamSpec& spec) { return spec.get_number && spec.set_number && is_real(spec); }
 // The key a fit gives the spec's whole value.
 const std::string& whole_key(const analytic::ParamSpec& spec) {
   return spec.whole_fit_key.empty() ? spec.key : spec.whole_fit_key;
@@ -70,12 +72,14 @@ const analytic::ParamSpec& fit_spec(const std::string& model_name, const std::st
   const bool ok = spec && (k.index < 0 ? (is_scalar(*spec) || (is_list(*spec) && whole_key(*spec) == k.name))
                                        : is_list(*spec) && k.name == spec->key);
   if (ok) return *spec;
-  std::string fittable;
+  // The numeric keys in table order (a list also per entry, NAME[p]), then
+  // the lists' whole fit keys.
+  std::string fittable, whole;
   for (const analytic::ParamSpec& s : analytic::model_info(model_name).params) {
-    if (is_scalar(s) || (is_list(s) && s.whole_fit_key.empty()))
-      fittable += (fittable.empty() ? "" : ", ") + s.key;
-    if (is_list(s) && !s.whole_fit_key.empty()) fittable += (fittable.empty() ? "" : ", ") + s.whole_fit_key;
+    if (is_scalar(s) || is_list(s)) fittable += (fittable.empty() ? "" : ", ") + s.key;
+    if (is_list(s) && !s.whole_fit_key.empty()) whole += ", " + s.whole_fit_key;
   }
+  fittable += whole;
   if (spec && is_list(*spec) && k.index < 0 && k.name == spec->key)
     throw Error(fmt::format("--fit {}: one common shift for every lobe moves R the wrong way; fit "
                             "{}[p] per lobe (e.g. {}[0],{}[1]) or the physical {}",
