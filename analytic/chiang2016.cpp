@@ -389,7 +389,7 @@ ModelInfo chiang2016_info() {
               lobes_param()};
   m.make = [](const ModelParams& p) { return make_chiang2016(p); };
   m.approximations = chiang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     if (f.eccentricity != 1.0)
       throw Error(fmt::format("model chiang2016: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));
@@ -397,7 +397,7 @@ ModelInfo chiang2016_info() {
     p.scale_tilt = f.scale_tilt;
     // Widths as for d'Eon's M_p (the same function), then through the
     // inverse mappings: an approximate width match; smooth gives 0 exactly.
-    apply_fiber_roughness(f, p, deon2011_width_calibration());
+    apply_fiber_roughness(f, p, deon2011_width_calibration(), mapping);
     p.beta_m = chiang2016::beta_m_for_width(for_lobe(p.beta_long, 0));
     p.beta_n = chiang2016::beta_n_for_scale(for_lobe(p.beta_azim, 0) * std::sqrt(3.0) / kPi);
   };

@@ -483,12 +483,12 @@ ModelInfo deon2011_info() {
   };
   m.make = make_deon2011;
   m.approximations = deon_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     if (f.eccentricity != 1.0)
       throw Error(fmt::format("model deon2011: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));
     apply_fiber_basics(f, p);
-    apply_fiber_roughness(f, p, deon2011_width_calibration());
+    apply_fiber_roughness(f, p, deon2011_width_calibration(), mapping);
   };
   return m;
 }

@@ -710,6 +710,52 @@ std::vector<std::string> huang_approximations(const ModelParams& p) {
   return a;
 }
 
+// The GGX alpha of a simulated fiber (ModelInfo::from_fiber). The model's
+// facets are isotropic GGX with alpha in [0, 1]: a fiber it cannot represent
+// is refused, naming the field and what is allowed; an approximate rule is
+// noted in `mapping`.
+double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
+  auto refuse = [&](const std::string& why) -> double {
+    throw Error(fmt::format("model huang2022: roughness: {}; huang2022 allows a smooth or isotropic ggx fiber "
+                            "(alpha in [0, 1]), or --set roughness=A",
+                            why));
+  };
+  double alpha = 0.0;
+  switch (f.roughness) {
+    case PhysicalFiber::Roughness::Smooth: return 0.0;
+    case PhysicalFiber::Roughness::ExitBlur: return refuse("an exit_blur fiber has no microfacets");
+    case PhysicalFiber::Roughness::GGX:
+    case PhysicalFiber::Roughness::Beckmann:
+      if (f.alpha_long != f.alpha_azim)
+        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+      alpha = f.alpha_long;
+      if (f.roughness == PhysicalFiber::Roughness::Beckmann)
+        // Beckmann and GGX of the same alpha have the same density at the
+        // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
+        mapping.notes.push_back(fmt::format(
+            "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
+            "tails differ)",
+            f.roughness_text()));
+      break;
+    case PhysicalFiber::Roughness::Gaussian: {
+      const double bl = for_lobe(f.beta_long, 0), ba = f.beta_azim.empty() ? bl : for_lobe(f.beta_azim, 0);
+      if (bl != ba)
+        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+      // Equal density at the mean normal: a Gaussian tilt of sd beta per
+      // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+      alpha = std::sqrt(2.0) * std::tan(bl);
+      mapping.notes.push_back(fmt::format(
+          "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
+          "normal)",
+          f.roughness_text(), alpha));
+      break;
+    }
+  }
+  if (!(alpha >= 0.0 && alpha <= 1.0))
+    return refuse(fmt::format("{} gives alpha = {:g}, outside [0, 1]", f.roughness_text(), alpha));
+  return alpha;
+}
+
 }  // namespace
 
 ModelInfo huang2022_info() {
@@ -721,7 +767,9 @@ ModelInfo huang2022_info() {
   ParamSpec roughness = number_param("roughness", "GGX microfacet roughness alpha about the mesonormal (0: smooth)",
                                      "", "0.3", "a number in [0, 1]", &ModelParams::ggx_roughness,
                                      [](double x) { return x >= 0.0 && x <= 1.0; });
-  roughness.from_fiber = "roughness (smooth: 0; gaussian: sqrt(2) tan(beta_long), approximate)";
+  roughness.from_fiber =
+      "roughness (smooth: 0; ggx: alpha; beckmann: alpha, approximate; gaussian: sqrt(2) tan(beta), approximate; "
+      "an anisotropic fiber or exit_blur is refused unless --set roughness)";
   ParamSpec tilt = number_param("tilt",
                                 "cuticle scale tilt of the mesonormal, > 0 towards the root as fiber.scale_tilt "
                                 "(Cycles' Huang Tilt)",
@@ -762,20 +810,11 @@ ModelInfo huang2022_info() {
               flux,          residual,        lobes_param(),   points};
   m.make = [](const ModelParams& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     apply_fiber_basics(f, p);
     p.eccentricity = f.eccentricity;
     p.scale_tilt = f.scale_tilt;
-    switch (f.roughness) {
-      case PhysicalFiber::Roughness::Smooth: p.ggx_roughness = 0.0; break;
-      case PhysicalFiber::Roughness::Gaussian:
-        // Equal density at the mean normal: a Gaussian tilt of sd beta per
-        // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
-        p.ggx_roughness = std::min(1.0, std::sqrt(2.0) * std::tan(for_lobe(f.beta_long, 0)));
-        break;
-      case PhysicalFiber::Roughness::ExitBlur:
-        throw Error("model huang2022: an exit_blur fiber has no microfacets; set --set roughness=A");
-    }
+    if (!mapping.user_sets("roughness")) p.ggx_roughness = huang_roughness(f, mapping);
   };
   return m;
 }

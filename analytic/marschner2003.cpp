@@ -917,10 +917,10 @@ ModelInfo marschner2003_info() {
   };
   m.make = make_marschner2003;
   m.approximations = marschner_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     apply_fiber_basics(f, p);
     p.eccentricity = f.eccentricity;
-    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), kMinMarschnerBeta);
+    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), mapping, kMinMarschnerBeta);
   };
   return m;
 }

@@ -172,7 +172,7 @@ ModelInfo exact_info() {
   m.params = {eta_param(), sigma_a_param(), absorption_param("chord"), lobes_param()};
   m.make = make_smooth_cylinder;
   m.approximations = exact_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping&) {
     if (f.eccentricity != 1.0)
       throw Error(fmt::format("model exact: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));

@@ -61,10 +61,11 @@ struct Predicted {
 };
 
 Predicted predicted_by_model(const sim::ResultFile& result, const compare::ModelSpec& spec,
-                             const analytic::ModelParams& params) {
+                             const analytic::ModelParams& params,
+                             const std::vector<std::string>& fiber_notes = {}) {
   Predicted p;
   p.label = spec.label;
-  p.header = compare::model_header(spec, params);
+  p.header = compare::model_header(spec, params, fiber_notes);
   p.bins = compare::predict_result(*compare::make_model(spec.name, params), result);
   p.alpha = params.alpha;
   return p;
@@ -133,9 +134,10 @@ void compare_command(const CompareOptions& o) {
     throw Error(fmt::format("--channel {} out of range (the result has {} channels)", o.channel, result.channels));
   compare::ModelSpec spec;
   analytic::ModelParams params;
+  std::vector<std::string> fiber_notes;
   if (!from_file) {
     spec = compare::parse_model_spec(o.model);
-    params = compare::params_for(result.settings, spec, o.settings);
+    params = compare::params_for(result.settings, spec, o.settings, &fiber_notes);
     analytic::make_model(spec.name, params);  // the model's own checks, before any output
     compare::check_fit_keys(spec.name, split_commas(o.fit));
   }
@@ -148,7 +150,7 @@ void compare_command(const CompareOptions& o) {
   const auto t0 = std::chrono::steady_clock::now();
   fmt::print("{}: {} incident direction(s), {} lobes, {} channel(s), {} x {} bins\n", o.result,
              result.configs(), result.lobes, result.channels, result.grid.n_theta(), result.grid.n_phi());
-  Predicted current = from_file ? pred : predicted_by_model(result, spec, params);
+  Predicted current = from_file ? pred : predicted_by_model(result, spec, params, fiber_notes);
   fmt::print("{}", current.header);
   compare::Verdict v = compare::judge(compare::compare(result, current.bins, current.alpha, copt), max_chi2);
   fmt::print("{}", compare::verdict_table(v, result.lobes));

@@ -28,9 +28,10 @@ struct PredictOptions {
 void predict(const PredictOptions& o) {
   const sim::Settings s = sim::load_settings_or_result(o.input);
   const compare::ModelSpec spec = compare::parse_model_spec(o.model);
-  const analytic::ModelParams params = compare::params_for(s, spec, o.settings);
+  std::vector<std::string> fiber_notes;
+  const analytic::ModelParams params = compare::params_for(s, spec, o.settings, &fiber_notes);
   const std::unique_ptr<analytic::Model> model = analytic::make_model(spec.name, params);
-  fmt::print("{}", compare::model_header(spec, params));
+  fmt::print("{}", compare::model_header(spec, params, fiber_notes));
 
   compare::PredictionFile pred;
   pred.model = spec.name;
