@@ -34,12 +34,7 @@ void apply_run_flags(const RunRequest& o, sim::Settings& settings) {
     check_output_name(o.output);
     settings.output = o.output;
   }
-  // photons x incident configurations must fit in uint64 (sim/run/settings.cpp
-  // checks the config; a flag can raise photons past it).
-  const std::uint64_t k = settings.incidences().size();
-  if (settings.photons > kU64Max / k)
-    throw Error(fmt::format("command line: --photons = {} x {} incident configurations exceeds "
-                            "2^64 - 1 photons in total", settings.photons, k));
+  check_total_photons(settings, "command line: --photons");
 }
 
 // --threads: 1 to sim::kMaxThreads; absent means every core.
@@ -194,6 +189,14 @@ RunReport run(const sim::ProcessGroup& group, const RunRequest& o,
     report.failed_elsewhere = true;  // rank 0 reports
   }
   return report;
+}
+
+void check_total_photons(const sim::Settings& settings, const std::string& what) {
+  constexpr std::uint64_t kU64Max = ~std::uint64_t{0};
+  const std::uint64_t k = settings.incidences().size();
+  if (settings.photons > kU64Max / k)
+    throw Error(fmt::format("{} = {} x {} incident configurations exceeds 2^64 - 1 photons in total", what,
+                            settings.photons, k));
 }
 
 std::optional<sim::ResultFile> simulate(const sim::Settings& settings, int threads,

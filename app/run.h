@@ -46,6 +46,11 @@ struct RunReport {
 RunReport run(const sim::ProcessGroup& group, const RunRequest& request,
               const std::function<sim::ProgressCallback()>& progress = {});
 
+// photons x incident configurations must fit in uint64 (sim/run/settings.cpp
+// checks a config; a --photons flag or fiberlab.run's photons can raise
+// photons past it): otherwise fiberlab::Error, `what` naming the override.
+void check_total_photons(const sim::Settings& settings, const std::string& what);
+
 // One process's in-memory run of `settings` on `threads` threads (after the
 // memory budget, sim/run/memory_budget.h). No result when a signal stopped it.
 std::optional<sim::ResultFile> simulate(const sim::Settings& settings, int threads,

@@ -76,6 +76,7 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
                                      std::optional<std::uint64_t> seed, int threads, py::object progress) {
   if (photons) settings.photons = *photons;
   if (seed) settings.seed = *seed;
+  app::check_total_photons(settings, "photons");
   threads = app::run_threads(threads);
   ProgressRelay relay(std::move(progress));
   std::shared_ptr<sim::ResultFile> result;
