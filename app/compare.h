@@ -3,6 +3,7 @@
 // fiber of a result, where, and by how much? The statistics:
 // compare/comparison.h; the rule: compare/verdict.h; the prediction format:
 // compare/prediction_file.h; the fit: app/fit.h.
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
