@@ -195,7 +195,7 @@ class Result:
                                       ", ".join(str(int(n)) for n in np.unique(self.photons))))
 
 
-MAX_THREADS = 1024  # sim/run/memory_budget.h kMaxThreads, the cap of `fiberlab run --threads`
+MAX_THREADS = _fiberlab.max_threads  # sim/run/memory_budget.h kMaxThreads, the cap of `fiberlab run --threads`
 
 
 def run(config, photons=None, seed=None, threads=None, progress=True):

@@ -129,8 +129,8 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
 // One internal segment for the photons about to cross the fiber (SPEC
 // sections 2 and 4). A photon that did not leave at the boundary ending its
 // last allowed segment is truncated (SPEC section 5), and so is one running
-// exactly along the axis (guided for ever). Always inline: GCC left it out
-// of line, passing the state through memory (bench_sim b +10%, c +6% inline).
+// exactly along the axis (guided for ever). Always inline: out of line, GCC
+// passes the state through memory (bench/bench_sim.cpp shows the cost).
 template <class T, class Light>
 [[gnu::always_inline]] inline void travel(const LifeConfig& c, PhotonState<T, Light>& s,
                                           const MaskOf<T>& live) {
