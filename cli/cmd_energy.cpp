@@ -21,6 +21,7 @@
 #include "analytic/model_registry.h"
 #include "cli/commands.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/result_layout.h"
 #include "common/units.h"
 #include "compare/comparison.h"
@@ -144,7 +145,7 @@ bool has_key(const std::string& name, const std::string& key_value) {
   return analytic::find_param(analytic::model_info(name).params, key) != nullptr;
 }
 
-std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
+std::string curve_json(const compare::EnergyCurve& e, int c, const std::vector<std::string>& lobe_names) {
   using compare::json_number;
   auto arr = [](const std::vector<double>& v) {
     std::string s;
@@ -162,7 +163,7 @@ std::string curve_json(const compare::EnergyCurve& e, int c, int lobes_shown) {
     }
     lobes += (l ? ", " : "") + arr(v);
     errors += (l ? ", " : "") + arr(err);
-    names += fmt::format("{}\"{}\"", l ? ", " : "", compare::lobe_name(l, lobes_shown));
+    names += fmt::format("{}\"{}\"", l ? ", " : "", lobe_names.at(l));
   }
   for (std::size_t k = 0; k < K; ++k) {
     th.push_back(rad_to_deg(e.theta_i[k]));
@@ -224,6 +225,8 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
       if (theta_i.empty() || theta_i.back() != inc.theta_i) theta_i.push_back(inc.theta_i);
   bool white = true;
   for (double s : settings.fiber.sigma_a) white = white && s == 0.0;
+  if (settings.fiber.medulla)
+    for (double s : settings.fiber.medulla->sigma_a) white = white && s == 0.0;
   const bool every_model = o.models.empty();
   const std::vector<std::string> model_specs = every_model ? analytic::model_names() : split_commas(o.models);
   // --set KEY=VALUE goes to every model whose table has KEY; a key no model has is an error.
@@ -288,12 +291,17 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
              white ? " (white: the furnace test applies, total should be 1)" : " (absorbing: no furnace test)",
              c);
   std::string csv = "source,beta_long_deg,theta_i_deg,channel";
+  // A fiber with a medulla: its lobe `scattered`, which no model has (docs/FUR.md).
+  if (settings.fiber.medulla)
+    for (auto& e : curves)
+      if (!e.simulated) compare::add_scattered_lobe(e);
   const int L = curves.front().lobes;
-  for (int l = 0; l < L; ++l) csv += fmt::format(",{0},{0}_error", compare::lobe_name(l, L));
+  const std::vector<std::string> names = lobe_names(L, settings.fiber.medulla.has_value());
+  for (int l = 0; l < L; ++l) csv += fmt::format(",{0},{0}_error", names[l]);
   csv += ",total,total_error,three_lobe,absorbed,truncated,lost,ledger,furnace_departure\n";
   for (std::size_t k = 0; k < theta_i.size(); ++k) {
     fmt::print("\ntheta_i = {:.2f} deg\n  {:<44}", rad_to_deg(theta_i[k]), "source");
-    for (int l = 0; l < L; ++l) fmt::print(" {:>9}", compare::lobe_name(l, L));
+    for (int l = 0; l < L; ++l) fmt::print(" {:>9}", names[l]);
     fmt::print(" {:>9} {:>9} {:>10}{}\n", "total", "R+TT+TRT", white ? "total-1" : "",
                simulated ? "  absorbed truncated      lost ledger" : "");
     for (const auto& e : curves) {
@@ -328,7 +336,7 @@ void energy_command(const EnergyOptions& o, bool photons_given) {
       const std::string& dir = folder.staging();
       compare::write_text(dir, "metrics.csv", csv);
       std::string js;
-      for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, L);
+      for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, names);
       compare::write_text(dir, "metrics.json",
                           fmt::format("{{\n  \"kind\": \"energy\",\n  \"input\": {},\n  \"simulated\": {},\n"
                                       "  \"white\": {},\n  \"channel\": {},\n  \"curves\": [{}\n  ]\n}}\n",
