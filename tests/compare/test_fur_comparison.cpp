@@ -32,6 +32,10 @@ TEST(FurAtlas, MedullaSweepMakesOneFiberPerEntry) {
   EXPECT_EQ(c.fibers[1].settings.fiber.medulla->g, 0.4);
   EXPECT_EQ(c.fibers[1].medulla_index, 1);
   EXPECT_NE(c.fibers[1].label.find("medulla k 0.5"), std::string::npos) << c.fibers[1].label;
+  const AtlasConfig shipped = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas_fur.yaml");
+  ASSERT_EQ(shipped.fibers.size(), 3u);
+  EXPECT_FALSE(shipped.fibers[0].settings.fiber.medulla.has_value());
+  EXPECT_EQ(shipped.fibers[2].settings.fiber.medulla->radius, 0.7);
   // Without the list: no medulla, labels as before.
   const AtlasConfig plain =
       parse_atlas_config("photons: 10\nsweep: {roughness: [{model: smooth}], theta_i: 30}\n", "t");

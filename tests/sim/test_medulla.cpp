@@ -25,6 +25,7 @@
 #include <random>
 
 #include "analytic/smooth_cylinder.h"
+#include "common/error.h"
 #include "sim/life/medulla.h"
 #include "tests/sim/sim_test_support.h"
 
@@ -262,6 +263,48 @@ TEST(MedullaVanishing, ThinMedullaChangesNothing) {
   }
 }
 
+// A visit to the medulla is bounded by max_segments events: a photon still
+// scattering after them is truncated (SPEC section 5's rule), never lost or
+// dropped, and the ledger still closes (white fiber: nothing absorbed).
+TEST(MedullaBound, EventsBeyondMaxSegmentsAreTruncated) {
+  Settings s = testing::smooth_circle(10.0, 50000);
+  s.tally.n_theta = 18;
+  s.tally.n_phi = 36;
+  s.max_segments = 3;
+  s.fiber.medulla = medulla(0.6, 200.0, {0.0}, 0.0, 1.55);
+  const ResultFile r = testing::run(s);
+  const double n = static_cast<double>(r.photons[0]);
+  EXPECT_GT(r.truncated[0], 0.3 * n);
+  EXPECT_EQ(r.lost[0], 0.0);
+  EXPECT_LT(std::abs(r.absorbed[0]), 1e-9 * n);
+}
+
+// Scattering turns the direction: on a smooth untilted circle every
+// unscattered photon leaves on the specular cone theta_r = -theta_i, while
+// isotropic scattering spreads the inclination (inside, sin theta is uniform
+// in [-1, 1] after a scattering, and only |sin theta| < 1/eta gets out
+// through a smooth boundary): well under half of `scattered` stays in the
+// 10-degree theta bin of the cone.
+TEST(MedullaScattering, ScatteredLightLeavesTheSpecularCone) {
+  Settings s = testing::smooth_circle(0.7, 100000);
+  s.tally.n_theta = 18;
+  s.tally.n_phi = 36;
+  s.fiber.medulla = medulla(0.6, 3.0, {0.0}, 0.0, 1.55);
+  const ResultFile r = testing::run(s);
+  const std::vector<double> theta = testing::theta_marginal(r, 0, 4, 0);
+  double total = 0.0;
+  for (double x : theta) total += x;
+  ASSERT_GT(total, 0.0);
+  const int cone = r.grid.theta_bin(deg_to_rad(-0.7));
+  std::printf("scattered in the specular theta bin: %.3f\n", theta[cone] / total);
+  EXPECT_LT(theta[cone] / total, 0.5);
+  // The unscattered lobes stay on the cone.
+  const std::vector<double> tt = testing::theta_marginal(r, 0, 1, 0);
+  double tt_total = 0.0;
+  for (double x : tt) tt_total += x;
+  EXPECT_EQ(tt[cone], tt_total);
+}
+
 TEST(MedullaThreads, BitIdenticalForAnyThreadCount) {
   Settings s = testing::smooth_circle(25.0, 60000);
   s.fiber.eccentricity = 0.8;
@@ -277,6 +320,44 @@ TEST(MedullaThreads, BitIdenticalForAnyThreadCount) {
   EXPECT_EQ(one.weight_sq_sum, three.weight_sq_sum);
   EXPECT_EQ(one.count, three.count);
   EXPECT_EQ(one.truncated, three.truncated);
+}
+
+// fiber.medulla in the config: defaults, the round trip through to_yaml
+// (the result file's config_yaml), and one-line errors naming the field.
+TEST(MedullaSettings, ParsedCheckedAndRoundTripped) {
+  const Settings s = parse_settings_yaml(
+      "fiber: {eta: 1.6, sigma_a: [0.1, 0.2], medulla: {radius: 0.4, sigma_s: 5}}\n", "m.yaml");
+  ASSERT_TRUE(s.fiber.medulla.has_value());
+  EXPECT_EQ(s.fiber.medulla->sigma_a, (std::vector<double>{0.0, 0.0}));
+  EXPECT_EQ(s.fiber.medulla->eta, 1.6);
+  EXPECT_EQ(s.fiber.medulla->g, 0.0);
+  EXPECT_EQ(s.tally_lobes(), s.tally.lobes + 1);
+  EXPECT_EQ(parse_settings_yaml(to_yaml(s), "again"), s) << to_yaml(s);
+  EXPECT_FALSE(parse_settings_yaml("{}\n", "plain").fiber.medulla.has_value());
+  auto error_of = [](const std::string& yaml) {
+    try {
+      parse_settings_yaml(yaml, "m.yaml");
+    } catch (const Error& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  const std::string f = "fiber: {sigma_a: [0.1, 0.2], medulla: ";
+  EXPECT_EQ(error_of(f + "{radius: 0, sigma_s: 1}}\n"),
+            "m.yaml: fiber.medulla.radius = 0 is out of range (must be in (0, 1): a fraction of the "
+            "fiber's semi-axes)");
+  EXPECT_NE(error_of(f + "{radius: 0.5}}\n").find("fiber.medulla.sigma_s is missing"), std::string::npos);
+  EXPECT_NE(error_of(f + "{radius: 0.5, sigma_s: .nan}}\n").find("fiber.medulla.sigma_s"), std::string::npos);
+  EXPECT_NE(error_of(f + "{radius: 0.5, sigma_s: 1, g: -1}}\n").find("fiber.medulla.g = -1 is out of range"),
+            std::string::npos);
+  EXPECT_NE(error_of(f + "{radius: 0.5, sigma_s: 1, sigma_a: [1, 2, 3]}}\n")
+                .find("must have the fiber's 2 channels"),
+            std::string::npos);
+  EXPECT_NE(error_of(f + "{radius: 0.5, sigma_s: 1, eta: 0.5}}\n").find("fiber.medulla.eta = 0.5"),
+            std::string::npos);
+  EXPECT_NE(error_of(f + "{radius: 0.5, sigma_s: 1}}\nroughness: {model: ggx, alpha: 0.2, masking: smith_g1}\n")
+                .find("fiber.medulla is not allowed with roughness.masking"),
+            std::string::npos);
 }
 
 // Henyey-Greenstein: P(cos <= mu) = (1 - g^2) / (2 g) ((1 + g^2 - 2 g mu)^(-1/2)
