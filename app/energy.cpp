@@ -14,6 +14,7 @@
 #include "app/run.h"
 #include "app/threads.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/interrupt.h"
 #include "common/result_layout.h"
 #include "common/units.h"
@@ -170,6 +171,8 @@ EnergyResult energy(const EnergyRequest& o) {
       if (theta_i.empty() || theta_i.back() != inc.theta_i) theta_i.push_back(inc.theta_i);
   bool white = true;
   for (double s : settings.fiber.sigma_a) white = white && s == 0.0;
+  if (settings.fiber.medulla)
+    for (double s : settings.fiber.medulla->sigma_a) white = white && s == 0.0;
   const bool every_model = o.models.empty();
   const std::vector<std::string> model_specs = every_model ? analytic::model_names() : split_commas(o.models);
   // --set KEY=VALUE goes to every model whose table has KEY; a key no model has is an error.
@@ -220,6 +223,10 @@ EnergyResult energy(const EnergyRequest& o) {
   }
   if (curves.empty()) throw Error(fmt::format("energy {}: no model applies to this fiber ({})", o.input,
                                               fmt::join(skipped, "; ")));
+  // A fiber with a medulla: its lobe `scattered`, which no model has (docs/FUR.md).
+  if (settings.fiber.medulla)
+    for (auto& e : curves)
+      if (!e.simulated) compare::add_scattered_lobe(e);
   const int C = curves.empty() ? 0 : curves.front().channels;
   if (o.channel < 0 || o.channel >= C)
     throw Error(fmt::format("--channel {} out of range ({} channels)", o.channel, C));
@@ -232,6 +239,7 @@ EnergyResult energy(const EnergyRequest& o) {
   out.theta_i = std::move(theta_i);
   out.curves = std::move(curves);
   out.skipped = std::move(skipped);
+  out.lobe_names = lobe_names(out.curves.front().lobes, out.settings.fiber.medulla.has_value());
   return out;
 }
 
@@ -245,6 +253,7 @@ std::string write_energy_report(const EnergyRequest& o, const EnergyResult& r) {
   report.n_theta = o.n_theta;
   report.n_phi = o.n_phi;
   report.theta_i = r.theta_i;
+  report.lobe_names = r.lobe_names;
   return compare::write_energy_report(report, r.curves);
 }
 

@@ -32,6 +32,7 @@ struct EnergyResult {
   std::vector<double> theta_i;               // radians
   std::vector<compare::EnergyCurve> curves;  // the simulation's (if any), then each model's
   std::vector<std::string> skipped;          // "NAME: not applicable: why", every-model runs only
+  std::vector<std::string> lobe_names;       // the curves' lobes (`scattered` last for a fiber with a medulla)
 };
 
 // --help of --models: the default is every registered model.

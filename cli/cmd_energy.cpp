@@ -41,7 +41,7 @@ void print_energy(const app::EnergyRequest& o, const app::EnergyResult& r) {
   const int L = curves.front().lobes;
   for (std::size_t k = 0; k < theta_i.size(); ++k) {
     fmt::print("\ntheta_i = {:.2f} deg\n  {:<44}", rad_to_deg(theta_i[k]), "source");
-    for (int l = 0; l < L; ++l) fmt::print(" {:>9}", compare::lobe_name(l, L));
+    for (int l = 0; l < L; ++l) fmt::print(" {:>9}", r.lobe_names.at(l));
     fmt::print(" {:>9} {:>9} {:>10}{}\n", "total", "R+TT+TRT", white ? "total-1" : "",
                simulated ? "  absorbed truncated      lost ledger" : "");
     for (const auto& e : curves) {

@@ -124,7 +124,8 @@ std::string absorption_label(const Reader& r, const YAML::Node& entry, const std
 // The simulator config of one fiber, parsed by the simulator's own parser.
 sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML::Node& roughness,
                              const YAML::Node& absorption, double tilt, double eccentricity,
-                             const YAML::Node& theta_i, const std::string& where) {
+                             const YAML::Node& medulla, const YAML::Node& theta_i,
+                             const std::string& where) {
   YAML::Node c;
   c["photons"] = top["photons"];
   c["seed"] = top["seed"] ? top["seed"] : YAML::Node(1);
@@ -134,6 +135,7 @@ sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML:
   fiber["eccentricity"] = eccentricity;
   fiber["scale_tilt"] = tilt;
   for (const auto& kv : absorption) fiber[kv.first.Scalar()] = kv.second;
+  if (!(medulla.IsScalar() && medulla.Scalar() == "none")) fiber["medulla"] = medulla;
   c["fiber"] = fiber;
   c["roughness"] = roughness;
   YAML::Node source;
@@ -244,7 +246,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   integer(r, top["photons"], "photons", 1, 1e12);
   if (!top["sweep"]) r.fail("sweep is missing (roughness, absorption, scale_tilt, eccentricity, theta_i lists)");
   const YAML::Node sweep = top["sweep"];
-  only_keys(r, sweep, "sweep", {"roughness", "absorption", "scale_tilt", "eccentricity", "theta_i"});
+  only_keys(r, sweep, "sweep", {"roughness", "absorption", "scale_tilt", "eccentricity", "medulla", "theta_i"});
 
   AtlasConfig c;
   c.path = origin;
@@ -262,6 +264,13 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   const auto tilts = sweep["scale_tilt"] ? numbers(r, sweep["scale_tilt"], "sweep.scale_tilt") : std::vector<double>{0.0};
   const auto eccs =
       sweep["eccentricity"] ? numbers(r, sweep["eccentricity"], "sweep.eccentricity") : std::vector<double>{1.0};
+  // sweep.medulla: `none` or a simulator fiber.medulla block each (docs/FUR.md).
+  const auto medullas = sweep["medulla"] ? items(r, sweep["medulla"], "sweep.medulla")
+                                         : std::vector<YAML::Node>{YAML::Node("none")};
+  for (std::size_t m = 0; m < medullas.size(); ++m)
+    if (!medullas[m].IsMap() && !(medullas[m].IsScalar() && medullas[m].Scalar() == "none"))
+      r.fail(fmt::format("sweep.medulla[{}] = {} must be none or a medulla block such as "
+                         "{{radius: 0.5, sigma_s: 8}}", m, show(medullas[m])));
   const YAML::Node theta_node = sweep["theta_i"];
   const auto theta = numbers(r, theta_node, "sweep.theta_i");
   for (double t : theta) c.theta_i.push_back(deg_to_rad(t));
@@ -271,18 +280,22 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   for (std::size_t g = 0; g < roughness.size(); ++g)
     if (!roughness[g].IsMap()) r.fail(fmt::format("sweep.roughness[{}] = {} must be a roughness block such as "
                                                   "{{model: gaussian, beta_long: 5}}", g, show(roughness[g])));
-  if (roughness.size() * absorption.size() * tilts.size() * eccs.size() > kMaxFibers)
+  if (roughness.size() * absorption.size() * tilts.size() * eccs.size() * medullas.size() > kMaxFibers)
     r.fail(fmt::format("the sweep has more than {} fibers (shorten its lists)", kMaxFibers));
 
   for (std::size_t g = 0; g < roughness.size(); ++g)
     for (std::size_t a = 0; a < absorption.size(); ++a)
       for (std::size_t t = 0; t < tilts.size(); ++t)
-        for (std::size_t e = 0; e < eccs.size(); ++e) {
+        for (std::size_t e = 0; e < eccs.size(); ++e)
+        for (std::size_t m = 0; m < medullas.size(); ++m) {
           AtlasFiber f;
           roughness_size(roughness[g], f);
           const std::string where =
-              fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e);
-          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], theta_node, where);
+              fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e) +
+              (sweep["medulla"] ? fmt::format(" x medulla[{}]", m) : "");
+          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], medullas[m],
+                                      theta_node, where);
+          f.medulla_index = static_cast<int>(m);
           f.roughness_index = static_cast<int>(g);
           f.absorption_index = static_cast<int>(a);
           f.tilt_index = static_cast<int>(t);
@@ -293,6 +306,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
                                                                : fmt::format(" alpha {:g}", f.roughness);
           f.label = fmt::format("{}{}, {}, tilt {:g}, e {:g}", f.roughness_model, size, f.absorption_label,
                                 tilts[t], eccs[e]);
+          if (const auto& md = f.settings.fiber.medulla)
+            f.label += fmt::format(", medulla k {:g} sigma_s {:g}", md->radius, md->sigma_s);
           c.fibers.push_back(std::move(f));
         }
   // fit.lobes: names of the tally's lobes (every fiber shares the tally).

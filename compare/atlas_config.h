@@ -15,6 +15,7 @@
 //       - {sigma_a: 0.0}
 //     scale_tilt: [0, 3]  # degrees
 //     eccentricity: [1.0]
+//     medulla: [none, {radius: 0.5, sigma_s: 8}]  # optional: fur (docs/FUR.md); none: no medulla
 //     theta_i: [0, 30, 60]  # degrees: the incident directions of every fiber
 //   models: all           # or a list of registered model names
 //   model_parameters:     # optional: fixed (not fitted) parameters per model
@@ -51,6 +52,7 @@ struct AtlasFiber {
   double roughness = 0.0;       // its size: beta_long (deg) or alpha; 0 for smooth
   std::string roughness_unit;   // "deg" (beta) or "" (alpha)
   int roughness_index = 0, absorption_index = 0, tilt_index = 0, eccentricity_index = 0;
+  int medulla_index = 0;        // sweep.medulla's entry (0 without the list)
   std::string absorption_label; // "sigma_a=0.2" or "melanin 0.8/0.1"
 };
 

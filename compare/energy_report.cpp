@@ -11,7 +11,7 @@ namespace fiberlab::compare {
 
 namespace {
 
-std::string curve_json(const EnergyCurve& e, int c, int lobes_shown) {
+std::string curve_json(const EnergyCurve& e, int c, const std::vector<std::string>& lobe_names) {
   auto arr = [](const std::vector<double>& v) {
     std::string s;
     for (double x : v) s += fmt::format("{}{}", s.empty() ? "" : ", ", json_number(x));
@@ -31,7 +31,7 @@ std::string curve_json(const EnergyCurve& e, int c, int lobes_shown) {
     lobes += arr(v);
     errors += sep;
     errors += arr(err);
-    names += fmt::format("{}\"{}\"", l ? ", " : "", lobe_name(l, lobes_shown));
+    names += fmt::format("{}\"{}\"", l ? ", " : "", lobe_names.at(l));
   }
   for (std::size_t k = 0; k < K; ++k) {
     th.push_back(rad_to_deg(e.theta_i[k]));
@@ -61,7 +61,7 @@ std::string energy_csv(const EnergyReport& r, const std::vector<EnergyCurve>& cu
   const std::vector<double>& theta_i = r.theta_i;
   std::string csv = "source,beta_long_deg,theta_i_deg,channel";
   const int L = curves.front().lobes;
-  for (int l = 0; l < L; ++l) csv += fmt::format(",{0},{0}_error", lobe_name(l, L));
+  for (int l = 0; l < L; ++l) csv += fmt::format(",{0},{0}_error", r.lobe_names.at(l));
   csv += ",total,total_error,three_lobe,absorbed,truncated,lost,ledger,furnace_departure\n";
   for (std::size_t k = 0; k < theta_i.size(); ++k) {
     for (const auto& e : curves) {
@@ -92,7 +92,7 @@ std::string write_energy_report(const EnergyReport& r, const std::vector<EnergyC
     const std::string& dir = folder.staging();
     write_text(dir, "metrics.csv", energy_csv(r, curves));
     std::string js;
-    for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, L);
+    for (const auto& e : curves) js += (js.empty() ? "\n    " : ",\n    ") + curve_json(e, c, r.lobe_names);
     write_text(dir, "metrics.json",
                fmt::format("{{\n  \"kind\": \"energy\",\n  \"input\": {},\n  \"simulated\": {},\n"
                            "  \"white\": {},\n  \"channel\": {},\n  \"curves\": [{}\n  ]\n}}\n",

@@ -16,6 +16,7 @@ struct EnergyReport {
   int channel = 0;              // the channel of metrics.json, the table and the plots
   int n_theta = 0, n_phi = 0;   // the models' integration grid
   std::vector<double> theta_i;  // radians
+  std::vector<std::string> lobe_names;  // the curves' lobes (with `scattered` for a fiber with a medulla)
 };
 
 // metrics.csv: one row per (curve, theta_i, channel).

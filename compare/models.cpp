@@ -149,8 +149,12 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 namespace fiberlab::compare {
 
 std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& r, std::size_t k) {
-  return predict_bins(model, r.grid, r.theta_i.at(k), r.phi_i.at(k), r.lobes, r.channels,
-                      r.settings.fiber.eccentricity != 1.0);
+  const bool medulla = r.settings.fiber.medulla.has_value();
+  std::vector<double> bins = predict_bins(model, r.grid, r.theta_i.at(k), r.phi_i.at(k),
+                                          medulla ? r.lobes - 1 : r.lobes, r.channels,
+                                          r.settings.fiber.eccentricity != 1.0);
+  if (medulla) bins.resize(r.bin_cells(), 0.0);
+  return bins;
 }
 
 std::vector<std::vector<double>> predict_result(const analytic::Model& model,

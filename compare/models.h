@@ -68,7 +68,9 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 
 namespace fiberlab::compare {
 
-// predict_bins() for incident configuration k of a result.
+// predict_bins() for incident configuration k of a result. For a fiber with
+// a medulla (docs/FUR.md) the models, which have none, predict nothing in
+// its last lobe, `scattered`: their bins are followed by a zero lobe.
 std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& result, std::size_t k);
 
 // predict_config() for every incident configuration of a result (parallel

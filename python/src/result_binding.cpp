@@ -100,7 +100,8 @@ void bind_result(py::module_& m) {
   py::class_<sim::Settings>(m, "Settings", "A resolved simulation configuration (sim/run/settings.h)")
       .def_property_readonly("yaml", [](const sim::Settings& s) { return sim::to_yaml(s); })
       .def_property_readonly("config", [](const sim::Settings& s) { return yaml_to_python(YAML::Load(sim::to_yaml(s))); })
-      .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally.lobes; })
+      .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally_lobes(); })
+      .def_property_readonly("medulla", [](const sim::Settings& s) { return s.fiber.medulla.has_value(); })
       .def_property_readonly("channels", [](const sim::Settings& s) { return s.fiber.sigma_a.size(); })
       .def_property_readonly("melanin", [](const sim::Settings& s) { return s.fiber.eumelanin.has_value(); });
   m.def("parse_settings", &sim::parse_settings_yaml, py::arg("yaml_text"), py::arg("origin"),
@@ -160,7 +161,9 @@ void bind_result(py::module_& m) {
     py::gil_scoped_release release;
     return std::make_shared<Result>(sim::read_result(source));
   }, py::arg("path"));
-  m.def("lobe_names", &lobe_names, py::arg("lobes"), "R, TT, TRT, ..., p>=L-1 (common/file_schema.h)");
+  m.def("lobe_names", [](int lobes, bool scattered) { return lobe_names(lobes, scattered); }, py::arg("lobes"),
+        py::arg("scattered") = false,
+        "R, TT, TRT, ..., p>=L-1, and `scattered` last for a fiber with a medulla (common/file_schema.h)");
   m.def("channel_names", [](const sim::Settings& s) {
     return channel_names(static_cast<int>(s.fiber.sigma_a.size()), s.fiber.eumelanin.has_value());
   }, py::arg("settings"), "R, G, B for a melanin fiber, else c0, c1, ... (common/file_schema.h)");

@@ -31,7 +31,7 @@ constexpr int kRoundsPerStep = 8;
 struct Pool {
   enum Column {
     kPx, kPy, kDx, kDy, kDz, kInside, kPath, kSegments, kEventsHere, kTries, kWeight, kCode,
-    kPhiI, kScalarColumns,
+    kPhiI, kMedullaPath, kScatters, kScalarColumns,
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
   enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
@@ -55,6 +55,8 @@ struct Pool {
     s.tries = load<T>(col[kTries] + o);
     s.weight = load<T>(col[kWeight] + o);
     s.code = load<T>(col[kCode] + o);
+    s.medulla_path = load<T>(col[kMedullaPath] + o);
+    s.scatters = load<T>(col[kScatters] + o);
     s.rng = {load_bits<T>(bits[kS0] + o), load_bits<T>(bits[kS1] + o),
              load_bits<T>(bits[kS2] + o), load_bits<T>(bits[kS3] + o)};
     if constexpr (Light::kPolarized) {
@@ -82,6 +84,8 @@ struct Pool {
     put(s.tries, col[kTries]);
     put(s.weight, col[kWeight]);
     put(s.code, col[kCode]);
+    put(s.medulla_path, col[kMedullaPath]);
+    put(s.scatters, col[kScatters]);
     for (int k = 0; k < 4; ++k) put(s.rng.word(k), bits[kS0 + k]);
     if constexpr (Light::kPolarized) {
       put(s.light.q, col[kQ]);
@@ -133,6 +137,9 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   pack_store(s.d.z, lanes, f.dz + n);
   pack_store(s.path, lanes, f.path + n);
   pack_store(s.weight, lanes, f.weight + n);
+  pack_store(s.medulla_path, lanes, f.medulla_path + n);
+  const std::uint64_t scattered =
+      life::pack_bits(life::lane_bits(s.scatters > Lanes(0.0)), lanes);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
   // Fates as fate_of (sim/life/tracer.h) gives them, from the code's mask bits.
@@ -147,6 +154,7 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = (lost >> j) & 1;
+    f.scattered[n + j] = (scattered >> j) & 1;
   }
   // No exit direction for a photon that did not exit.
   for (std::uint64_t rest = ~exited & ((std::uint64_t{1} << k) - 1); rest != 0; rest &= rest - 1) {

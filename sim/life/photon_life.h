@@ -22,6 +22,7 @@
 
 #include "sim/life/ellipse_cross_section.h"
 #include "sim/life/interface_event.h"
+#include "sim/life/medulla.h"
 #include "sim/roughness/roughness_model.h"
 #include "sim/run/settings.h"
 
@@ -35,11 +36,19 @@ struct LifeConfig {
   explicit LifeConfig(const Settings& s)
       : ellipse(s.fiber.eccentricity), eta(s.fiber.eta), cos_tilt(std::cos(s.fiber.scale_tilt)),
         sin_tilt(std::sin(s.fiber.scale_tilt)), max_segments(s.max_segments),
-        max_events(s.max_events_per_point) {}
+        max_events(s.max_events_per_point), medulla(medulla_config(s)) {}
   EllipseCrossSection ellipse;
   double eta;
   double cos_tilt, sin_tilt;  // cuticle tilt towards the root (SPEC section 2)
   int max_segments, max_events;
+  MedullaConfig medulla;  // not present: a plain fiber (sim/life/medulla.h)
+
+  static MedullaConfig medulla_config(const Settings& s) {
+    if (!s.fiber.medulla) return {};
+    const MedullaSettings& m = *s.fiber.medulla;
+    const EllipseCrossSection e(s.fiber.eccentricity);
+    return {e.r_v(), e.r_w(), m.radius, m.sigma_s, m.g, s.fiber.eta, m.eta, s.max_segments};
+  }
 };
 
 template <class T, class Light>
@@ -56,6 +65,8 @@ struct PhotonState {
   LaneRandom<T> rng;
   Light light;
   LossRecord<T> losses;  // weight removed by the model's event weights
+  T medulla_path;        // 3D path length inside the medulla (sim/life/medulla.h)
+  T scatters;            // scattering events in the medulla
 };
 
 // Photons arriving along d at the entry points (pv, pw), with their streams.
@@ -63,7 +74,8 @@ template <class Light, class T>
 PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
-  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {}};
+  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
+          zero, zero};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -144,12 +156,16 @@ template <class T, class Light>
   const MaskOf<T> moved = go & !along_axis;
   T pv = s.px, pw = s.py;
   c.ellipse.advance(pv, pw, s.d.y, s.d.z, t);
+  T cortex = t;
+  const MaskOf<T> stuck = c.medulla.present ? cross_medulla(c.medulla, s, moved, cortex, pv, pw)
+                                            : MaskOf<T>(false);
   s.px = select(moved, pv, s.px);
   s.py = select(moved, pw, s.py);
-  s.path = s.path + t;
+  s.path = s.path + cortex;
   s.segments = s.segments + ones<T>(moved);
   s.events_here = select(moved, T(0.0), s.events_here);
   s.code = select(moved, T(kAtBoundary), select(go & along_axis, T(kTruncated), s.code));
+  s.code = select(stuck, T(kTruncated), s.code);
 }
 
 // One step of the life for the photons in `live`, all at a boundary point:

@@ -28,6 +28,8 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   PhotonOutcome out = finished_outcome(model, static_cast<int>(s.code), s.d.to_vec3(),
                                        static_cast<int>(s.segments), s.path, s.weight, rng);
   out.losses = std::move(s.losses.list);
+  out.medulla_path = s.medulla_path;
+  out.scattered = s.scatters > 0.0;
   if (out.fate == PhotonFate::Exited) {
     out.theta = inclination(out.direction);
     out.phi = azimuth(out.direction);

@@ -26,6 +26,11 @@ struct PhotonOutcome {
   // without masking, 0 when Lost). Channel c carries weight exp(-sigma_a[c] l).
   double weight = 1.0;
   std::vector<WeightLoss> losses;  // what masking removed, in order (empty without masking)
+  // With a medulla (sim/life/medulla.h): the 3D length inside it (absorbed
+  // with the medulla's sigma_a; path_length is the cortex's), and whether the
+  // photon scattered there (then it is tallied in the lobe `scattered`).
+  double medulla_path = 0.0;
+  bool scattered = false;
 };
 
 // Work counters, for benchmarks and notes.

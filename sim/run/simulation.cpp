@@ -334,7 +334,7 @@ Simulation::Simulation(Settings settings)
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {
-  return {settings_.tally.lobes, settings_.tally.n_theta, settings_.tally.n_phi,
+  return {settings_.tally_lobes(), settings_.tally.n_theta, settings_.tally.n_phi,
           static_cast<int>(settings_.fiber.sigma_a.size())};
 }
 
@@ -342,7 +342,8 @@ void Simulation::trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tal
                                TracerCounters& counters, std::atomic<std::uint64_t>* traced,
                                std::uint64_t per_photon) const {
   const Settings::Incidence inc = incidences_[k];
-  ExitScorer scorer(grid_, settings_.fiber.sigma_a, tally.lobes());
+  ExitScorer scorer(grid_, settings_.fiber.sigma_a, settings_.tally.lobes,
+                    settings_.fiber.medulla ? settings_.fiber.medulla->sigma_a : std::vector<double>{});
   auto score = [&](const FinishedPhotons& f) { scorer.score(f, tally); };
   // Every run handed out is launched and traced in full, so it counts as
   // launched here, and as progress: a counter the threads share, touched a
