@@ -44,19 +44,23 @@
 // BatchTracer ask it (runs_batched in sim/roughness/roughness_models.h); a
 // model written for T = double only runs on the reference tracer.
 //
-// To add a model (files touched, counted for the microfacet models):
+// To add a model, the files it touches (counted for beckmann / ggx, which
+// touch 23; a model of one header and one test file touches 12):
 // 1. its sampler, one header sim/roughness/roughness_<name>.h (see
 //    roughness_gaussian.h for a rejection sampler, roughness_smooth.h for the
 //    simplest, roughness_microfacet.h for one with an event weight), more
-//    files if it has parts of its own to test (the microfacet models: five);
-// 2. sim/roughness/roughness_models.h: the variant and make_roughness;
-// 3. its settings: sim/run/settings.h and settings.cpp (the model's name, its
-//    parameters, their reading and validation), sim/store/result_file.cpp
-//    (its parameters as file attributes), cli/cmd_info.cpp (their
-//    description);
-// 4. its tests: its own file(s) in tests/sim/ (an oracle for its normals) and
-//    a case in tests/sim/test_batch_tracer.cpp (photon by photon against the
-//    reference tracer), tests/CMakeLists.txt for a new test file.
+//    files if it has parts of its own (the microfacet models: seven);
+// 2. its registration and settings (six): sim/roughness/roughness_models.h
+//    (the variant and make_roughness), sim/run/settings.h and settings.cpp
+//    (its name, parameters, reading and validation),
+//    sim/store/result_file.cpp (its parameters as file attributes),
+//    cli/cmd_info.cpp (their description), compare/models.cpp (the analytic
+//    models' stand-in for its fibers);
+// 3. its tests: its own file(s) in tests/sim/ (an oracle for its normals;
+//    the microfacet models: six), listed in tests/CMakeLists.txt, and a case
+//    in tests/sim/test_batch_tracer.cpp (photon by photon against the
+//    reference tracer);
+// 4. docs/PHYSICS.md (the model) and docs/FILE_FORMAT.md (its attributes).
 // Both tracers, the batched one's lane management, Fresnel, Stokes light,
 // tilt, the consistency rule, truncation and masking's losses then apply to
 // it unchanged.
