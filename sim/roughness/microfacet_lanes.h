@@ -9,7 +9,8 @@
 // - GGX: Heitz 2018, "Sampling the GGX Distribution of Visible Normals"
 //   (JCGT 7(4)), section 4. Its angle 2 pi u2 goes through sincos_turn
 //   (sim/simd/life_trig.h), one operation sequence for one photon and for a
-//   vector, so both give the same bits.
+//   vector, so both compute the same numbers (up to the compiler fusing a
+//   product into a sum in one form and not the other).
 // - Beckmann: Heitz and d'Eon 2014 (EGSR), section 4: the marginal CDF of the
 //   stretched visible slope x inverted by safeguarded Newton iteration to
 //   rounding (exact, not a fit), y | x ~ Normal(0, 1/2) by the inverse error

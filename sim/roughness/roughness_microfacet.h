@@ -29,13 +29,14 @@ struct MicrofacetLifeModel {
   // Smith G1 masking of the outgoing direction: the throughput factor; a
   // factor 0 ends the path (Lost).
   template <class T>
-  life::EventWeight<T> event_weight(const life::EventGeometry<T>& e, const life::MaskOf<T>& act,
+  life::EventWeight<T> event_weight(const life::EventGeometry<T>& e,
+                                    const life::MaskOf<T>& /*act*/,
                                     life::LaneRandom<T>& /*rng*/) const {
     if (!roughness.masks()) return {T(1.0), life::MaskOf<T>(false)};
     const life::Vec3Of<T> mean =
         MicrofacetRoughness::mean_normal(e.d_in, e.frame.facing, e.frame.untilted_facing);
     const T g1 = roughness.masking_factor(mean, e.d_out, e.refracted);
-    return {g1, act & !(g1 > T(0.0))};
+    return {g1, !(g1 > T(0.0))};  // photon_life keeps the lanes that acted
   }
 
   MicrofacetRoughness roughness;

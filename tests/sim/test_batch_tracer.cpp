@@ -170,20 +170,25 @@ Settings microfacet_case(RoughnessModel model, double ax, double ay, Masking mas
 // paths agree to rounding, not always to the last bit (the count printed).
 TEST(BatchTracer, GgxMatchesReference) {
   for (const Masking masking : {Masking::None, Masking::SmithG1}) {
-    for (const auto [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.15, 0.5}}) {
+    for (const auto& [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.15, 0.5}}) {
       const Settings s = microfacet_case(RoughnessModel::GGX, ax, ay, masking);
       const std::string what = "ggx " + std::to_string(ax) + "/" + std::to_string(ay) +
                                (masking == Masking::SmithG1 ? " smith_g1" : "");
       expect_same_photons(s, what.c_str());
     }
   }
+  // Photons launched one lane at a time (a random fiber rotation), each
+  // given its list of losses there.
+  Settings s = microfacet_case(RoughnessModel::GGX, 0.3, 0.3, Masking::SmithG1);
+  s.source.phi_i_uniform = true;
+  expect_same_photons(s, "ggx 0.3 smith_g1, uniform phi_i");
 }
 
 // Beckmann's Newton iteration uses the C library's erfc and exp for one
 // photon and xsimd's for a vector: normals may differ in the last bits.
 TEST(BatchTracer, BeckmannMatchesReference) {
   for (const Masking masking : {Masking::None, Masking::SmithG1}) {
-    for (const auto [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.5, 0.15}}) {
+    for (const auto& [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.5, 0.15}}) {
       const Settings s = microfacet_case(RoughnessModel::Beckmann, ax, ay, masking);
       const std::string what = "beckmann " + std::to_string(ax) + "/" + std::to_string(ay) +
                                (masking == Masking::SmithG1 ? " smith_g1" : "");
