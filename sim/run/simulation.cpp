@@ -329,8 +329,8 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      // The microfacet models run on the reference tracer (sim/roughness/roughness_microfacet.h).
-      use_batch_tracer_(!settings_.roughness.microfacet()),  // scalar and Stokes light
+      // The model's type decides (sim/roughness/roughness_model.h, RunsBatched).
+      use_batch_tracer_(runs_batched(make_roughness(settings_))),
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {
