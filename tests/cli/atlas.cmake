@@ -3,3 +3,9 @@
 add_test(NAME atlas_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
 set_tests_properties(atlas_cli PROPERTIES TIMEOUT 300)
+# `fiberlab atlas` with model variants (configs/atlas_variants.yaml): named
+# in file, report and info; a variant without parameters equals its model;
+# one-line errors for bad entries.
+add_test(NAME atlas_variants_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_variants.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
+set_tests_properties(atlas_variants_cli PROPERTIES TIMEOUT 300)
