@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -573,6 +575,59 @@ AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
                          "/dataset_digests differs: datasets swapped, edited or damaged)",
                          names[d]));
   return c;
+}
+
+namespace {
+
+AtlasConfig one_fiber_config(const AtlasConfig& config, std::size_t index) {
+  AtlasConfig one = config;
+  one.fibers = {config.fibers.at(index)};
+  return one;
+}
+
+// Removes the scratch file however the caller leaves.
+struct ScratchFile {
+  std::string path;
+  ~ScratchFile() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> pack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                           const AtlasFiberResult& result, const std::string& scratch) {
+  const AtlasConfig one = one_fiber_config(config, index);
+  const ScratchFile file{scratch};
+  {
+    h5::File f = h5::File::create(scratch);
+    write_flat(f, flatten({result}), 1, one.theta_i.size(), one.models.size());
+    f.close();
+  }
+  std::ifstream in(scratch, std::ios::binary);
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw Error(fmt::format("{}: cannot read back the packed fiber", scratch));
+  return bytes;
+}
+
+AtlasFiberResult unpack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                    const std::vector<std::uint8_t>& bytes, const std::string& scratch) {
+  const AtlasConfig one = one_fiber_config(config, index);
+  const ScratchFile file{scratch};
+  {
+    std::ofstream out(scratch, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw Error(fmt::format("{}: cannot write the received fiber", scratch));
+  }
+  const h5::File f = h5::File::open_read(scratch);
+  const std::string origin = fmt::format("fiber {} received from another rank", index + 1);
+  const Reader r{f, origin};
+  const Stored stored = read_stored(r, 1, one);
+  Cursor at;
+  AtlasFiberResult result = read_fiber(r, stored, at, one, 0);
+  result.fiber = config.fibers.at(index);
+  return result;
 }
 
 std::string describe_atlas_checkpoint(const std::string& path) {
