@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "app/fit.h"
+#include "app/comma_list.h"
 #include "common/error.h"
 #include "compare/prediction_file.h"
 #include "compare/report.h"
@@ -12,15 +13,6 @@
 namespace fiberlab::app {
 
 namespace {
-
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::string part;
-  std::istringstream in(s);
-  while (std::getline(in, part, ','))
-    if (!part.empty()) out.push_back(part);
-  return out;
-}
 
 Predicted predicted_by_file(const sim::ResultFile& result, const CompareRequest& o) {
   const compare::PredictionFile file = compare::read_prediction_for(o.prediction, result, o.result);

@@ -13,6 +13,7 @@
 #include "analytic/model_registry.h"
 #include "app/run.h"
 #include "app/threads.h"
+#include "app/comma_list.h"
 #include "common/error.h"
 #include "common/file_schema.h"
 #include "common/interrupt.h"
@@ -96,15 +97,6 @@ std::vector<double> parse_degrees(const std::string& option, const std::string& 
                               range.text));
     out.push_back(deg_to_rad(d));
   }
-  return out;
-}
-
-std::vector<std::string> split_commas(const std::string& s) {
-  std::vector<std::string> out;
-  std::string part;
-  std::istringstream in(s);
-  while (std::getline(in, part, ','))
-    if (!part.empty()) out.push_back(part);
   return out;
 }
 

@@ -8,6 +8,7 @@
 #include <new>
 #include <optional>
 
+#include "app/on_all_ranks.h"
 #include "app/threads.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
@@ -97,25 +98,6 @@ void write_output(const sim::Simulation& simulation, const Job& job, int threads
   std::filesystem::remove(sim::checkpoint_path(s.output));
 }
 
-// Runs `step` on every rank; when it fails anywhere, every rank stops, rank 0
-// with the (first failing rank's) message, the others quietly.
-template <typename Step>
-void on_all_ranks(const sim::ProcessGroup& group, Step&& step) {
-  std::optional<std::string> error;
-  try {
-    step();
-  } catch (const Error& e) {
-    error = e.what();
-  } catch (const std::bad_alloc&) {
-    error = "out of memory";
-  } catch (const std::exception& e) {
-    error = std::string("internal error: ") + e.what();
-  }
-  if (const auto message = group.agree_on_error(error)) {
-    if (!group.is_root()) throw sim::FailedElsewhere{};
-    throw Error(*message);
-  }
-}
 
 }  // namespace
 

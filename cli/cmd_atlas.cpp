@@ -21,6 +21,7 @@
 #include <memory>
 #include <optional>
 
+#include "app/on_all_ranks.h"
 #include "cli/commands.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
@@ -40,6 +41,8 @@
 namespace fiberlab::cli {
 
 namespace {
+
+using app::on_all_ranks;
 
 struct AtlasOptions {
   std::string config, output, report, threads, photons, resume;
@@ -113,23 +116,6 @@ AtlasJob resumed_job(const AtlasOptions& o) {
   return job;
 }
 
-// Runs `step` on every rank; when it fails anywhere, every rank stops, rank 0
-// with the (first failing rank's) message, the others quietly (as `run`).
-template <typename Step>
-void on_all_ranks(const sim::ProcessGroup& group, Step&& step) {
-  std::optional<std::string> error;
-  try {
-    step();
-  } catch (const Error& e) {
-    error = e.what();
-  } catch (const std::bad_alloc&) {
-    error = "out of memory";
-  }
-  if (const auto message = group.agree_on_error(error)) {
-    if (!group.is_root()) throw sim::FailedElsewhere{};
-    throw Error(*message);
-  }
-}
 
 // Rank r's fiber bytes into rank 0: each rank's segment of a zeroed buffer,
 // summed exactly (the other ranks add zeros). Returns, on rank 0, every
