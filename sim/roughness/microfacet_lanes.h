@@ -41,7 +41,10 @@ namespace microfacet_detail {
 inline constexpr double kSqrtPi = 1.7724538509055160273;
 
 inline double exp_of(double x) { return std::exp(x); }
-inline Batch exp_of(const Batch& x) { return xsimd::exp(x); }
+// xsimd's exp converts its reduced argument to integers, which for -inf is
+// undefined behaviour where the target has no vector conversion (AVX2); every
+// argument below -1000 gives 0 alike, so -inf is met as -1000 (NaN stays).
+inline Batch exp_of(const Batch& x) { return xsimd::exp(xsimd::select(x < Batch(-1000.0), Batch(-1000.0), x)); }
 template <class V>
 Pair<V> exp_of(const Pair<V>& x) {
   return {exp_of(x.a), exp_of(x.b)};
