@@ -41,22 +41,27 @@ namespace microfacet_detail {
 inline constexpr double kSqrtPi = 1.7724538509055160273;
 
 inline double exp_of(double x) { return std::exp(x); }
-// xsimd's exp converts its reduced argument to integers, which for -inf is
-// undefined behaviour where the target has no vector conversion (AVX2); every
-// argument below -1000 gives 0 alike, so -inf is met as -1000 (NaN stays).
+// xsimd's exp (and erf, erfc, which call it) converts a reduced argument to
+// integers, undefined behaviour for an infinite argument where the target has
+// no vector conversion (AVX2). Infinite arguments are met as finite ones with
+// the same double result: exp(x < -1000) = 0, erf(|x| > 30) = +-1,
+// erfc(x > 30) = 0, erfc(x < -30) = 2 (NaN stays NaN).
+inline Batch clamped(const Batch& x, double limit) {
+  return xsimd::select(x < Batch(-limit), Batch(-limit), xsimd::select(x > Batch(limit), Batch(limit), x));
+}
 inline Batch exp_of(const Batch& x) { return xsimd::exp(xsimd::select(x < Batch(-1000.0), Batch(-1000.0), x)); }
 template <class V>
 Pair<V> exp_of(const Pair<V>& x) {
   return {exp_of(x.a), exp_of(x.b)};
 }
 inline double erf_of(double x) { return std::erf(x); }
-inline Batch erf_of(const Batch& x) { return xsimd::erf(x); }
+inline Batch erf_of(const Batch& x) { return xsimd::erf(clamped(x, 30.0)); }
 template <class V>
 Pair<V> erf_of(const Pair<V>& x) {
   return {erf_of(x.a), erf_of(x.b)};
 }
 inline double erfc_of(double x) { return std::erfc(x); }
-inline Batch erfc_of(const Batch& x) { return xsimd::erfc(x); }
+inline Batch erfc_of(const Batch& x) { return xsimd::erfc(clamped(x, 30.0)); }
 template <class V>
 Pair<V> erfc_of(const Pair<V>& x) {
   return {erfc_of(x.a), erfc_of(x.b)};
