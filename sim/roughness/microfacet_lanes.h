@@ -42,26 +42,36 @@ inline constexpr double kSqrtPi = 1.7724538509055160273;
 
 inline double exp_of(double x) { return std::exp(x); }
 // xsimd's exp (and erf, erfc, which call it) converts a reduced argument to
-// integers, undefined behaviour for an infinite argument where the target has
-// no vector conversion (AVX2). Infinite arguments are met as finite ones with
-// the same double result: exp(x < -1000) = 0, erf(|x| > 30) = +-1,
-// erfc(x > 30) = 0, erfc(x < -30) = 2 (NaN stays NaN).
-inline Batch clamped(const Batch& x, double limit) {
-  return xsimd::select(x < Batch(-limit), Batch(-limit), xsimd::select(x > Batch(limit), Batch(limit), x));
+// integers, undefined behaviour for an infinite or NaN argument where the
+// target has no vector conversion (AVX2). Such arguments are met as finite
+// ones with the same double result: exp(x < -1000) = 0, exp(x > 1000) = inf,
+// erf(|x| > 30) = +-1, erfc(x > 30) = 0, erfc(x < -30) = 2; a NaN argument still gives NaN.
+template <class F>
+Batch with_finite_argument(const Batch& x, double low, double high, F&& f) {
+  const auto nan = x != x;
+  Batch finite = xsimd::select(x < Batch(low), Batch(low), xsimd::select(x > Batch(high), Batch(high), x));
+  finite = xsimd::select(nan, Batch(0.0), finite);
+  return xsimd::select(nan, x, f(finite));
 }
-inline Batch exp_of(const Batch& x) { return xsimd::exp(xsimd::select(x < Batch(-1000.0), Batch(-1000.0), x)); }
+inline Batch exp_of(const Batch& x) {
+  return with_finite_argument(x, -1000.0, 1000.0, [](const Batch& y) { return xsimd::exp(y); });
+}
 template <class V>
 Pair<V> exp_of(const Pair<V>& x) {
   return {exp_of(x.a), exp_of(x.b)};
 }
 inline double erf_of(double x) { return std::erf(x); }
-inline Batch erf_of(const Batch& x) { return xsimd::erf(clamped(x, 30.0)); }
+inline Batch erf_of(const Batch& x) {
+  return with_finite_argument(x, -30.0, 30.0, [](const Batch& y) { return xsimd::erf(y); });
+}
 template <class V>
 Pair<V> erf_of(const Pair<V>& x) {
   return {erf_of(x.a), erf_of(x.b)};
 }
 inline double erfc_of(double x) { return std::erfc(x); }
-inline Batch erfc_of(const Batch& x) { return xsimd::erfc(clamped(x, 30.0)); }
+inline Batch erfc_of(const Batch& x) {
+  return with_finite_argument(x, -30.0, 30.0, [](const Batch& y) { return xsimd::erfc(y); });
+}
 template <class V>
 Pair<V> erfc_of(const Pair<V>& x) {
   return {erfc_of(x.a), erfc_of(x.b)};
