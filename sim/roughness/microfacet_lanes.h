@@ -41,20 +41,27 @@ namespace microfacet_detail {
 inline constexpr double kSqrtPi = 1.7724538509055160273;
 
 inline double exp_of(double x) { return std::exp(x); }
-// xsimd's exp (and erf, erfc, which call it) converts a reduced argument to
-// integers, undefined behaviour for an infinite or NaN argument where the
-// target has no vector conversion (AVX2). Such arguments are met as finite
-// ones with the same double result: exp(x < -1000) = 0, exp(x > 1000) = inf,
-// erf(|x| > 30) = +-1, erfc(x > 30) = 0, erfc(x < -30) = 2; a NaN argument still gives NaN.
-template <class F>
-Batch with_finite_argument(const Batch& x, double low, double high, F&& f) {
-  const auto nan = x != x;
-  Batch finite = xsimd::select(x < Batch(low), Batch(low), xsimd::select(x > Batch(high), Batch(high), x));
-  finite = xsimd::select(nan, Batch(0.0), finite);
-  return xsimd::select(nan, x, f(finite));
+// xsimd's exp (and its erf, erfc, which call it) converts a reduced argument
+// to integers; without a vector conversion (AVX-512 DQ) it does so lane by
+// lane in C++, undefined behaviour for the infinite or NaN arguments that
+// masked-out lanes and grazing directions give. There the lanes are
+// computed one by one with the C library instead (the same functions the
+// scalar tracer uses).
+template <class F, class G>
+Batch lane_function(const Batch& x, F&& vector_form, G&& scalar_form) {
+#if defined(__AVX512DQ__)
+  (void)scalar_form;
+  return vector_form(x);
+#else
+  (void)vector_form;
+  alignas(64) double lanes[kBatchWidth];
+  x.store_aligned(lanes);
+  for (double& v : lanes) v = scalar_form(v);
+  return Batch::load_aligned(lanes);
+#endif
 }
 inline Batch exp_of(const Batch& x) {
-  return with_finite_argument(x, -1000.0, 1000.0, [](const Batch& y) { return xsimd::exp(y); });
+  return lane_function(x, [](const Batch& y) { return xsimd::exp(y); }, [](double y) { return std::exp(y); });
 }
 template <class V>
 Pair<V> exp_of(const Pair<V>& x) {
@@ -62,7 +69,7 @@ Pair<V> exp_of(const Pair<V>& x) {
 }
 inline double erf_of(double x) { return std::erf(x); }
 inline Batch erf_of(const Batch& x) {
-  return with_finite_argument(x, -30.0, 30.0, [](const Batch& y) { return xsimd::erf(y); });
+  return lane_function(x, [](const Batch& y) { return xsimd::erf(y); }, [](double y) { return std::erf(y); });
 }
 template <class V>
 Pair<V> erf_of(const Pair<V>& x) {
@@ -70,7 +77,7 @@ Pair<V> erf_of(const Pair<V>& x) {
 }
 inline double erfc_of(double x) { return std::erfc(x); }
 inline Batch erfc_of(const Batch& x) {
-  return with_finite_argument(x, -30.0, 30.0, [](const Batch& y) { return xsimd::erfc(y); });
+  return lane_function(x, [](const Batch& y) { return xsimd::erfc(y); }, [](double y) { return std::erfc(y); });
 }
 template <class V>
 Pair<V> erfc_of(const Pair<V>& x) {
