@@ -41,6 +41,18 @@ namespace microfacet_detail {
 inline constexpr double kSqrtPi = 1.7724538509055160273;
 
 inline double exp_of(double x) { return std::exp(x); }
+// f applied to each lane (a function with no vector form).
+template <class F>
+double per_lane(double x, F f) {
+  return f(x);
+}
+template <class F>
+Batch per_lane(const Batch& x, F f) {
+  alignas(64) double v[kBatchWidth];
+  x.store_aligned(v);
+  for (double& e : v) e = f(e);
+  return Batch::load_aligned(v);
+}
 // xsimd's exp (and its erf, erfc, which call it) converts a reduced argument
 // to integers; without a vector conversion (AVX-512 DQ) it does so lane by
 // lane in C++, undefined behaviour for the infinite or NaN arguments that
@@ -54,10 +66,7 @@ Batch lane_function(const Batch& x, F&& vector_form, G&& scalar_form) {
   return vector_form(x);
 #else
   (void)vector_form;
-  alignas(64) double lanes[kBatchWidth];
-  x.store_aligned(lanes);
-  for (double& v : lanes) v = scalar_form(v);
-  return Batch::load_aligned(lanes);
+  return per_lane(x, scalar_form);
 #endif
 }
 inline Batch exp_of(const Batch& x) {
@@ -84,18 +93,6 @@ Pair<V> erfc_of(const Pair<V>& x) {
   return {erfc_of(x.a), erfc_of(x.b)};
 }
 
-// f applied to each lane (a function with no vector form).
-template <class F>
-double per_lane(double x, F f) {
-  return f(x);
-}
-template <class F>
-Batch per_lane(const Batch& x, F f) {
-  alignas(64) double v[kBatchWidth];
-  x.store_aligned(v);
-  for (double& e : v) e = f(e);
-  return Batch::load_aligned(v);
-}
 template <class V, class F>
 Pair<V> per_lane(const Pair<V>& x, F f) {
   return {per_lane(x.a, f), per_lane(x.b, f)};
