@@ -358,9 +358,14 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   }
   c.model_parameters = read_model_parameters(r, top["model_parameters"], entries);
   if (const YAML::Node fit = top["fit"]) {
-    only_keys(r, fit, "fit", {"max_iterations", "lobes"});
+    only_keys(r, fit, "fit", {"max_iterations", "lobes", "per_lobe"});
     if (fit["max_iterations"])
       c.max_iterations = static_cast<int>(integer(r, fit["max_iterations"], "fit.max_iterations", 0, 1000));
+    if (const YAML::Node per_lobe = fit["per_lobe"]) {
+      if (!per_lobe.IsScalar() || (per_lobe.Scalar() != "true" && per_lobe.Scalar() != "false"))
+        r.fail(fmt::format("fit.per_lobe = {} must be true or false", show(per_lobe)));
+      c.per_lobe = per_lobe.Scalar() == "true";
+    }
   }
   const auto roughness = items(r, sweep["roughness"], "sweep.roughness");
   const auto absorption = sweep["absorption"] ? items(r, sweep["absorption"], "sweep.absorption")

@@ -172,7 +172,11 @@ TEST_F(AtlasCheckpointTest, FibersWithoutFitsReadBackToo) {
 
 TEST(AtlasCheckpoint, IdentityFollowsWhatChangesTheResults) {
   const std::string base = atlas_config_identity(parse_atlas_config(kConfig, "a"));
-  // Comments, key order and the file's name change nothing.
+  // Comments, key order and the file's name change nothing, nor do the
+  // defaults written out.
+  std::string defaults = kConfig;
+  defaults.replace(defaults.find("max_iterations: 2"), 17, "max_iterations: 2, per_lobe: false");
+  EXPECT_EQ(atlas_config_identity(parse_atlas_config(defaults, "e")), base);
   std::string reordered = std::string("# a comment\nseed: 4\n") + kConfig;
   reordered.erase(reordered.find("seed: 4\ntally"), 8);
   EXPECT_EQ(atlas_config_identity(parse_atlas_config(reordered, "b")), base);
@@ -182,7 +186,9 @@ TEST(AtlasCheckpoint, IdentityFollowsWhatChangesTheResults) {
                           {"[0.1, 0.3]", "[0.1, 0.31]"}, {"[20, 50]", "[20, 51]"},
                           {"models: [exact, deon2011]", "models: [deon2011]"},
                           {"quadrature_order: 12", "quadrature_order: 13"},
-                          {"max_iterations: 2", "max_iterations: 3"}}) {
+                          {"max_iterations: 2", "max_iterations: 3"},
+                          {"max_iterations: 2", "max_iterations: 2, per_lobe: true"},
+                          {"max_iterations: 2", "max_iterations: 2, lobes: [TT]"}}) {
     std::string changed = kConfig;
     const auto at = changed.find(from);
     ASSERT_NE(at, std::string::npos) << from;
