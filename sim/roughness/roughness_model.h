@@ -54,7 +54,7 @@
 //    (the variant and make_roughness), sim/run/settings.h and settings.cpp
 //    (its name, parameters, reading and validation),
 //    sim/store/result_file.cpp (its parameters as file attributes),
-//    cli/cmd_info.cpp (their description), compare/models.cpp (the analytic
+//    app/info.cpp (their description), compare/models.cpp (the analytic
 //    models' stand-in for its fibers);
 // 3. its tests: its own file(s) in tests/sim/ (an oracle for its normals;
 //    the microfacet models: six), listed in tests/CMakeLists.txt, and a case
