@@ -125,6 +125,7 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
     p = atlas_start_params(config, fiber, name);
   } catch (const Error& e) {
     m.status = std::string("not applicable: ") + e.what();
+    if (config.per_lobe) m.lobe_fit_status = "not fitted lobe by lobe: not applicable";
     say(control, fmt::format("  {}: {}", name, m.status));
     return m;
   }
