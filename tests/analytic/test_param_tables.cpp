@@ -87,6 +87,7 @@ TEST(ParamTables, AKeyOfOneModelIsRefusedByAnother) {
 
 // One model's parameters given to another model's table or factory are
 // refused (fiberlab::Error naming the model), even for a key both have.
+// Mutation tried and caught: apply_setting() without the registry's check.
 TEST(ParamTables, AnotherModelsParametersAreRefused) {
   for (const ModelInfo& a : registered_models())
     for (const ModelInfo& b : registered_models()) {
