@@ -803,7 +803,8 @@ ModelInfo huang2022_info() {
   m.make = [](const P& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
   m.from_fiber = huang2022_from_fiber;
-  // The mesonormal's tilt moves the lobes as SPEC s7's shifts (to first order).
+  // The tilt is the fiber's cuticle tilt (same sign as scale_tilt): SPEC s7's
+  // shifts of it (rays through the fiber's centre), as for the simulator.
   m.theta_r_shifts = [](const P& p) { return tilt_shifts(p.tilt); };
   return define_model(std::move(m));
 }

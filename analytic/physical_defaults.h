@@ -111,14 +111,10 @@ double first_order_spread(double eta, int p);
 
 inline constexpr double kMinMarschnerBeta = 0.1 * 3.14159265358979323846 / 180.0;  // 0.1 deg
 
-}  // namespace fiberlab::analytic
-
-namespace fiberlab::analytic {
-
 // The part of every model's physical defaults that is the same for all:
-// eta, sigma_a, lobes copied into the model's struct P (each model's from
-// its own rule adds its tilt: the theta_r shifts tilt_shifts() of a model
-// with per-lobe shifts, the scale tilt itself of a model with one).
+// eta, sigma_a, lobes copied into the model's struct P (each model's own
+// rule adds its tilt: the theta_r shifts tilt_shifts() for a model with
+// per-lobe shifts, the scale tilt itself for a model with one).
 template <class P>
 void apply_fiber_basics(const PhysicalFiber& fiber, P& params) {
   params.eta = fiber.eta;
