@@ -68,14 +68,7 @@ LobeWidths gaussian_lobe_widths(double beta_long, double beta_azim, double eta, 
 
 namespace fiberlab::analytic {
 
-void apply_fiber_basics(const PhysicalFiber& f, ModelParams& p) {
-  p.eta = f.eta;
-  p.sigma_a = f.sigma_a;
-  p.lobes = f.lobes;
-  p.alpha = tilt_shifts(f.scale_tilt);
-}
-
-void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& p, const WidthCalibration& cal,
+void apply_fiber_roughness(const PhysicalFiber& fiber, LobeWidths& p, const WidthCalibration& cal,
                            FiberMapping& mapping, double min_beta_long) {
   PhysicalFiber f = fiber;
   if (f.microfacet()) {

@@ -111,20 +111,21 @@ double first_order_spread(double eta, int p);
 
 inline constexpr double kMinMarschnerBeta = 0.1 * 3.14159265358979323846 / 180.0;  // 0.1 deg
 
-}  // namespace fiberlab::analytic
-
-#include "analytic/model.h"
-
-namespace fiberlab::analytic {
-
 // The part of every model's physical defaults that is the same for all:
-// eta, sigma_a, lobes copied, alpha from the tilt (tilt_shifts).
-void apply_fiber_basics(const PhysicalFiber& fiber, ModelParams& params);
+// eta, sigma_a, lobes copied into the model's struct P (each model's own
+// rule adds its tilt: the theta_r shifts tilt_shifts() for a model with
+// per-lobe shifts, the scale tilt itself for a model with one).
+template <class P>
+void apply_fiber_basics(const PhysicalFiber& fiber, P& params) {
+  params.eta = fiber.eta;
+  params.sigma_a = fiber.sigma_a;
+  params.lobes = fiber.lobes;
+}
 // beta_long / beta_azim from the roughness (see the top of this file), in
 // the model's width variable; every beta_long at least min_beta_long.
 // A beckmann / ggx fiber goes through microfacet_as_gaussian() per axis, as
 // a gaussian fiber, and the mapping is noted in `mapping`.
-void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params,
+void apply_fiber_roughness(const PhysicalFiber& fiber, LobeWidths& widths,
                            const WidthCalibration& calibration, FiberMapping& mapping,
                            double min_beta_long = 0.0);
 

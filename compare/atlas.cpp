@@ -46,9 +46,9 @@ sim::ResultFile simulate(const sim::Settings& s, const AtlasControl& control) {
 }
 
 std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::string& name,
-                                        const analytic::ModelParams& p) {
+                                        const analytic::ModelParameters& p) {
   const auto model = compare::make_model(name, p);
-  return compare(r, predict_result(*model, r), p.alpha);
+  return compare(r, predict_result(*model, r), analytic::theta_r_shifts(name, p));
 }
 
 // "fitted (converged: why)", "fitted (at a bound: key = value; why)" or
@@ -120,7 +120,7 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
   AtlasModelResult m;
   m.model = name;  // the entry's name; `model` is the registered model it runs
   const std::string& model = registered_model(config, name);
-  analytic::ModelParams p;
+  analytic::ModelParameters p;
   try {
     p = atlas_start_params(config, fiber, name);
   } catch (const Error& e) {
@@ -162,11 +162,11 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
 
 }  // namespace
 
-analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+analytic::ModelParameters atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
                                          const std::string& entry) {
   const std::string& model = registered_model(config, entry);
   const auto fixed = config.model_parameters.find(entry);
-  const analytic::ModelParams p = params_for(
+  const analytic::ModelParameters p = params_for(
       fiber.settings,
       ModelSpec{model, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second, entry},
       {});

@@ -82,7 +82,7 @@ AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t fiber, c
 // fiber (ModelInfo::from_fiber) with the entry's fixed settings on top,
 // checked by the model. Throws fiberlab::Error when
 // the model refuses the fiber (then "not applicable").
-analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+analytic::ModelParameters atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
                                          const std::string& entry);
 
 // Summary per fiber, model and lobe, over every theta_i and channel.

@@ -262,7 +262,7 @@ std::vector<std::string> read_fixed_settings(const Reader& r, const YAML::Node& 
                            "value (fixed keys of {}: {})",
                            path, spec->key, model, fmt::join(fixed, ", ")));
   only_keys(r, settings, path, fixed);
-  analytic::ModelParams p = analytic::default_params(model);
+  analytic::ModelParameters p = analytic::default_params(model);
   for (const auto& setting : settings) {
     const std::string key = setting.first.Scalar();
     const analytic::ParamSpec* spec = analytic::find_param(table, key);

@@ -27,16 +27,16 @@ inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::Roug
 using sim::testing::run;
 
 // Model params for a result (analytic/physical_defaults.h, via compare::params_for) plus --set overrides.
-inline analytic::ModelParams params(const sim::ResultFile& r, const std::string& model,
+inline analytic::ModelParameters params(const sim::ResultFile& r, const std::string& model,
                                     const std::vector<std::string>& settings = {}) {
   return params_for(r.settings, parse_model_spec(model), settings);
 }
 
 inline std::vector<LobeComparison> compare_with(const sim::ResultFile& r, const std::string& model,
                                                 const std::vector<std::string>& settings = {}) {
-  const analytic::ModelParams p = params(r, model, settings);
-  const auto m = make_model(parse_model_spec(model).name, p);
-  return compare(r, predict_result(*m, r), p.alpha);
+  const analytic::ModelParameters p = params(r, model, settings);
+  const auto m = compare::make_model(parse_model_spec(model).name, p);
+  return compare(r, predict_result(*m, r), compare::theta_r_shifts(parse_model_spec(model).name, p));
 }
 
 // The acceptance rule of `fiberlab compare` without --max-chi2: chi2/dof

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "analytic/huang2022.h"
 #include "common/error.h"
 #include "common/units.h"
 #include "analytic/model_registry.h"
@@ -147,10 +148,10 @@ TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
   ASSERT_EQ(fiber.roughness_model, "ggx");
   ASSERT_EQ(fiber.roughness, 0.3);
   ASSERT_EQ(fiber.settings.fiber.eccentricity, 0.85);
-  const analytic::ModelParams p =
+  const analytic::ModelParameters p =
       params_for(fiber.settings, ModelSpec{"huang2022", c.model_parameters.at("huang2022"), "huang2022"}, {});
-  analytic::ModelParams reference = p;
-  reference.quadrature_points = 4 * p.quadrature_points;
+  analytic::ModelParameters reference = p;
+  reference.as<analytic::Huang2022Params>().quadrature_points = 4 * p.as<analytic::Huang2022Params>().quadrature_points;
   const sim::TallySettings& t = fiber.settings.tally;
   const BinGrid grid = BinGrid::make(t.n_theta, t.n_phi, t.theta_bins);
   const double theta_i = deg_to_rad(45.0), photons = static_cast<double>(fiber.settings.photons);

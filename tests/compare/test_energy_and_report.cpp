@@ -33,7 +33,7 @@ TEST(Energy, WhiteFiberFurnace) {
   const sim::ResultFile r = testing::run(s);
   const EnergyCurve sim_e = simulation_energy(r);
   auto curve = [&](const std::string& spec, const std::vector<std::string>& set) {
-    const analytic::ModelParams p = testing::params(r, spec, set);
+    const analytic::ModelParameters p = testing::params(r, spec, set);
     return model_energy(*make_model(parse_model_spec(spec).name, p), spec, r.theta_i, 90, 45);
   };
   const EnergyCurve deon = curve("deon2011", {"r_fresnel=per_h"});

@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analytic/huang2022.h"
 #include "compare_test_support.h"
 
 namespace fiberlab::compare {
@@ -42,8 +43,8 @@ void expect_accepted(const std::vector<LobeComparison>& cs) {
 
 TEST(Huang2022VsSimulation, SmoothEllipseIsTheZeroRoughnessLimit) {
   const sim::ResultFile r = testing::run(ellipse(40.0, 0.0));
-  const analytic::ModelParams p = testing::params(r, "huang2022", {"quadrature_points=262144"});
-  EXPECT_EQ(p.ggx_roughness, 0.0);  // smooth config -> the model's exact limit
+  const analytic::ModelParameters p = testing::params(r, "huang2022", {"quadrature_points=262144"});
+  EXPECT_EQ(p.as<analytic::Huang2022Params>().roughness, 0.0);  // smooth config -> the model's exact limit
   expect_accepted(testing::compare_with(r, "huang2022", {"quadrature_points=262144"}));
 }
 
