@@ -374,7 +374,7 @@ struct FitArrays {
 // as fit_model made them: `start` with each key set to its fitted value.
 FitResult fit_from(const Reader& r, const double* n, const std::vector<double>& values, std::size_t& value_at,
                    const std::vector<std::string>& keys, const std::string& model,
-                   const analytic::ModelParams& start, const std::string& where) {
+                   const analytic::ModelParameters& start, const std::string& where) {
   FitResult fit;
   fit.keys = keys;
   fit.chi2_start = n[0];
@@ -415,7 +415,7 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
   if (fits.keys[at.fit] != joined(keys, ","))
     r.fail(fmt::format("{}: fit keys {} are not {}'s free keys {}", where, fits.keys[at.fit], model,
                        joined(keys, ",")));
-  analytic::ModelParams start;
+  analytic::ModelParameters start;
   try {
     start = atlas_start_params(config, fiber, entry);
   } catch (const Error& e) {
