@@ -721,35 +721,32 @@ double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
                             why));
   };
   double alpha = 0.0;
-  switch (f.roughness) {
-    case PhysicalFiber::Roughness::Smooth: return 0.0;
-    case PhysicalFiber::Roughness::ExitBlur: return refuse("an exit_blur fiber has no microfacets");
-    case PhysicalFiber::Roughness::GGX:
-    case PhysicalFiber::Roughness::Beckmann:
-      if (f.alpha_long != f.alpha_azim)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      alpha = f.alpha_long;
-      if (f.roughness == PhysicalFiber::Roughness::Beckmann)
-        // Beckmann and GGX of the same alpha have the same density at the
-        // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
-        mapping.notes.push_back(fmt::format(
-            "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
-            "tails differ)",
-            f.roughness_text()));
-      break;
-    case PhysicalFiber::Roughness::Gaussian: {
-      const double bl = for_lobe(f.beta_long, 0), ba = f.beta_azim.empty() ? bl : for_lobe(f.beta_azim, 0);
-      if (bl != ba)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      // Equal density at the mean normal: a Gaussian tilt of sd beta per
-      // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
-      alpha = std::sqrt(2.0) * std::tan(bl);
+  if (std::holds_alternative<roughness::Smooth>(f.roughness)) return 0.0;
+  if (std::holds_alternative<roughness::ExitBlur>(f.roughness))
+    return refuse("an exit_blur fiber has no microfacets");
+  if (const auto* m = microfacet_alpha(f.roughness)) {
+    if (m->alpha_long != m->alpha_azim)
+      return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+    alpha = m->alpha_long;
+    if (std::holds_alternative<roughness::Beckmann>(f.roughness))
+      // Beckmann and GGX of the same alpha have the same density at the
+      // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
       mapping.notes.push_back(fmt::format(
-          "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
-          "normal)",
-          f.roughness_text(), alpha));
-      break;
-    }
+          "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
+          "tails differ)",
+          f.roughness_text()));
+  }
+  if (const auto* g = std::get_if<roughness::Gaussian>(&f.roughness)) {
+    const double bl = g->beta_long, ba = g->beta_azim;
+    if (bl != ba)
+      return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+    // Equal density at the mean normal: a Gaussian tilt of sd beta per
+    // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+    alpha = std::sqrt(2.0) * std::tan(bl);
+    mapping.notes.push_back(fmt::format(
+        "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
+        "normal)",
+        f.roughness_text(), alpha));
   }
   if (!(alpha >= 0.0 && alpha <= 1.0))
     return refuse(fmt::format("{} gives alpha = {:g}, outside [0, 1]", f.roughness_text(), alpha));

@@ -23,12 +23,6 @@ namespace fiberlab::cli {
 
 namespace {
 
-std::string degrees(const std::vector<double>& radians) {
-  std::string s;
-  for (double r : radians) s += fmt::format("{}{:g}", s.empty() ? "" : ", ", rad_to_deg(r));
-  return "[" + s + "]";
-}
-
 void result_info(const std::string& path) {
   const sim::ResultFile r = sim::read_result(path);
   const sim::Settings& s = r.settings;
@@ -38,13 +32,7 @@ void result_info(const std::string& path) {
   fmt::print("seeds: {}\n", seeds);
   fmt::print("fiber: eta {}, eccentricity {}, scale_tilt {:g} deg, sigma_a {}\n", s.fiber.eta,
              s.fiber.eccentricity, rad_to_deg(s.fiber.scale_tilt), fmt::join(s.fiber.sigma_a, ", "));
-  if (s.roughness.microfacet())
-    fmt::print("roughness: {}, alpha_long {}, alpha_azim {}, masking {}\n",
-               sim::to_string(s.roughness.model), s.roughness.alpha_long, s.roughness.alpha_azim,
-               sim::to_string(s.roughness.masking));
-  else
-    fmt::print("roughness: {}, beta_long {} deg, beta_azim {} deg\n", sim::to_string(s.roughness.model),
-               degrees(s.roughness.beta_long), degrees(s.roughness.beta_azim));
+  fmt::print("roughness: {}\n", roughness::describe(s.fiber.roughness));
   fmt::print("tally: {} x {} bins ({} theta), {} lobes, {} channels; max_segments {}, polarization {}\n",
              r.grid.n_theta(), r.grid.n_phi(), to_string(r.grid.theta_binning), r.lobes, r.channels,
              s.max_segments, sim::to_string(s.polarization));
