@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
+#include <variant>
 
 #include "common/units.h"
 
@@ -77,21 +79,29 @@ void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& p, const Wid
         "atan(alpha / sqrt 2) = [{:g}, {:g}] deg, then the calibrated rule (nominal: fit or --set the widths)",
         fiber.roughness_text(), rad_to_deg(g.beta_long), rad_to_deg(g.beta_azim)));
   }
-  if (const auto* e = std::get_if<roughness::ExitBlur>(&f.roughness)) {
-    // SPEC s3: the exit blur's vMF is d'Eon's M_p (a theta_r width); a
-    // theta_h Gaussian needs half of it.
-    p.beta_long = e->beta_long;
-    if (cal.variable == WidthVariable::ThetaH)
-      for (double& b : p.beta_long) b *= 0.5;
-    p.beta_azim = e->beta_azim;
-  } else if (std::holds_alternative<roughness::Smooth>(f.roughness)) {
-    p.beta_long = {0.0};
-    p.beta_azim = {0.0};
-  } else if (const auto* g = std::get_if<roughness::Gaussian>(&f.roughness)) {
-    const LobeWidths w = gaussian_lobe_widths(g->beta_long, g->beta_azim, f.eta, f.lobes, cal);
-    p.beta_long = w.beta_long;
-    p.beta_azim = w.beta_azim;
-  }
+  // Every roughness type has its rule here: a type without one does not compile.
+  std::visit(
+      [&](const auto& g) {
+        using G = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<G, roughness::ExitBlur>) {
+          // SPEC s3: the exit blur's vMF is d'Eon's M_p (a theta_r width); a
+          // theta_h Gaussian needs half of it.
+          p.beta_long = g.beta_long;
+          if (cal.variable == WidthVariable::ThetaH)
+            for (double& b : p.beta_long) b *= 0.5;
+          p.beta_azim = g.beta_azim;
+        } else if constexpr (std::is_same_v<G, roughness::Smooth>) {
+          p.beta_long = {0.0};
+          p.beta_azim = {0.0};
+        } else if constexpr (std::is_same_v<G, roughness::Gaussian>) {
+          const LobeWidths w = gaussian_lobe_widths(g.beta_long, g.beta_azim, f.eta, f.lobes, cal);
+          p.beta_long = w.beta_long;
+          p.beta_azim = w.beta_azim;
+        } else {
+          static_assert(std::is_base_of_v<roughness::MicrofacetAlpha, G>, "a roughness type without a rule");
+        }  // microfacet: read as gaussian above
+      },
+      f.roughness);
   for (double& b : p.beta_long) b = std::max(b, min_beta_long);
 }
 
