@@ -1,6 +1,7 @@
 #include "common/roughness/roughness.h"
 
 #include <algorithm>
+#include <type_traits>
 
 #include <fmt/format.h>
 
@@ -33,6 +34,23 @@ Roughness read_model(const std::variant<Models...>*, std::size_t i, const config
   return readers[i](r, n);
 }
 
+// After the model's own read (which names the other models' keys it meets
+// in its own words): any key the model does not take is refused, so a key of
+// another model is never dropped. `masking: none` means no masking for
+// every model (microfacet.h).
+void refuse_other_keys(const config::Reader& r, const YAML::Node& n, const Roughness& g) {
+  const std::vector<std::string>& own = std::visit([](const auto& m) -> const std::vector<std::string>& {
+    return std::decay_t<decltype(m)>::keys();
+  }, g);
+  for (const auto& kv : n) {
+    const std::string key = kv.first.Scalar();
+    if (key == "model" || std::find(own.begin(), own.end(), key) != own.end()) continue;
+    if (key == "masking" && kv.second.IsScalar() && kv.second.Scalar() == "none") continue;
+    r.bad("roughness." + key, kv.second, "is not allowed for model " + name(g),
+          fmt::format("model {} takes {}", name(g), own.empty() ? "no other key" : config::join(own)));
+  }
+}
+
 constexpr const Roughness* kVariant = nullptr;
 
 }  // namespace
@@ -43,7 +61,9 @@ Roughness read(const config::Reader& r, const YAML::Node& config) {
   const std::size_t model =
       n["model"] ? r.word(n["model"], "roughness.model", names)
                  : static_cast<std::size_t>(Roughness(Gaussian{}).index());
-  return read_model(kVariant, model, r, n);
+  const Roughness g = read_model(kVariant, model, r, n);
+  refuse_other_keys(r, n, g);
+  return g;
 }
 
 std::string name(const Roughness& g) {
