@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
+#include <variant>
 
 #include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
@@ -704,37 +706,40 @@ double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
                             "(alpha in [0, 1]), or --set roughness=A",
                             why));
   };
-  double alpha = 0.0;
-  switch (f.roughness) {
-    case PhysicalFiber::Roughness::Smooth: return 0.0;
-    case PhysicalFiber::Roughness::ExitBlur: return refuse("an exit_blur fiber has no microfacets");
-    case PhysicalFiber::Roughness::GGX:
-    case PhysicalFiber::Roughness::Beckmann:
-      if (f.alpha_long != f.alpha_azim)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      alpha = f.alpha_long;
-      if (f.roughness == PhysicalFiber::Roughness::Beckmann)
-        // Beckmann and GGX of the same alpha have the same density at the
-        // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
-        mapping.notes.push_back(fmt::format(
-            "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
-            "tails differ)",
-            f.roughness_text()));
-      break;
-    case PhysicalFiber::Roughness::Gaussian: {
-      const double bl = for_lobe(f.beta_long, 0), ba = f.beta_azim.empty() ? bl : for_lobe(f.beta_azim, 0);
-      if (bl != ba)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      // Equal density at the mean normal: a Gaussian tilt of sd beta per
-      // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
-      alpha = std::sqrt(2.0) * std::tan(bl);
-      mapping.notes.push_back(fmt::format(
-          "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
-          "normal)",
-          f.roughness_text(), alpha));
-      break;
-    }
-  }
+  // Every roughness type has its rule here: a type without one does not compile.
+  const double alpha = std::visit(
+      [&](const auto& g) -> double {
+        using G = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<G, roughness::Smooth>) {
+          return 0.0;
+        } else if constexpr (std::is_same_v<G, roughness::ExitBlur>) {
+          return refuse("an exit_blur fiber has no microfacets");
+        } else if constexpr (std::is_base_of_v<roughness::MicrofacetAlpha, G>) {
+          if (g.alpha_long != g.alpha_azim)
+            return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+          if constexpr (std::is_same_v<G, roughness::Beckmann>)
+            // Beckmann and GGX of the same alpha have the same density at the
+            // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
+            mapping.notes.push_back(fmt::format(
+                "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
+                "tails differ)",
+                f.roughness_text()));
+          return g.alpha_long;
+        } else {
+          static_assert(std::is_same_v<G, roughness::Gaussian>, "a roughness type without a rule");
+          if (g.beta_long != g.beta_azim)
+            return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+          // Equal density at the mean normal: a Gaussian tilt of sd beta per
+          // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+          const double a = std::sqrt(2.0) * std::tan(g.beta_long);
+          mapping.notes.push_back(fmt::format(
+              "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
+              "normal)",
+              f.roughness_text(), a));
+          return a;
+        }
+      },
+      f.roughness);
   if (!(alpha >= 0.0 && alpha <= 1.0))
     return refuse(fmt::format("{} gives alpha = {:g}, outside [0, 1]", f.roughness_text(), alpha));
   return alpha;

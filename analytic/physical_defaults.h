@@ -28,24 +28,17 @@
 #include <string>
 #include <vector>
 
+#include "common/fiber.h"
+
 namespace fiberlab::analytic {
 
-struct PhysicalFiber {
-  enum class Roughness { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
-  double eta = 1.55;
-  double eccentricity = 1.0;
-  double scale_tilt = 0.0;  // radians, towards the root
-  std::vector<double> sigma_a{0.0, 0.0, 0.0};
-  Roughness roughness = Roughness::Smooth;
-  std::vector<double> beta_long{0.0};  // radians; indexed by p for exit_blur
-  std::vector<double> beta_azim;       // radians; empty: beta_long
-  // beckmann / ggx: the facets' roughness along the fiber axis and about it.
-  double alpha_long = 0.0, alpha_azim = 0.0;
+// What a model's rule is given: the simulated fiber (common/fiber.h) and the
+// number of lobes its tally separates.
+struct PhysicalFiber : Fiber {
   int lobes = 4;
 
-  bool microfacet() const { return roughness == Roughness::Beckmann || roughness == Roughness::GGX; }
   // "ggx alpha = [0.3, 0.1]": the roughness as the config gives it, for notes and errors.
-  std::string roughness_text() const;
+  std::string roughness_text() const { return roughness::text(roughness); }
 };
 
 // What a model's rule (ModelInfo::from_fiber) knows and says besides the
@@ -57,6 +50,9 @@ struct FiberMapping {
   std::vector<std::string> notes;
   bool user_sets(const std::string& key) const;
 };
+
+// The alpha of a beckmann or ggx fiber; null for the other roughness models.
+const roughness::MicrofacetAlpha* microfacet_alpha(const Roughness& g);
 
 // The gaussian fiber of the same RMS facet slope per axis: Beckmann's slopes
 // are Normal(0, alpha^2 / 2) per axis, so beta = atan(alpha / sqrt 2). A

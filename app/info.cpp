@@ -6,6 +6,7 @@
 #include "common/error.h"
 #include "common/h5_file.h"
 #include "common/result_layout.h"
+#include "common/roughness/roughness.h"
 #include "common/units.h"
 #include "compare/atlas_checkpoint.h"
 #include "compare/atlas_file.h"
@@ -16,12 +17,6 @@
 namespace fiberlab::app {
 
 namespace {
-
-std::string degrees(const std::vector<double>& radians) {
-  std::string s;
-  for (double r : radians) s += fmt::format("{}{:g}", s.empty() ? "" : ", ", rad_to_deg(r));
-  return "[" + s + "]";
-}
 
 FileDescription result_info(const std::string& path) {
   FileDescription d;
@@ -35,13 +30,7 @@ FileDescription result_info(const std::string& path) {
   t += fmt::format("seeds: {}\n", seeds);
   t += fmt::format("fiber: eta {}, eccentricity {}, scale_tilt {:g} deg, sigma_a {}\n", s.fiber.eta,
                    s.fiber.eccentricity, rad_to_deg(s.fiber.scale_tilt), fmt::join(s.fiber.sigma_a, ", "));
-  if (s.roughness.microfacet())
-    t += fmt::format("roughness: {}, alpha_long {}, alpha_azim {}, masking {}\n",
-                     sim::to_string(s.roughness.model), s.roughness.alpha_long, s.roughness.alpha_azim,
-                     sim::to_string(s.roughness.masking));
-  else
-    t += fmt::format("roughness: {}, beta_long {} deg, beta_azim {} deg\n", sim::to_string(s.roughness.model),
-                     degrees(s.roughness.beta_long), degrees(s.roughness.beta_azim));
+  t += fmt::format("roughness: {}\n", roughness::describe(s.fiber.roughness));
   t += fmt::format("tally: {} x {} bins ({} theta), {} lobes, {} channels; max_segments {}, polarization {}\n",
                    r.grid.n_theta(), r.grid.n_phi(), to_string(r.grid.theta_binning), r.lobes, r.channels,
                    s.max_segments, sim::to_string(s.polarization));

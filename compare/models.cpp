@@ -43,25 +43,8 @@ std::vector<double> theta_r_shifts(const std::string& name, const analytic::Mode
 
 analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
   analytic::PhysicalFiber f;
-  f.eta = s.fiber.eta;
-  f.eccentricity = s.fiber.eccentricity;
-  f.scale_tilt = s.fiber.scale_tilt;
-  f.sigma_a = s.fiber.sigma_a;
+  static_cast<Fiber&>(f) = s.fiber;
   f.lobes = s.tally.lobes;
-  switch (s.roughness.model) {
-    case sim::RoughnessModel::Smooth: f.roughness = analytic::PhysicalFiber::Roughness::Smooth; break;
-    case sim::RoughnessModel::Gaussian: f.roughness = analytic::PhysicalFiber::Roughness::Gaussian; break;
-    case sim::RoughnessModel::ExitBlur: f.roughness = analytic::PhysicalFiber::Roughness::ExitBlur; break;
-    case sim::RoughnessModel::Beckmann: f.roughness = analytic::PhysicalFiber::Roughness::Beckmann; break;
-    case sim::RoughnessModel::GGX: f.roughness = analytic::PhysicalFiber::Roughness::GGX; break;
-  }
-  if (f.microfacet()) {
-    f.alpha_long = s.roughness.alpha_long;
-    f.alpha_azim = s.roughness.alpha_azim;
-  } else {
-    f.beta_long = s.roughness.beta_long;
-    f.beta_azim = s.roughness.beta_azim;
-  }
   return f;
 }
 

@@ -17,10 +17,10 @@ namespace fiberlab::compare::testing {
 
 // A white circular fiber without tilt (the simulator tests' smooth circle,
 // seed 4242); `model` picks roughness.
-inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::RoughnessModel model) {
+inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, const Roughness& model) {
   sim::Settings s = sim::testing::smooth_circle(theta_i_deg, photons);
   s.seed = 4242;
-  s.roughness.model = model;
+  s.fiber.roughness = model;
   return s;
 }
 

@@ -26,12 +26,12 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   // Roughness slowest, eccentricity fastest.
   EXPECT_EQ(full.fibers[1].settings.fiber.eccentricity, 0.85);
   EXPECT_EQ(full.fibers[8].roughness, 10.0);
-  EXPECT_NEAR(full.fibers[8].settings.roughness.beta_long[0], deg_to_rad(10.0), 1e-15);
+  EXPECT_NEAR(std::get<fiberlab::roughness::Gaussian>(full.fibers[8].settings.fiber.roughness).beta_long, deg_to_rad(10.0), 1e-15);
   // Microfacet entries go through the simulator's parser as they are.
   EXPECT_EQ(full.fibers[16].roughness_model, "ggx");
   EXPECT_EQ(full.fibers[16].roughness, 0.1);
-  EXPECT_EQ(full.fibers[16].settings.roughness.model, sim::RoughnessModel::GGX);
-  EXPECT_EQ(full.fibers[24].settings.roughness.masking, sim::Masking::SmithG1);
+  EXPECT_TRUE(std::holds_alternative<fiberlab::roughness::Ggx>(full.fibers[16].settings.fiber.roughness));
+  EXPECT_EQ(fiberlab::roughness::masking(full.fibers[24].settings.fiber.roughness), Masking::SmithG1);
   // Melanin: three channels, sigma_a derived by the simulator.
   EXPECT_EQ(full.fibers[4].settings.fiber.sigma_a.size(), 3u);
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());

@@ -30,7 +30,7 @@ double theta_spread(const std::vector<double>& m, const BinGrid& g, int lobe, in
 }
 
 TEST(CalibratedWidths, DefaultLobeSpreadsWithin25PercentOnHeldOutFiber) {
-  sim::Settings s = testing::circle(-19.0, 200000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(-19.0, 200000, fiberlab::roughness::Gaussian{});
   sim::testing::make_rough(s, 6.0);
   s.fiber.sigma_a = {0.2};
   s.source.theta_i = {deg_to_rad(-19.0), deg_to_rad(43.0)};

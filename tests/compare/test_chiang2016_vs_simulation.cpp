@@ -15,7 +15,7 @@ namespace fiberlab::compare {
 namespace {
 
 TEST(Chiang2016VsSimulation, SmoothCircleIsTheZeroRoughnessLimit) {
-  sim::Settings s = testing::circle(35.0, 1000000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 1000000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   const sim::ResultFile r = testing::run(s);
   const analytic::ModelParameters p = testing::params(r, "chiang2016");

@@ -18,11 +18,8 @@
 namespace fiberlab::compare {
 namespace {
 
-sim::Settings microfacet_fiber(sim::RoughnessModel model, double alpha_long, double alpha_azim) {
-  sim::Settings s = testing::circle(30.0, 1000, model);
-  s.roughness.alpha_long = alpha_long;
-  s.roughness.alpha_azim = alpha_azim;
-  return s;
+sim::Settings microfacet_fiber(sim::MicrofacetModel model, double alpha_long, double alpha_azim) {
+  return testing::circle(30.0, 1000, sim::testing::microfacet(model, alpha_long, alpha_azim));
 }
 
 std::string refusal(const sim::Settings& s, const std::string& model) {
@@ -40,7 +37,7 @@ TEST(FiberToModel, IsotropicGgxFiberIsHuangsRoughnessItself) {
   for (double alpha : {0.1, 0.3, 0.7}) {
     std::vector<std::string> notes;
     const analytic::ModelParameters p =
-        params_for(microfacet_fiber(sim::RoughnessModel::GGX, alpha, alpha), parse_model_spec("huang2022"), {}, &notes);
+        params_for(microfacet_fiber(sim::MicrofacetModel::GGX, alpha, alpha), parse_model_spec("huang2022"), {}, &notes);
     EXPECT_EQ(p.as<analytic::Huang2022Params>().roughness, alpha);
     EXPECT_TRUE(notes.empty()) << notes.front();  // the same distribution: nothing approximated
   }
@@ -50,7 +47,7 @@ TEST(FiberToModel, IsotropicGgxFiberIsHuangsRoughnessItself) {
 // isotropic one: huang2022 refuses it, naming the field and what it allows;
 // with --set roughness the user's choice stands.
 TEST(FiberToModel, AnisotropicGgxFiberIsRefusedByHuang) {
-  const sim::Settings s = microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.1);
+  const sim::Settings s = microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.1);
   const std::string why = refusal(s, "huang2022");
   EXPECT_NE(why.find("roughness"), std::string::npos) << why;
   EXPECT_NE(why.find("anisotropic"), std::string::npos) << why;
@@ -60,12 +57,12 @@ TEST(FiberToModel, AnisotropicGgxFiberIsRefusedByHuang) {
   EXPECT_EQ(params_for(s, parse_model_spec("huang2022:roughness=0.25"), {}).as<analytic::Huang2022Params>().roughness,
             0.25);
   // The same for the other fibers it has no isotropic GGX for.
-  EXPECT_NE(refusal(microfacet_fiber(sim::RoughnessModel::Beckmann, 0.3, 0.1), "huang2022").find("anisotropic"),
+  EXPECT_NE(refusal(microfacet_fiber(sim::MicrofacetModel::Beckmann, 0.3, 0.1), "huang2022").find("anisotropic"),
             std::string::npos);
-  EXPECT_NE(refusal(microfacet_fiber(sim::RoughnessModel::GGX, 2.0, 2.0), "huang2022").find("outside [0, 1]"),
+  EXPECT_NE(refusal(microfacet_fiber(sim::MicrofacetModel::GGX, 2.0, 2.0), "huang2022").find("outside [0, 1]"),
             std::string::npos);
-  sim::Settings blur = testing::circle(30.0, 1000, sim::RoughnessModel::ExitBlur);
-  blur.roughness.beta_long = {deg_to_rad(5.0)};
+  sim::Settings blur = testing::circle(30.0, 1000, fiberlab::roughness::ExitBlur{});
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(blur).beta_long = {deg_to_rad(5.0)};
   EXPECT_NE(refusal(blur, "huang2022").find("exit_blur"), std::string::npos);
   EXPECT_EQ(params_for(blur, parse_model_spec("huang2022"), {"roughness=0.1"}).as<analytic::Huang2022Params>().roughness,
             0.1);
@@ -77,10 +74,10 @@ TEST(FiberToModel, AnisotropicGgxFiberIsRefusedByHuang) {
 TEST(FiberToModel, GaussianWidthModelsKeepTheAzimuthalAlphaAndStateTheMapping) {
   for (const std::string model : {"deon2011", "chiang2016", "marschner2003"}) {
     std::vector<std::string> notes;
-    const analytic::ModelParameters aniso = params_for(microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.1),
+    const analytic::ModelParameters aniso = params_for(microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.1),
                                                    parse_model_spec(model), {}, &notes);
     const analytic::ModelParameters iso =
-        params_for(microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.3), parse_model_spec(model), {});
+        params_for(microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.3), parse_model_spec(model), {});
     ASSERT_EQ(notes.size(), 1u) << model;
     EXPECT_NE(notes.front().find("ggx alpha = [0.3, 0.1]"), std::string::npos) << notes.front();
     if (model == "chiang2016") {

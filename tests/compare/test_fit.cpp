@@ -21,9 +21,9 @@ namespace {
 // exit_blur, no tilt, one beta_long for every lobe (8 deg): fit beta_long
 // of d'Eon (exact for this design, see test_compare_models.cpp) from 5 deg.
 TEST(Fit, RecoversExitBlurBetaLong) {
-  sim::Settings s = testing::circle(2.0, 300000, sim::RoughnessModel::ExitBlur);
-  s.roughness.beta_long = {deg_to_rad(8.0)};
-  s.roughness.beta_azim = {deg_to_rad(15.0)};
+  sim::Settings s = testing::circle(2.0, 300000, fiberlab::roughness::ExitBlur{});
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(8.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(15.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 36;
   const sim::ResultFile r = testing::run(s);
@@ -41,7 +41,7 @@ TEST(Fit, RecoversExitBlurBetaLong) {
 
 // Smooth circle against the exact model: fit eta from 1.50.
 TEST(Fit, RecoversEtaOfSmoothCircle) {
-  sim::Settings s = testing::circle(35.0, 500000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 500000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   s.tally.n_phi = 90;
   const sim::ResultFile r = testing::run(s);
@@ -62,10 +62,10 @@ TEST(Fit, RecoversEtaOfSmoothCircle) {
 // (SPEC s7: about -1.2a for the mean). The test checks the fit lands
 // between -2.2a and -0.6a with a small error, and prints what it measured.
 TEST(Fit, MeasuresTiltShiftOfR) {
-  sim::Settings s = testing::circle(2.0, 300000, sim::RoughnessModel::ExitBlur);
+  sim::Settings s = testing::circle(2.0, 300000, fiberlab::roughness::ExitBlur{});
   s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.beta_long = {deg_to_rad(4.0)};
-  s.roughness.beta_azim = {deg_to_rad(15.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(4.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(15.0)};
   s.tally.n_theta = 90;
   s.tally.n_phi = 36;
   const sim::ResultFile r = testing::run(s);
@@ -126,9 +126,9 @@ TEST(Fit, ScaleTiltIsTheShiftRule) {
 // threads give the same fit to the last bit. Three incident directions and
 // three keys: an odd number of tasks for two threads.
 TEST(Fit, SameForAnyThreadCount) {
-  sim::Settings s = testing::circle(20.0, 40000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(20.0, 40000, fiberlab::roughness::Gaussian{});
   s.source.theta_i = {deg_to_rad(20.0), deg_to_rad(45.0), deg_to_rad(70.0)};
-  s.roughness.beta_long = {deg_to_rad(10.0)};
+  sim::testing::roughness_of<fiberlab::roughness::Gaussian>(s).beta_long = {deg_to_rad(10.0)};
   s.tally.n_theta = 18;
   s.tally.n_phi = 24;
   const sim::ResultFile r = testing::run(s);

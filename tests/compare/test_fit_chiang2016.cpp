@@ -26,7 +26,7 @@ namespace {
 // A result with the layout of `s` whose tallies are a multinomial draw of
 // `photons` photons per incident direction from `model` (white fiber).
 sim::ResultFile synthetic_result(const analytic::ModelParameters& truth, std::uint64_t photons, std::uint64_t seed) {
-  sim::Settings s = testing::circle(25.0, 4096, sim::RoughnessModel::Smooth);  // the layout only
+  sim::Settings s = testing::circle(25.0, 4096, fiberlab::roughness::Smooth{});  // the layout only
   s.source.theta_i = {deg_to_rad(25.0), deg_to_rad(55.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 72;

@@ -40,7 +40,7 @@ sim::ResultFile synthetic(sim::ResultFile r, const std::string& model, const ana
 }
 
 sim::ResultFile template_result(double theta_i_deg, double tilt_deg) {
-  sim::Settings s = testing::circle(theta_i_deg, 2000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(theta_i_deg, 2000, fiberlab::roughness::Gaussian{});
   s.fiber.scale_tilt = deg_to_rad(tilt_deg);
   s.tally.n_theta = 24;
   s.tally.n_phi = 36;

@@ -20,7 +20,7 @@ namespace fiberlab::compare {
 namespace {
 
 sim::Settings ellipse(double theta_i_deg, double tilt_deg) {
-  sim::Settings s = testing::circle(theta_i_deg, 400000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(theta_i_deg, 400000, fiberlab::roughness::Smooth{});
   s.fiber.eccentricity = 0.7;
   s.fiber.scale_tilt = deg_to_rad(tilt_deg);
   s.fiber.sigma_a = {0.3};
