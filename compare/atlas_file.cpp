@@ -259,21 +259,30 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
 }  // namespace
 
 void write_atlas_axis_names(h5::File& f, const AtlasConfig& config) {
+  // A fiber with a medulla has one lobe more, `scattered` (docs/FUR.md): the
+  // file's lobe axis is the longest, NaN where a fiber has no such lobe.
   int lobes = 0, channels = 0;
-  bool from_melanin = true;
+  bool from_melanin = true, scattered = false;
   for (const AtlasFiber& fiber : config.fibers) {
-    lobes = std::max(lobes, fiber.settings.tally.lobes);
+    const bool medulla = fiber.settings.fiber.medulla.has_value();
+    lobes = std::max(lobes, fiber.settings.tally.lobes + (medulla ? 1 : 0));
+    scattered = scattered || medulla;
     channels = std::max(channels, static_cast<int>(fiber.settings.fiber.sigma_a.size()));
     from_melanin = from_melanin && fiber.settings.fiber.eumelanin.has_value();
   }
-  write_axis_names(f, lobes, channels, from_melanin);
+  write_axis_names(f, lobes, channels, from_melanin, scattered);
 }
 
 void write_atlas_file(const std::string& path, const AtlasConfig& config,
                       const std::vector<AtlasFiberResult>& fibers) {
   if (fibers.empty()) throw Error("atlas: no fiber was simulated");
-  Shape s{fibers.size(), config.theta_i.size(), static_cast<hsize_t>(fibers[0].lobes), 1};
-  for (const auto& r : fibers) s.C = std::max<hsize_t>(s.C, r.channels);
+  // The longest lobe axis and the most channels of any fiber (a medulla adds
+  // the lobe `scattered`; absorption entries may differ in channels).
+  Shape s{fibers.size(), config.theta_i.size(), 1, 1};
+  for (const auto& r : fibers) {
+    s.L = std::max<hsize_t>(s.L, r.lobes);
+    s.C = std::max<hsize_t>(s.C, r.channels);
+  }
   AtomicOutput out(path);
   {
     h5::File f = h5::File::create(out.temp_path());
