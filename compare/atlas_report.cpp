@@ -81,35 +81,6 @@ void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
   out.commit();
 }
 
-// fit.per_lobe's headline: the joint fit's and the lobes' own fits' columns.
-std::string headline_with_lobe_fits(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
-  const int L = lobe_count(fibers);
-  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after joint fit | after per-lobe fit | "
-                  "median χ²/dof before | after joint fit | after per-lobe fit |\n"
-                  "|---|---|---|---|---|---|---|---|---|\n";
-  for (std::size_t m = 0; m < config.models.size(); ++m)
-    for (int l = 0; l < L; ++l) {
-      std::vector<double> eb, ea, el, cb, ca, cl;
-      int applicable = 0;
-      for (const auto& f : fibers) {
-        const AtlasModelResult& r = f.models[m];
-        if (!r.applicable) continue;
-        ++applicable;
-        const AtlasLobeSummary sum = summarize_lobe(r, l);
-        eb.push_back(sum.max_abs_energy_error);
-        if (r.fitted) ea.push_back(sum.max_abs_energy_error_after);
-        if (sum.lobe_fitted) el.push_back(sum.max_abs_energy_error_lobe_fit);
-        if (sum.dof_before > 0) cb.push_back(per_dof(sum.chi2_before, sum.dof_before));
-        if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
-        if (sum.lobe_fitted && sum.dof_lobe_fit > 0) cl.push_back(per_dof(sum.chi2_lobe_fit, sum.dof_lobe_fit));
-      }
-      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable,
-                       lobe_label(l, fibers), num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"),
-                       num(median(el), "{:.4f}"), num(median(cb)), num(median(ca)), num(median(cl)));
-    }
-  return s;
-}
-
 // fit.per_lobe: each lobe's own fitted values, or why the model was not
 // fitted lobe by lobe.
 std::string lobe_fitted_params(const AtlasModelResult& m, const std::vector<AtlasFiberResult>& fibers) {
@@ -127,14 +98,20 @@ std::string lobe_fitted_params(const AtlasModelResult& m, const std::vector<Atla
 
 }  // namespace
 
+// Per model and lobe, medians over the fibers; with fit.per_lobe also the
+// columns of the lobes' own fits beside the joint fit's.
 std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
-  if (config.per_lobe) return headline_with_lobe_fits(config, fibers);
+  const bool lobe_fits = config.per_lobe;
   const int L = lobe_count(fibers);
-  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | after fit |\n"
-                  "|---|---|---|---|---|---|---|\n";
+  std::string s = lobe_fits ? "| model | fibers | lobe | median max\\|ΔE\\| before | after joint fit | after per-lobe fit | "
+                              "median χ²/dof before | after joint fit | after per-lobe fit |\n"
+                              "|---|---|---|---|---|---|---|---|---|\n"
+                            : "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | "
+                              "after fit |\n"
+                              "|---|---|---|---|---|---|---|\n";
   for (std::size_t m = 0; m < config.models.size(); ++m)
     for (int l = 0; l < L; ++l) {
-      std::vector<double> eb, ea, cb, ca;
+      std::vector<double> eb, ea, el, cb, ca, cl;
       int applicable = 0;
       for (const auto& f : fibers) {
         const AtlasModelResult& r = f.models[m];
@@ -143,11 +120,17 @@ std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector
         const AtlasLobeSummary sum = summarize_lobe(r, l);
         eb.push_back(sum.max_abs_energy_error);
         if (r.fitted) ea.push_back(sum.max_abs_energy_error_after);
+        if (sum.lobe_fitted) el.push_back(sum.max_abs_energy_error_lobe_fit);
         if (sum.dof_before > 0) cb.push_back(per_dof(sum.chi2_before, sum.dof_before));
         if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
+        if (sum.lobe_fitted && sum.dof_lobe_fit > 0) cl.push_back(per_dof(sum.chi2_lobe_fit, sum.dof_lobe_fit));
       }
-      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable, lobe_label(l, fibers),
-                       num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"), num(median(cb)), num(median(ca)));
+      s += fmt::format("| {} | {} | {} | {} | {} |", config.models[m], applicable, lobe_label(l, fibers),
+                       num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"));
+      if (lobe_fits) s += fmt::format(" {} |", num(median(el), "{:.4f}"));
+      s += fmt::format(" {} | {} |", num(median(cb)), num(median(ca)));
+      if (lobe_fits) s += fmt::format(" {} |", num(median(cl)));
+      s += "\n";
     }
   return s;
 }
