@@ -453,7 +453,8 @@ std::size_t read_lobe_fits(const Reader& r, std::size_t F, const AtlasConfig& co
   for (std::size_t i = 0; i < F; ++i)
     for (std::size_t m = 0; m < M; ++m) {
       const std::uint64_t* st = &out.state[(i * M + m) * 2];
-      const std::uint64_t L = config.fibers[i].settings.tally.lobes, C = config.fibers[i].settings.fiber.sigma_a.size();
+      // tally_lobes(): a medulla's `scattered` lobe is fitted lobe by lobe too.
+      const std::uint64_t L = config.fibers[i].settings.tally_lobes(), C = config.fibers[i].settings.fiber.sigma_a.size();
       if (st[0] > L || st[1] > config.theta_i.size() * L * C)
         r.fail(fmt::format("lobe_fit_state of fiber {}, model {} is out of range", i + 1, config.models[m]));
       fits += st[0];
@@ -490,7 +491,8 @@ Stored read_stored(const Reader& r, std::size_t F, const AtlasConfig& config) {
   std::size_t energies = 0, rows = 0, fitted = 0, fitted_keys = 0;
   for (std::size_t i = 0; i < F; ++i) {
     const AtlasFiber& fiber = config.fibers[i];
-    const std::uint64_t L = fiber.settings.tally.lobes, C = fiber.settings.fiber.sigma_a.size();
+    // The result's lobes: the tally's, and `scattered` after them with a medulla (docs/FUR.md).
+    const std::uint64_t L = fiber.settings.tally_lobes(), C = fiber.settings.fiber.sigma_a.size();
     if (s.shape[2 * i] != L || s.shape[2 * i + 1] != C)
       r.fail(fmt::format("shape of fiber {} = ({}, {}) is not its config's (lobes {}, channels {})", i + 1,
                          s.shape[2 * i], s.shape[2 * i + 1], L, C));

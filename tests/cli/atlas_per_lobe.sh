@@ -78,13 +78,9 @@ grep -q "per-lobe fit: none; fiber 1: not fitted lobe by lobe: no per-lobe param
   || { echo "FAIL: info does not say why chiang2016 is not fitted lobe by lobe"; fail=1; }
 
 # 2. Interrupted once the first fiber is saved, then resumed.
-set -m
-"$fiberlab" atlas "$work/p.yaml" -o "$work/res.h5" --threads 1 >"$work/res.out" 2>"$work/res.err" &
-pid=$!
-set +m
-for _ in $(seq 1200); do [ -e "$work/res.checkpoint.h5" ] && break; sleep 0.1; done
-kill -INT "$pid"; wait "$pid"; code=$?
-[ "$code" = 130 ] || { echo "FAIL: interrupted atlas exited $code, not 130"; fail=1; }
+source "$source_dir/tests/cli/atlas_interrupt.sh"
+interrupt_atlas "$work/p.yaml" res INT "" --threads 1
+[ "$got" = 130 ] || { echo "FAIL: interrupted atlas exited $got, not 130"; fail=1; }
 "$fiberlab" info "$work/res.checkpoint.h5" | grep -q "1 of 2 fibers saved" || { echo "FAIL: checkpoint lacks fiber 1"; fail=1; }
 "$fiberlab" atlas --resume "$work/res.checkpoint.h5" --threads 1 --quiet >"$work/res2.out" 2>"$work/res2.err" \
   || { echo "FAIL: resume exited $?"; cat "$work/res2.err"; fail=1; }

@@ -52,23 +52,11 @@ export FIBERLAB_PYTHON=/nonexistent/python3
   || { echo "FAIL: reference run exited $?"; cat "$work/err"; exit 1; }
 [ -e "$work/ref.checkpoint.h5" ] && say_fail "the finished run left its checkpoint"
 
-# Starts an atlas of OUT in the background (set -m: SIGINT not ignored),
-# waits for the file WAIT_FOR in the work folder (OUT's checkpoint by
-# default), sends SIGNAL; sets `got` to its exit status.
+source "$source_dir/tests/cli/atlas_interrupt.sh"
+# An atlas of r.yaml to OUT, sent SIGNAL once WAIT_FOR exists (OUT's
+# checkpoint by default); sets `got` to its exit status.
 interrupt_after_checkpoint() {  # OUT SIGNAL [WAIT_FOR]
-  local out=$1 sig=$2 wait_for=${3:-$1.checkpoint.h5} pid
-  set -m
-  "$fiberlab" atlas "$work/r.yaml" -o "$work/$out.h5" --threads 2 >"$work/$out.out" 2>"$work/$out.err" &
-  pid=$!
-  set +m
-  for _ in $(seq 1 3000); do
-    [ -e "$work/$wait_for" ] && break
-    kill -0 "$pid" 2>/dev/null || break
-    sleep 0.02
-  done
-  kill "-$sig" "$pid" 2>/dev/null
-  wait "$pid" 2>/dev/null
-  got=$?
+  interrupt_atlas "$work/r.yaml" "$1" "$2" "${3:-}" --threads 2
 }
 
 # 2. SIGINT after the first fiber.
