@@ -28,19 +28,6 @@ Predicted predicted_by_file(const sim::ResultFile& result, const CompareRequest&
   return p;
 }
 
-// A verdict's rows of one lobe.
-compare::Verdict only_lobe(const compare::Verdict& v, int lobe) {
-  compare::Verdict w = v;
-  w.rows.clear();
-  w.accepted.clear();
-  for (std::size_t i = 0; i < v.rows.size(); ++i)
-    if (v.rows[i].lobe == lobe) {
-      w.rows.push_back(v.rows[i]);
-      w.accepted.push_back(v.accepted[i]);
-    }
-  return w;
-}
-
 }  // namespace
 
 Comparison set_up(const CompareRequest& o) {
@@ -103,16 +90,9 @@ JointFit fit_jointly(const Comparison& c, const std::function<void(const std::st
 
 std::vector<LobeFitVerdict> fit_each_lobe(const Comparison& c, const compare::Verdict& before,
                                           const std::function<void(const std::string&)>& progress) {
-  std::vector<LobeFitVerdict> out;
-  for (const compare::LobeFit& lf :
-       compare::fit_each_lobe(c.result, c.spec.name, c.params, c.fit_keys, c.fit_options, kFitIterations, progress)) {
-    const Predicted fitted = predicted_by_model(c.result, c.spec, lf.fit.params);
-    // Each lobe is judged with the fit's options; the verdict stays the joint fit's.
-    const compare::Verdict after =
-        compare::judge(compare::compare(c.result, fitted.bins, fitted.alpha, c.fit_options), c.max_chi2);
-    out.push_back({lf.lobe, lf.fit, only_lobe(before, lf.lobe), only_lobe(after, lf.lobe)});
-  }
-  return out;
+  // Each lobe is judged with the fit's options; the command's verdict stays the joint fit's.
+  return app::fit_each_lobe(c.result, c.spec.name, c.params, c.fit_keys, c.fit_options, c.max_chi2, kFitIterations,
+                            before, progress);
 }
 
 }  // namespace fiberlab::app

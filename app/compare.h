@@ -10,6 +10,7 @@
 
 #include "analytic/model.h"
 #include "analytic/model_parameters.h"
+#include "app/fit.h"
 #include "compare/comparison.h"
 #include "compare/fit.h"
 #include "compare/models.h"
@@ -72,13 +73,9 @@ struct JointFit {
 };
 JointFit fit_jointly(const Comparison& c, const std::function<void(const std::string&)>& progress);
 
-// --per-lobe: each lobe fitted alone (compare::fit_each_lobe) from c.params,
-// with that lobe's rows of the verdicts before and after.
-struct LobeFitVerdict {
-  int lobe = 0;
-  compare::FitResult fit;
-  compare::Verdict before, after;  // this lobe's rows only
-};
+// --per-lobe: each lobe fitted alone from c.params (app/fit.h
+// fit_each_lobe, which fiberlab.fit(per_lobe=True) calls too), with that
+// lobe's rows of the verdicts before and after.
 std::vector<LobeFitVerdict> fit_each_lobe(const Comparison& c, const compare::Verdict& before,
                                           const std::function<void(const std::string&)>& progress);
 

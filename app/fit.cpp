@@ -17,6 +17,33 @@ compare::Verdict judge_model(const sim::ResultFile& result, const std::string& n
                         max_chi2);
 }
 
+namespace {
+
+// The verdict on one lobe's rows of `v` (judged again: the same rule row by
+// row, and the counts, thresholds and all_accepted of those rows alone).
+compare::Verdict only_lobe(const compare::Verdict& v, int lobe, double max_chi2) {
+  std::vector<compare::LobeComparison> rows;
+  for (const compare::LobeComparison& row : v.rows)
+    if (row.lobe == lobe) rows.push_back(row);
+  return compare::judge(std::move(rows), max_chi2);
+}
+
+}  // namespace
+
+std::vector<LobeFitVerdict> fit_each_lobe(const sim::ResultFile& result, const std::string& model,
+                                          const analytic::ModelParameters& start,
+                                          const std::vector<std::string>& keys, const compare::Options& options,
+                                          double max_chi2, int max_iterations, const compare::Verdict& before,
+                                          const std::function<void(const std::string&)>& progress) {
+  std::vector<LobeFitVerdict> out;
+  for (const compare::LobeFit& lf :
+       compare::fit_each_lobe(result, model, start, keys, options, max_iterations, progress)) {
+    const compare::Verdict after = judge_model(result, model, lf.fit.params, options, max_chi2);
+    out.push_back({lf.lobe, lf.fit, only_lobe(before, lf.lobe, max_chi2), only_lobe(after, lf.lobe, max_chi2)});
+  }
+  return out;
+}
+
 FitReport fit(const sim::ResultFile& result, const FitRequest& r,
               const std::function<void(const std::string&)>& progress) {
   compare::Options o = r.options;
@@ -35,6 +62,9 @@ FitReport fit(const sim::ResultFile& result, const FitRequest& r,
   out.before = judge_model(result, spec.name, out.start, o, limit);
   out.fit = compare::fit_model(result, spec.name, out.start, r.keys, o, r.max_iterations, progress);
   out.after = judge_model(result, spec.name, out.fit.params, o, limit);
+  if (r.per_lobe)
+    out.lobe_fits = fit_each_lobe(result, spec.name, out.start, r.keys, o, limit, r.max_iterations, out.before,
+                                  progress);
   return out;
 }
 

@@ -34,16 +34,38 @@ struct FitRequest {
   compare::Options options;        // checked by compare::check_options
   std::optional<double> max_chi2;
   int max_iterations = kFitIterations;
+  bool per_lobe = false;  // also fit each lobe alone (fit_each_lobe), as `compare --per-lobe`
+};
+
+// One lobe fitted alone, with that lobe's rows of the verdicts before and
+// after its fit.
+struct LobeFitVerdict {
+  int lobe = 0;
+  compare::FitResult fit;
+  compare::Verdict before, after;  // this lobe's rows only
 };
 
 struct FitReport {
   analytic::ModelParameters start;
   compare::FitResult fit;
   compare::Verdict before, after;
+  std::vector<LobeFitVerdict> lobe_fits;  // with per_lobe
 };
 
+// Each lobe of options.lobes (every lobe when empty) fitted alone from
+// `start` (compare::fit_each_lobe: a per-lobe key becomes the lobe's own
+// entry), judged after its fit with `options` and `max_chi2` (0: the
+// five-sigma rule); `before` is the verdict at `start`, of which each lobe
+// keeps its rows. `compare --per-lobe` and fiberlab.fit(per_lobe=True) both
+// give these.
+std::vector<LobeFitVerdict> fit_each_lobe(const sim::ResultFile& result, const std::string& model,
+                                          const analytic::ModelParameters& start,
+                                          const std::vector<std::string>& keys, const compare::Options& options,
+                                          double max_chi2, int max_iterations, const compare::Verdict& before,
+                                          const std::function<void(const std::string&)>& progress = {});
+
 // Checks the request (keys given once each, the model's own checks), then
-// fits. `progress` gets compare::fit_model's line per iteration; what it
+// fits (jointly; with per_lobe, then each lobe alone from the same start). `progress` gets compare::fit_model's line per iteration; what it
 // throws ends the fit and leaves here.
 FitReport fit(const sim::ResultFile& result, const FitRequest& request,
               const std::function<void(const std::string&)>& progress = {});

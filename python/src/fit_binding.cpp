@@ -1,5 +1,6 @@
 // fiberlab.fit from Python: app::fit, the fit of `fiberlab compare --fit` on
-// a result with the verdicts before and after it, as the CLI prints them. The GIL is released during the fit; between iterations
+// a result with the verdicts before and after it, as the CLI prints them,
+// and with per_lobe each lobe's own fit (app::fit_each_lobe, as --per-lobe). The GIL is released during the fit; between iterations
 // the progress callable (if any) gets the CLI's progress line and pending
 // Python signals are handled (Ctrl-C stops a fit at the next iteration with
 // KeyboardInterrupt).
@@ -43,32 +44,10 @@ class FitProgress {
   std::unique_ptr<py::error_already_set> error_;
 };
 
-py::dict fit(const sim::ResultFile& result, const std::string& model_name, const std::vector<std::string>& keys,
-             const std::vector<std::string>& sets, std::optional<double> max_chi2, double min_effective,
-             double model_error, double min_energy, int max_iterations, const std::vector<std::string>& lobes,
-             py::object progress) {
-  app::FitRequest request;
-  request.model = model_name;
-  request.keys = keys;
-  request.sets = sets;
-  request.lobes = lobes;
-  request.options = comparison_options(max_chi2, min_effective, model_error, min_energy);
-  request.max_chi2 = max_chi2;
-  request.max_iterations = max_iterations;
-  FitProgress relay(std::move(progress));
-  app::FitReport report;
-  bool stopped = false;
-  {
-    py::gil_scoped_release release;
-    try {
-      report = app::fit(result, request, relay.callback());
-    } catch (const StopFit&) {
-      stopped = true;
-    }
-  }
-  if (stopped) relay.rethrow();
-  const compare::FitResult& fr = report.fit;
-
+// One fit's numbers and its verdicts before and after, as fiberlab.Fit takes them.
+py::dict fit_dict(const compare::FitResult& fr, const std::string& model_name,
+                  const analytic::ModelParameters& start, const compare::Verdict& before,
+                  const compare::Verdict& after, int lobes) {
   py::dict d;
   d["keys"] = fr.keys;
   d["start"] = fr.start;
@@ -85,10 +64,47 @@ py::dict fit(const sim::ResultFile& result, const std::string& model_name, const
   d["converged"] = fr.converged;
   d["outcome"] = std::string(compare::outcome_name(fr.outcome));
   d["stop_reason"] = fr.stop_reason;
-  d["params_start"] = params_dict(model_name, report.start);
+  d["params_start"] = params_dict(model_name, start);
   d["params"] = params_dict(model_name, fr.params);
-  d["before"] = verdict_dict(report.before, result.lobes);
-  d["after"] = verdict_dict(report.after, result.lobes);
+  d["before"] = verdict_dict(before, lobes);
+  d["after"] = verdict_dict(after, lobes);
+  return d;
+}
+
+py::dict fit(const sim::ResultFile& result, const std::string& model_name, const std::vector<std::string>& keys,
+             const std::vector<std::string>& sets, std::optional<double> max_chi2, double min_effective,
+             double model_error, double min_energy, int max_iterations, const std::vector<std::string>& lobes,
+             bool per_lobe, py::object progress) {
+  app::FitRequest request;
+  request.model = model_name;
+  request.keys = keys;
+  request.sets = sets;
+  request.lobes = lobes;
+  request.options = comparison_options(max_chi2, min_effective, model_error, min_energy);
+  request.max_chi2 = max_chi2;
+  request.max_iterations = max_iterations;
+  request.per_lobe = per_lobe;
+  FitProgress relay(std::move(progress));
+  app::FitReport report;
+  bool stopped = false;
+  {
+    py::gil_scoped_release release;
+    try {
+      report = app::fit(result, request, relay.callback());
+    } catch (const StopFit&) {
+      stopped = true;
+    }
+  }
+  if (stopped) relay.rethrow();
+  py::dict d = fit_dict(report.fit, model_name, report.start, report.before, report.after, result.lobes);
+  py::list lobe_fits;
+  for (const app::LobeFitVerdict& lf : report.lobe_fits) {
+    py::dict one = fit_dict(lf.fit, model_name, report.start, lf.before, lf.after, result.lobes);
+    one["lobe"] = lf.lobe;
+    one["lobe_name"] = compare::lobe_name(lf.lobe, result.lobes);
+    lobe_fits.append(one);
+  }
+  d["lobe_fits"] = lobe_fits;
   return d;
 }
 
@@ -98,8 +114,9 @@ void bind_fit(py::module_& m) {
   m.def("fit", &fit, py::arg("result"), py::arg("model"), py::arg("keys"), py::arg("settings_overrides"),
         py::arg("max_chi2") = py::none(), py::arg("min_effective") = compare::Options{}.min_effective,
         py::arg("model_error") = compare::Options{}.model_rel_error, py::arg("min_energy") = compare::Options{}.min_lobe_energy, py::arg("max_iterations") = app::kFitIterations, py::arg("lobes") = std::vector<std::string>{},
-        py::arg("progress") = py::none(),
-        "compare::fit_model (the fit of `fiberlab compare --fit`) with the verdicts before and after it");
+        py::arg("per_lobe") = false, py::arg("progress") = py::none(),
+        "app::fit (the fit of `fiberlab compare --fit`, and with per_lobe each lobe's own as --per-lobe) with "
+        "the verdicts before and after it");
 }
 
 }  // namespace fiberlab::python
