@@ -141,3 +141,24 @@ def test_a_lobe_fit_that_cannot_run_names_its_lobe(widths_result):
     with pytest.raises(fiberlab.Error, match=r"^per-lobe fit of R: .*1 residuals for 1 parameters"):
         fiberlab.fit(widths_result, "deon2011", ["beta_long"], beta_long=START, per_lobe=True,
                      min_effective=1e12, **SWITCHES)
+
+
+def test_progress_names_each_lobe_and_an_exception_in_it_stops_the_per_lobe_fits(widths_result):
+    """The per-lobe fits' progress lines start with the lobe's name, as the
+    command's; an exception raised in progress during them (as Ctrl-C's
+    KeyboardInterrupt) ends the whole fit with it."""
+    lines = []
+    fiberlab.fit(widths_result, "deon2011", ["beta_long"], beta_long=START, per_lobe=True, lobes=["TT"],
+                 progress=lines.append, **SWITCHES)
+    assert any(line.startswith("TT fit: iteration 1,") for line in lines), lines
+
+    class Stop(Exception):
+        pass
+
+    def stop_in_lobe_fits(line):
+        if line.startswith("TT "):
+            raise Stop(line)
+
+    with pytest.raises(Stop, match="^TT fit: "):
+        fiberlab.fit(widths_result, "deon2011", ["beta_long"], beta_long=START, per_lobe=True,
+                     progress=stop_in_lobe_fits, **SWITCHES)
