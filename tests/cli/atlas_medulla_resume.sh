@@ -12,6 +12,8 @@
 #    saved (exit 130, "1 of 2 fibers saved"), then --resume: the same
 #    results as the uninterrupted run of that order, bit for bit
 #    (tests/cli/atlas_same_results.py).
+# 3. mpirun -np 2 (when installed; a fiber run on another rank comes back
+#    through the checkpoint's reader): the same results as one process.
 set -uo pipefail
 fiberlab=$1 source_dir=$2
 work=$(mktemp -d)
@@ -56,17 +58,26 @@ PY
   interrupt_atlas "$work/$name.yaml" "$name.res" INT "" --threads 1
   if [ "$got" != 130 ] || ! tail -n 1 "$work/$name.res.err" | grep -q ": 1 of 2 fibers saved in"; then
     say_fail "$name: SIGINT gave exit $got (want 130, one fiber saved)"; tail -n 2 "$work/$name.res.err"
-    continue
+  elif ! "$fiberlab" atlas --resume "$work/$name.res.checkpoint.h5" --threads 1 --quiet \
+         >"$work/$name.res2.out" 2>"$work/$name.res2.err"; then
+    say_fail "$name: the resume failed: $(cat "$work/$name.res2.err")"
+  elif /usr/bin/python3 "$same_results" "$work/$name.h5" "$work/$name.res.h5"; then
+    echo "ok ($name): medulla $name, interrupted after fiber 1 and resumed: the uninterrupted run's results"
+  else
+    say_fail "$name: the resumed results differ from the uninterrupted run's"
   fi
-  "$fiberlab" atlas --resume "$work/$name.res.checkpoint.h5" --threads 1 --quiet \
-    >"$work/$name.res2.out" 2>"$work/$name.res2.err"
-  code=$?
-  if [ "$code" != 0 ]; then
-    say_fail "$name: resume exited $code: $(cat "$work/$name.res2.err")"
-    continue
+  if mpirun=$(command -v mpirun); then
+    "$mpirun" --allow-run-as-root --oversubscribe -np 2 "$fiberlab" atlas "$work/$name.yaml" -o "$work/$name.two.h5" \
+      --threads 1 --quiet >"$work/$name.two.out" 2>&1
+    code=$?
+    if [ "$code" != 0 ]; then
+      say_fail "$name: mpirun -np 2 exited $code"; grep "error" "$work/$name.two.out"
+    else
+      /usr/bin/python3 "$same_results" "$work/$name.h5" "$work/$name.two.h5" \
+        && echo "ok ($name): two ranks give one process's results" \
+        || say_fail "$name: two ranks differ from one process"
+    fi
   fi
-  /usr/bin/python3 "$same_results" "$work/$name.h5" "$work/$name.res.h5" \
-    && echo "ok ($name): medulla $name, interrupted after fiber 1 and resumed: the uninterrupted run's results" \
-    || say_fail "$name: the resumed results differ from the uninterrupted run's"
 done
+[ -n "${mpirun:-}" ] || echo "mpirun not installed: the two-rank checks are skipped"
 exit $fail
