@@ -107,7 +107,11 @@
 // point of the point set (h uniform over the projected width, the
 // microfacet normals of up to three interfaces) is one path whose exit
 // direction lands in one bin, with weight 1/N times its Fresnel, masking
-// and absorption factors; the residual's weight is spread over the theta
+// and absorption factors (where the fiber is mirror-symmetric about the
+// plane of the light and the fiber axis, a circle or an ellipse lit along
+// one of its axes, phi_i a multiple of 90 deg: half of it in that bin and
+// half in the bin of its mirror image, relative azimuth -phi, the push-
+// forward of the mirrored point set averaged in); the residual's weight is spread over the theta
 // bins by the integral of its M_p over each bin (Gauss-Legendre, exact to
 // the rule) and evenly over phi (for v = 4 alpha below 1e-6 the spread is
 // sampled by two more coordinates of the point set). Each lobe's total is
@@ -117,10 +121,15 @@
 // `quadrature_points` (2^22 by default). The quadrature error of R, TT and
 // TRT falls about 4x per 4x points (a push-forward of a fixed point set
 // into bins converges like an estimate from as many independent paths, a
-// little better): at the atlas's grid (24 x 36 bins) and photon count (300k)
-// the mean squared bin error over the simulated bin's variance is about
-// N_photons / N_points times 0.2-0.5 for TT and TRT. Lower it for quick
-// looks, raise it for long simulations.
+// little better; the error comes from the facet normals' coordinates, not
+// from h: an Owen-scrambled Sobol' set, or 16 to 256 entry points h per
+// sample of the normals, did no better at the same number of paths): at the
+// atlas's grid (24 x 36 bins) and photon count (300k) the mean squared bin
+// error over the simulated bin's variance is about N_photons / N_points
+// times 0.10-0.26 for TT and TRT on mirror-symmetric fibers (every fiber of
+// configs/atlas.yaml: `scripts/huang2022_quadrature_error.py
+// configs/atlas.yaml --white`), about twice that without the mirror. Lower
+// it for quick looks, raise it for long simulations.
 #include <memory>
 #include <vector>
 
