@@ -72,6 +72,9 @@ def main():
         for l, name in enumerate(LOBES[:ref.shape[1]]):
             r, y = ref[:, l], x[:, l]
             m = r * n >= 10
+            if not m.any():
+                row.append(f"{name} -")
+                continue
             z = (y - r)[m] / np.sqrt(r[m] / n)
             ms, mx = float(np.mean(z ** 2)), float(np.max(np.abs(z)))
             w = worst[name]
