@@ -3,11 +3,13 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <variant>
 
+#include "analytic/huang2022_lanes.h"
 #include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
@@ -416,6 +418,42 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
+// The same points W at a time through the lanes' paths (huang2022_lanes.h):
+// deposit(exits, u) takes each group's exits and coordinates. The last
+// group's lanes past point n - 1 carry weight 0 (their paths end at the
+// entry).
+template <class Deposit>
+void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposit) {
+  using huang_lanes::B;
+  constexpr int W = huang_lanes::kWidth;
+  const double base = 1.0 / static_cast<double>(n);
+  Halton set(0, n, static_cast<std::uint64_t>(n) + W);
+  alignas(64) double u[kDims][W], share[W];
+  B ub[kDims];
+  huang_lanes::Exits exits;
+  Point pt;
+  for (long i0 = 0; i0 < n; i0 += W) {
+    for (int l = 0; l < W; ++l, set.advance()) {
+      set.get(pt.u);
+      for (int k = 0; k < kDims; ++k) u[k][l] = pt.u[k];
+      share[l] = i0 + l < n ? base : 0.0;
+    }
+    for (int k = 0; k < kDims; ++k) ub[k] = B::load_aligned(u[k]);
+    tracer.trace(ub, B::load_aligned(share), exits);
+    deposit(exits, u);
+  }
+}
+
+// Bit l set where lane l of m is.
+unsigned lane_bits(const huang_lanes::M& m) {
+  using huang_lanes::B;
+  alignas(64) double f[huang_lanes::kWidth];
+  xsimd::select(m, B(1.0), B(0.0)).store_aligned(f);
+  unsigned bits = 0;
+  for (int l = 0; l < huang_lanes::kWidth; ++l) bits |= (f[l] != 0.0 ? 1u : 0u) << l;
+  return bits;
+}
+
 // The residual's inclination for the point (u1, u2): a von Mises-Fisher
 // spread (kappa = 1/v) of the specular direction at inclination -theta_i,
 // whose theta-marginal is d'Eon's M_p(v) (SPEC s3).
@@ -510,9 +548,40 @@ class BinSink : public Sink {
         residual_(static_cast<std::size_t>(grid.n_theta()) * C_, 0.0) {
     for (int p = 0; p < kResidualP; ++p) scale_[p] = paths.scale(p);
   }
-  void exit(int p, const Vec3& o, const double* w) override {
-    const double phi = azimuth(o) - phi_i_;
-    const int i = grid_.theta_bin(inclination(o)), j = grid_.phi_bin(wrap_angle(phi));
+  void exit(int p, const Vec3& o, const double* w) override { deposit(p, inclination(o), azimuth(o) - phi_i_, w); }
+  // W points' exits and residuals (integrate_lanes): the exit angles per
+  // lane by xsimd's asin and atan2, each live lane deposited as exit() does.
+  void lanes(const huang_lanes::Exits& e, const double (*u)[huang_lanes::kWidth]) {
+    using huang_lanes::B;
+    constexpr int W = huang_lanes::kWidth;
+    alignas(64) double theta[W], phi[W], w[kMaxChannels][W];
+    for (int p = 0; p < kResidualP; ++p) {
+      unsigned bits = lane_bits(e.live[p]);
+      if (bits == 0) continue;
+      const huang_lanes::V3& o = e.dir[p];
+      xsimd::asin(xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x))).store_aligned(theta);
+      (xsimd::atan2(o.z, o.y) - B(phi_i_)).store_aligned(phi);
+      for (int c = 0; c < C_; ++c) e.w[p][c].store_aligned(w[c]);
+      for (; bits != 0; bits &= bits - 1) {
+        const int l = std::countr_zero(bits);
+        double wl[kMaxChannels];
+        for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
+        deposit(p, theta[l], phi[l], wl);
+      }
+    }
+    if (v_ >= kMinExactResidualV) {
+      for (int c = 0; c < C_; ++c) residual_[c] += xsimd::hadd(e.residual[c]);
+      return;
+    }
+    for (int c = 0; c < C_; ++c) e.residual[c].store_aligned(w[c]);
+    for (int l = 0; l < W; ++l) {
+      double wl[kMaxChannels];
+      for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
+      residual(wl, u[7][l], u[8][l]);
+    }
+  }
+  void deposit(int p, double theta, double phi, const double* w) {
+    const int i = grid_.theta_bin(theta), j = grid_.phi_bin(wrap_angle(phi));
     double* b = bin(lobe_index(p, L_), i, j);
     const double s = scale_[p];
     if (!mirror_) {
@@ -576,8 +645,22 @@ class EnergySink : public Sink {
     for (int c = 0; c < C_; ++c) (masked ? e_.masked : e_.stopped)[c] += w[c];
   }
   void incident(double w) override { e_.incident += w; }
+  // W points' paths (integrate_lanes): the same sums.
+  void lanes(const huang_lanes::Exits& x) {
+    for (int p = 0; p < kResidualP; ++p) add_lanes(p, x.w[p], paths_.scale(p));
+    add_lanes(kResidualP, x.residual, 1.0);
+    for (int c = 0; c < C_; ++c) {
+      e_.masked[c] += xsimd::hadd(x.masked[c]);
+      e_.stopped[c] += xsimd::hadd(x.stopped[c]);
+    }
+    e_.incident += xsimd::hadd(x.incident);
+  }
 
  private:
+  void add_lanes(int p, const huang_lanes::B* w, double s) {
+    double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
+    for (int c = 0; c < C_; ++c) l[c] += s * xsimd::hadd(w[c]);
+  }
   void add(int p, const double* w, double s) {
     double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
     for (int c = 0; c < C_; ++c) l[c] += s * w[c];
@@ -657,7 +740,13 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
   const Paths paths(params_, theta_i, phi_i);
   BinSink sink(paths, grid, theta_i, phi_i, out);
-  integrate(paths, params_.quadrature_points, sink);
+  if (scalar_paths_) {
+    integrate(paths, params_.quadrature_points, sink);
+  } else {
+    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
+    integrate_lanes(tracer, params_.quadrature_points,
+                    [&](const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) { sink.lanes(e, u); });
+  }
   sink.finish();
   return out;
 }
@@ -666,7 +755,13 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   HuangEnergies e;
   const Paths paths(params_, theta_i, phi_i);
   EnergySink sink(paths, e);
-  integrate(paths, params_.quadrature_points, sink);
+  if (scalar_paths_) {
+    integrate(paths, params_.quadrature_points, sink);
+  } else {
+    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
+    integrate_lanes(tracer, params_.quadrature_points,
+                    [&](const huang_lanes::Exits& x, const double(*)[huang_lanes::kWidth]) { sink.lanes(x); });
+  }
   return e;
 }
 

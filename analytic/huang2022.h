@@ -193,10 +193,15 @@ class Huang2022 : public Model {
   const Huang2022Params& params() const { return params_; }
   // Points of density()'s set for the interfaces before the last (tests).
   void set_density_points(long n) { density_points_ = n; }
+  // bin_probabilities() and energies() by the scalar paths (the ones
+  // density() uses) instead of the SIMD lanes' (huang2022_lanes.h): tests
+  // compare the two.
+  void set_scalar_paths(bool scalar) { scalar_paths_ = scalar; }
 
  private:
   Huang2022Params params_;
   long density_points_ = 1L << 16;
+  bool scalar_paths_ = false;
 };
 
 std::unique_ptr<Model> make_huang2022(const Huang2022Params& params);

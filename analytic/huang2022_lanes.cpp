@@ -1,0 +1,265 @@
+#include "analytic/huang2022_lanes.h"
+
+#include <cmath>
+
+#include "analytic/model.h"
+#include "common/fiber_frame.h"
+#include "common/fresnel.h"
+#include "common/units.h"
+
+namespace fiberlab::analytic::huang_lanes {
+
+namespace {
+
+V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+V3 operator-(const V3& a) { return {-a.x, -a.y, -a.z}; }
+V3 operator*(const B& s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
+B dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+V3 cross(const V3& a, const V3& b) {
+  return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+V3 normalized(const V3& a) { return (B(1.0) / xsimd::sqrt(dot(a, a))) * a; }
+V3 reflect(const V3& d, const V3& m) { return d - (B(2.0) * dot(d, m)) * m; }
+B zero_unless(const M& m, const B& x) { return xsimd::select(m, x, B(0.0)); }
+
+// Snell about m for a travel direction d with d.m = -cos_i < 0, given the
+// refraction cosine cos_t (fresnel_reflectance's) and 1 / eta_rel.
+V3 refract(const V3& d, const V3& m, const B& cos_i, const B& cos_t, double inv_eta_rel) {
+  return B(inv_eta_rel) * d + (cos_i * inv_eta_rel - cos_t) * m;
+}
+
+// Adds x to acc where m (per channel).
+void add_where(B* acc, const M& m, const B* x, int C) {
+  for (int c = 0; c < C; ++c) acc[c] += zero_unless(m, x[c]);
+}
+
+}  // namespace
+
+Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
+    : eta_(p.eta), inv_eta_(1.0 / p.eta), alpha_(p.roughness), ct_(std::cos(p.tilt)), st_(std::sin(p.tilt)),
+      C_(static_cast<int>(p.sigma_a.size())), masking_(p.masking), mesonormal_flux_(p.mesonormal_flux),
+      cycles_residual_(p.residual == HuangResidual::CyclesEval),
+      cycles_trt_gate_(for_lobe(p.lobe_scale, 2) > 0.0) {
+  rv_ = 1.0 / std::sqrt(p.eccentricity);
+  rw_ = std::sqrt(p.eccentricity);
+  irv2_ = 1.0 / (rv_ * rv_);
+  irw2_ = 1.0 / (rw_ * rw_);
+  for (int c = 0; c < kMaxChannels; ++c) sigma_[c] = c < C_ ? p.sigma_a[c] : 0.0;
+  const Vec3 wi = direction_from_angles(theta_i, phi_i);
+  wi_[0] = wi.x(), wi_[1] = wi.y(), wi_[2] = wi.z();
+  // The beam's direction -wi in the circle space of the ellipse (Fiber::entry).
+  const double bv = -wi.y() / rv_, bw = -wi.z() / rw_, n = std::hypot(bv, bw);
+  gv_ = bv / n;
+  gw_ = bw / n;
+  // Cycles' eval() residual: (2 / pi) dgamma / (cos theta_i W) per point,
+  // dgamma = pi base, W the projected width with the major axis 1.
+  const double width = 2.0 * std::sqrt(rv_ * rv_ * wi.z() * wi.z() + rw_ * rw_ * wi.y() * wi.y()) /
+                       std::hypot(wi.y(), wi.z()) * std::sqrt(p.eccentricity);
+  cycles_scale_ = 2.0 / (std::cos(theta_i) * width);
+}
+
+Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
+  Hit h{pv, pw, normalized(V3{B(0.0), pv * irv2_, pw * irw2_}), V3{}};
+  h.ns = V3{B(-st_), B(ct_) * h.n0.y, B(ct_) * h.n0.z};
+  return h;
+}
+
+B Tracer::lambda(const B& c_in) const {
+  const B c = xsimd::min(B(1.0), xsimd::abs(c_in)), c2 = c * c;
+  return B(0.5) * (xsimd::sqrt(B(1.0) + (alpha_ * alpha_) * (B(1.0) - c2) / c2) - B(1.0));
+}
+
+B Tracer::leaving(const B& cos_in, const B& cos_out) const {
+  if (masking_ == HuangMasking::None || alpha_ == 0.0) return B(1.0);
+  const B lo = lambda(cos_out);
+  if (masking_ == HuangMasking::Separable) return B(1.0) / (B(1.0) + lo);
+  const B li = lambda(cos_in);
+  return (B(1.0) + li) / (B(1.0) + li + lo);
+}
+
+// Surface::normal of huang2022.cpp: the frame (the fiber axis in the facet
+// plane, its cross product with nf, nf) and Heitz 2018's VNDF map
+// (common/ggx.cpp's sample_visible) per lane.
+V3 Tracer::normal(const V3& nf, const V3& w, const B& u1, const B& u2) const {
+  if (alpha_ == 0.0) return nf;
+  const B a(alpha_);
+  V3 x = V3{B(1.0), B(0.0), B(0.0)} - nf.x * nf;
+  const V3 x_alt = V3{B(0.0), B(1.0), B(0.0)} - nf.y * nf;
+  const M degenerate = dot(x, x) < B(1e-20);
+  x = normalized(V3{xsimd::select(degenerate, x_alt.x, x.x), xsimd::select(degenerate, x_alt.y, x.y),
+                    xsimd::select(degenerate, x_alt.z, x.z)});
+  const V3 y = cross(nf, x);
+  const V3 vh = normalized(V3{a * dot(w, x), a * dot(w, y), dot(w, nf)});
+  const B len2 = vh.x * vh.x + vh.y * vh.y;
+  const M flat = len2 > B(0.0);
+  const B inv = B(1.0) / xsimd::sqrt(len2);
+  const V3 t1{xsimd::select(flat, -vh.y * inv, B(1.0)), xsimd::select(flat, vh.x * inv, B(0.0)), B(0.0)};
+  const V3 t2 = cross(vh, t1);
+  const B r = xsimd::sqrt(u1);
+  const auto sc = xsimd::sincos(B(kTwoPi) * u2);
+  const B p1 = r * sc.second;
+  const B s = B(0.5) * (B(1.0) + vh.z);
+  const B p2 = (B(1.0) - s) * xsimd::sqrt(xsimd::max(B(0.0), B(1.0) - p1 * p1)) + s * (r * sc.first);
+  const V3 nh = p1 * t1 + p2 * t2 + xsimd::sqrt(xsimd::max(B(0.0), B(1.0) - p1 * p1 - p2 * p2)) * vh;
+  const V3 ml = normalized(V3{a * nh.x, a * nh.y, xsimd::max(B(0.0), nh.z)});
+  return ml.x * x + ml.y * y + ml.z * nf;
+}
+
+void Tracer::trace(const B* u, const B& base, Exits& out) const {
+  for (int c = 0; c < C_; ++c) {
+    out.residual[c] = out.masked[c] = out.stopped[c] = B(0.0);
+    for (int p = 0; p < 3; ++p) out.w[p][c] = B(0.0);
+  }
+  for (int p = 0; p < 3; ++p) out.live[p] = M(false);
+  // The entry at circle-space angle g (Fiber::entry), its share of the beam
+  // cos(g) dg / 2, scaled onto the mesonormal by (wi.ns)/(wi.n0) (paper).
+  const B g = (u[0] - B(0.5)) * B(kPi);
+  const auto sc = xsimd::sincos(g);
+  const B sg = sc.first, cg = sc.second;
+  const Hit h = hit(B(rv_) * (-sg * gw_ - cg * gv_), B(rw_) * (sg * gv_ - cg * gw_));
+  const V3 wi{B(wi_[0]), B(wi_[1]), B(wi_[2])};
+  const B macro = dot(wi, h.n0), meso = dot(wi, h.ns);
+  B w0 = base * B(0.5 * kPi) * cg;
+  if (mesonormal_flux_) w0 = w0 * xsimd::max(B(0.0), meso) / macro;
+  out.incident = w0;
+  M alive = (macro > B(0.0)) & (w0 != B(0.0));
+  const M facing = meso > B(0.0);
+  for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & !facing, w0);
+  alive = alive & facing;
+  if (!xsimd::any(alive)) return;
+
+  const V3 d0 = -wi;
+  const V3 m = normal(h.ns, wi, u[1], u[2]);
+  const B ci = dot(wi, m);
+  const auto fr = fresnel_reflectance(ci, B(eta_), B(inv_eta_));
+  const B F = fr.F;
+  // R: reflection about m, on the outer side of ns and n0, masked towards o.
+  {
+    const V3 o = reflect(d0, m);
+    const B on = dot(o, h.ns), om = dot(o, h.n0);
+    const M ok = (on > B(0.0)) & (om > B(0.0));
+    const B gl = leaving(meso, on), wf = w0 * F;
+    const M live = alive & ok;
+    for (int c = 0; c < C_; ++c) {
+      out.stopped[c] += zero_unless(alive & !ok, wf);
+      out.masked[c] += zero_unless(live, wf * (B(1.0) - gl));
+      out.w[0][c] = zero_unless(live, wf * gl);
+    }
+    out.live[0] = live & (F > B(0.0));
+    out.dir[0] = o;
+  }
+  // T: into the fiber, on the inner side of ns and n0, masked towards t.
+  const M entering = alive & !fr.tir;
+  const V3 t = refract(d0, m, ci, fr.cos_t, inv_eta_);
+  const B on = -dot(t, h.ns), om = -dot(t, h.n0);
+  const M ok = (on > B(0.0)) & (om > B(0.0));
+  const B gl = leaving(meso, on), prob = B(1.0) - F;
+  const M live = entering & ok;
+  B w[kMaxChannels];
+  for (int c = 0; c < C_; ++c) {
+    out.stopped[c] += zero_unless(entering & !ok, w0 * prob);
+    out.masked[c] += zero_unless(live, w0 * prob * (B(1.0) - gl));
+    w[c] = zero_unless(live, w0 * prob * gl);
+  }
+  const M inside_live = live & (prob > B(0.0));
+  if (xsimd::any(inside_live)) inside(u, h, t, inside_live, w, prob, base * cycles_scale_, out);
+}
+
+// Huang2022's Paths::inside for k = 1 then k = 2: a chord, absorption, the
+// interface (stopped where its scale faces away from the arriving light),
+// the exit of order k and the internal reflection; after interface 3 the
+// residual (Cycles' sampler's geometric series, or with residual=cycles_eval
+// Cycles' eval()'s at interface 2 and nothing from interface 3).
+void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_in, const B* w_in,
+                    const B& t1, const B& cycles_weight, Exits& out) const {
+  const int C = C_;
+  M alive = alive_in;
+  Hit at = from;
+  V3 d = d_in;
+  B w[kMaxChannels], a1[kMaxChannels];
+  for (int c = 0; c < C; ++c) w[c] = w_in[c];
+  B t2(1.0);  // interface 2's Fresnel transmittance (the sampler's residual)
+  for (int k = 1; k <= 2; ++k) {
+    // The chord: the far root of the ellipse's quadratic from `at` along d.
+    const B qa = d.y * d.y * irv2_ + d.z * d.z * irw2_;
+    const B qb = B(2.0) * (at.pv * d.y * irv2_ + at.pw * d.z * irw2_);
+    const M runs = qa > B(0.0);
+    add_where(out.stopped, alive & !runs, w, C);
+    alive = alive & runs;
+    const B len = xsimd::max(B(0.0), -qb / qa);
+    const B pv = at.pv + len * d.y, pw = at.pw + len * d.z;
+    const B s = B(1.0) / xsimd::sqrt(pv * pv * irv2_ + pw * pw * irw2_);
+    at = hit(pv * s, pw * s);
+    B a[kMaxChannels];
+    for (int c = 0; c < C; ++c) {
+      a[c] = sigma_[c] == 0.0 ? B(1.0) : xsimd::exp(B(-sigma_[c]) * len);  // SPEC s4
+      w[c] = w[c] * a[c];
+    }
+    const V3 nf = -at.ns, wv = -d;
+    const B wn = dot(wv, nf);
+    const M facing = wn > B(0.0);
+    add_where(out.stopped, alive & !facing, w, C);
+    alive = alive & facing;
+    if (!xsimd::any(alive)) return;
+    const V3 m = normal(nf, wv, u[2 * k + 1], u[2 * k + 2]);
+    const B ci = dot(wv, m);
+    const auto fr = fresnel_reflectance(ci, B(inv_eta_), B(eta_));
+    const B F = fr.F;
+    // Out: order p = k (crossing: on the outer side of ns and n0).
+    {
+      const M leaving_side = alive & !fr.tir;
+      const V3 o = refract(d, m, ci, fr.cos_t, eta_);
+      const B on = dot(o, at.ns), om = dot(o, at.n0);
+      const M ok = (on > B(0.0)) & (om > B(0.0));
+      const B gl = leaving(wn, on), prob = B(1.0) - F;
+      const M live = leaving_side & ok;
+      for (int c = 0; c < C; ++c) {
+        out.stopped[c] += zero_unless(leaving_side & !ok, w[c] * prob);
+        out.masked[c] += zero_unless(live, w[c] * prob * (B(1.0) - gl));
+        out.w[k][c] = zero_unless(live, w[c] * prob * gl);
+      }
+      out.live[k] = live & (prob > B(0.0));
+      out.dir[k] = o;
+    }
+    // Internal reflection (staying: on the inner side of ns and n0).
+    if (cycles_residual_ && k == 2) {
+      for (int c = 0; c < C; ++c) out.stopped[c] += zero_unless(alive, w[c] * F);
+      return;
+    }
+    if (cycles_residual_ && cycles_trt_gate_) {
+      // Cycles' eval() residual at interface 2: T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)).
+      const B t_avg = xsimd::max(B(1.0) - F, B(1e-5));
+      for (int c = 0; c < C; ++c)
+        out.residual[c] += zero_unless(
+            alive, cycles_weight * t1 * F * F * t_avg * a[c] * a[c] * a[c] / (B(1.0) - a[c] * (B(1.0) - t_avg)));
+    }
+    const V3 r = reflect(d, m);
+    const B on = -dot(r, at.ns), om = -dot(r, at.n0);
+    const M ok = (on > B(0.0)) & (om > B(0.0));
+    const B gl = leaving(wn, on);
+    const M live = alive & ok;
+    for (int c = 0; c < C; ++c) {
+      out.stopped[c] += zero_unless(alive & !ok, w[c] * F);
+      out.masked[c] += zero_unless(live, w[c] * F * (B(1.0) - gl));
+      w[c] = zero_unless(live, w[c] * F * gl);
+    }
+    alive = live & (F > B(0.0));
+    if (k == 2) {
+      // Cycles' sampler's residual for every p >= 3:
+      // A_avg T_avg / (1 - A_avg (1 - T_avg)), A_avg = sqrt(A_1 A_2).
+      const B t_avg = xsimd::max(B(1e-5), B(0.5) * (t2 + (B(1.0) - F)));
+      for (int c = 0; c < C; ++c) {
+        const B a_avg = sigma_[c] == 0.0 ? B(1.0) : xsimd::sqrt(a1[c] * a[c]);
+        out.residual[c] += zero_unless(alive, w[c] * a_avg * t_avg / (B(1.0) - a_avg * (B(1.0) - t_avg)));
+      }
+      return;
+    }
+    for (int c = 0; c < C; ++c) a1[c] = a[c];
+    t2 = B(1.0) - F;
+    d = r;
+    if (!xsimd::any(alive)) return;
+  }
+}
+
+}  // namespace fiberlab::analytic::huang_lanes
