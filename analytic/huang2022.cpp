@@ -74,6 +74,39 @@ class Halton {
     u[0] += half_cell_;  // midpoints in dimension 0
     if (u[0] >= 1.0) u[0] -= 1.0;
   }
+  // The W points from the current one (coordinate k of point l in
+  // u[k][l]), then advanced past them. The same values as W calls of
+  // get() and advance(): within a block the lowest digits of W consecutive
+  // indices are consecutive table entries over the same higher blocks.
+  template <int W>
+  void get_lanes(double (*u)[W]) {
+    for (int k = 0; k < kDims; ++k) {
+      Digits& d = digits_[k];
+      if (d.c[0] + W > d.block) {  // a carry inside the group: point by point
+        for (int l = 0; l < W; ++l) {
+          u[k][l] = value(d);
+          step(d);
+        }
+        continue;
+      }
+      double hi = 0.0;
+      for (int q = d.used - 1; q > 0; --q) hi = (hi + d.table[d.c[q]]) * d.inv_block;
+      const double* t = &d.table[d.c[0]];
+      for (int l = 0; l < W; ++l) u[k][l] = hi + t[l];
+      d.c[0] += W;
+      if (d.c[0] == d.block) {
+        d.c[0] = 0;
+        for (int q = 1; q < kMaxBlocks; ++q) {
+          if (++d.c[q] < d.block) break;
+          d.c[q] = 0;
+        }
+      }
+    }
+    for (int l = 0; l < W; ++l) {
+      u[0][l] += half_cell_;
+      if (u[0][l] >= 1.0) u[0][l] -= 1.0;
+    }
+  }
   void advance() {
     for (Digits& d : digits_)
       for (int q = 0; q < kMaxBlocks; ++q) {
@@ -92,6 +125,17 @@ class Halton {
     std::vector<double> table;
     unsigned c[kMaxBlocks] = {};
   };
+  static double value(const Digits& d) {
+    double r = 0.0;
+    for (int q = d.used - 1; q >= 0; --q) r = (r + d.table[d.c[q]]) * (q > 0 ? d.inv_block : 1.0);
+    return r;
+  }
+  static void step(Digits& d) {
+    for (int q = 0; q < kMaxBlocks; ++q) {
+      if (++d.c[q] < d.block) break;
+      d.c[q] = 0;
+    }
+  }
   Digits digits_[kDims];
   double half_cell_;
 };
@@ -431,13 +475,9 @@ void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposi
   alignas(64) double u[kDims][W], share[W];
   B ub[kDims];
   huang_lanes::Exits exits;
-  Point pt;
   for (long i0 = 0; i0 < n; i0 += W) {
-    for (int l = 0; l < W; ++l, set.advance()) {
-      set.get(pt.u);
-      for (int k = 0; k < kDims; ++k) u[k][l] = pt.u[k];
-      share[l] = i0 + l < n ? base : 0.0;
-    }
+    set.get_lanes<W>(u);
+    for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? base : 0.0;
     for (int k = 0; k < kDims; ++k) ub[k] = B::load_aligned(u[k]);
     tracer.trace(ub, B::load_aligned(share), exits);
     deposit(exits, u);
@@ -550,23 +590,49 @@ class BinSink : public Sink {
   }
   void exit(int p, const Vec3& o, const double* w) override { deposit(p, inclination(o), azimuth(o) - phi_i_, w); }
   // W points' exits and residuals (integrate_lanes): the exit angles per
-  // lane by xsimd's asin and atan2, each live lane deposited as exit() does.
+  // lane by xsimd's asin and atan2, their bins' first guesses as in
+  // BinGrid::theta_bin / phi_bin, settled on the edges per live lane, each
+  // deposited as exit() does.
   void lanes(const huang_lanes::Exits& e, const double (*u)[huang_lanes::kWidth]) {
     using huang_lanes::B;
     constexpr int W = huang_lanes::kWidth;
-    alignas(64) double theta[W], phi[W], w[kMaxChannels][W];
+    const int nt = grid_.n_theta(), np = grid_.n_phi();
+    const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
+    alignas(64) double theta[W], phi[W], phi_m[W], gi[W], gj[W], gm[W], w[kMaxChannels][W];
+    auto guess = [](const B& x, int n, double* out) {
+      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), xsimd::floor(x))).store_aligned(out);
+    };
     for (int p = 0; p < kResidualP; ++p) {
       unsigned bits = lane_bits(e.live[p]);
       if (bits == 0) continue;
       const huang_lanes::V3& o = e.dir[p];
-      xsimd::asin(xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x))).store_aligned(theta);
-      (xsimd::atan2(o.z, o.y) - B(phi_i_)).store_aligned(phi);
+      const B x = xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x)), t = xsimd::asin(x);
+      t.store_aligned(theta);
+      guess(uniform ? (t + B(0.5 * kPi)) * B(nt / kPi) : (x + B(1.0)) * B(0.5 * nt), nt, gi);
+      const B f = xsimd::atan2(o.z, o.y) - B(phi_i_), fw = wrap(f);
+      fw.store_aligned(phi);
+      guess((fw + B(kPi)) * B(np / kTwoPi), np, gj);
+      if (mirror_) {
+        const B fm = wrap(-f);
+        fm.store_aligned(phi_m);
+        guess((fm + B(kPi)) * B(np / kTwoPi), np, gm);
+      }
       for (int c = 0; c < C_; ++c) e.w[p][c].store_aligned(w[c]);
       for (; bits != 0; bits &= bits - 1) {
         const int l = std::countr_zero(bits);
-        double wl[kMaxChannels];
-        for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
-        deposit(p, theta[l], phi[l], wl);
+        const int i = settle(grid_.theta_edges, static_cast<int>(gi[l]), theta[l]);
+        const int j = settle(grid_.phi_edges, static_cast<int>(gj[l]), phi[l]);
+        const double s = scale_[p];
+        double* b = bin(lobe_index(p, L_), i, j);
+        if (!mirror_) {
+          for (int c = 0; c < C_; ++c) b[c] += s * w[c][l];
+          continue;
+        }
+        double* m = bin(lobe_index(p, L_), i, settle(grid_.phi_edges, static_cast<int>(gm[l]), phi_m[l]));
+        for (int c = 0; c < C_; ++c) {
+          b[c] += 0.5 * s * w[c][l];
+          m[c] += 0.5 * s * w[c][l];
+        }
       }
     }
     if (v_ >= kMinExactResidualV) {
@@ -579,6 +645,20 @@ class BinSink : public Sink {
       for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
       residual(wl, u[7][l], u[8][l]);
     }
+  }
+  // wrap_angle() per lane: to [-pi, pi).
+  static huang_lanes::B wrap(const huang_lanes::B& a) {
+    using huang_lanes::B;
+    const B x = a + B(kPi);
+    const B w = x - B(kTwoPi) * xsimd::floor(x * B(1.0 / kTwoPi)) - B(kPi);
+    return xsimd::select(w >= B(kPi), B(-kPi), w);
+  }
+  // The bin of x among `edges` from a guess at most one off (BinGrid's rule).
+  static int settle(const std::vector<double>& edges, int i, double x) {
+    const int n = static_cast<int>(edges.size()) - 1;
+    if (i > 0 && x < edges[i]) return i - 1;
+    if (i < n - 1 && x >= edges[i + 1]) return i + 1;
+    return i;
   }
   void deposit(int p, double theta, double phi, const double* w) {
     const int i = grid_.theta_bin(theta), j = grid_.phi_bin(wrap_angle(phi));

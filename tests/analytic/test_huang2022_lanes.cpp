@@ -98,11 +98,13 @@ TEST(Huang2022, LanesEqualTheScalarPathsInEnergy) {
 // instead of the C library's: an exit within rounding of a bin edge could
 // change bins, none does here).
 TEST(Huang2022, LanesEqualTheScalarPathsInBins) {
-  const BinGrid g = BinGrid::make(24, 36, ThetaBinning::Uniform);
-  for (const Case& k : cases()) {
-    Huang2022 lanes(k.p), scalar(k.p);
-    scalar.set_scalar_paths(true);
-    const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
-    expect_close(lanes.bin_probabilities(g, ti, pi), scalar.bin_probabilities(g, ti, pi), 1e-13, k.name);
-  }
+  for (const BinGrid& g :
+       {BinGrid::make(24, 36, ThetaBinning::Uniform), BinGrid::make(17, 35, ThetaBinning::EqualArea)})
+    for (const Case& k : cases()) {
+      Huang2022 lanes(k.p), scalar(k.p);
+      scalar.set_scalar_paths(true);
+      const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
+      expect_close(lanes.bin_probabilities(g, ti, pi), scalar.bin_probabilities(g, ti, pi), 1e-13,
+                   k.name + " " + std::to_string(g.n_theta()));
+    }
 }
