@@ -574,7 +574,8 @@ std::vector<double> residual_theta_masses(const BinGrid& grid, double theta_i, d
 //
 // Where the model is mirror-symmetric (mirror_symmetric()), each exit lands
 // half in its bin and half in the bin of its mirror image (relative azimuth
-// -phi): the mirrored path has the same weight and the same density, so
+// -phi; done once after the points, finish(), as the average of every phi
+// bin with its mirror bin): the mirrored path has the same weight and the same density, so
 // this averages the push-forward of the point set and of its mirror image,
 // an estimate of the same integral from twice the paths (its quadrature
 // error about 1/sqrt(2) of the unmirrored one's at the same cost: measured
@@ -589,50 +590,55 @@ class BinSink : public Sink {
     for (int p = 0; p < kResidualP; ++p) scale_[p] = paths.scale(p);
   }
   void exit(int p, const Vec3& o, const double* w) override { deposit(p, inclination(o), azimuth(o) - phi_i_, w); }
-  // W points' exits and residuals (integrate_lanes): the exit angles per
-  // lane by xsimd's asin and atan2, their bins' first guesses as in
-  // BinGrid::theta_bin / phi_bin, settled on the edges per live lane, each
-  // deposited as exit() does.
+  // W points' exits and residuals (integrate_lanes). Each exit's bin as
+  // BinGrid::theta_bin / phi_bin would give it: the closed-form index per
+  // lane (xsimd's asin and atan2), and where a lane lies within 1e-9 of a
+  // bin's width of an edge, BinGrid's own rule on that lane's angles; each
+  // live lane deposited as exit() does.
   void lanes(const huang_lanes::Exits& e, const double (*u)[huang_lanes::kWidth]) {
     using huang_lanes::B;
+    using huang_lanes::M;
     constexpr int W = huang_lanes::kWidth;
     const int nt = grid_.n_theta(), np = grid_.n_phi();
     const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
-    alignas(64) double theta[W], phi[W], phi_m[W], gi[W], gj[W], gm[W], w[kMaxChannels][W];
-    auto guess = [](const B& x, int n, double* out) {
-      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), xsimd::floor(x))).store_aligned(out);
+    alignas(64) double at[W], ai[W], aj[W], w[kMaxChannels][W];
+    // floor(g) clamped to [0, n - 1] into out; the lanes within 1e-9 of an integer.
+    auto index = [](const B& g, int n, double* out) {
+      const B f = xsimd::floor(g), r = g - f;
+      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), f)).store_aligned(out);
+      return (r < B(1e-9)) | (r > B(1.0 - 1e-9));
     };
     for (int p = 0; p < kResidualP; ++p) {
       unsigned bits = lane_bits(e.live[p]);
       if (bits == 0) continue;
       const huang_lanes::V3& o = e.dir[p];
-      const B x = xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x)), t = xsimd::asin(x);
-      t.store_aligned(theta);
-      guess(uniform ? (t + B(0.5 * kPi)) * B(nt / kPi) : (x + B(1.0)) * B(0.5 * nt), nt, gi);
-      const B f = xsimd::atan2(o.z, o.y) - B(phi_i_), fw = wrap(f);
-      fw.store_aligned(phi);
-      guess((fw + B(kPi)) * B(np / kTwoPi), np, gj);
-      if (mirror_) {
-        const B fm = wrap(-f);
-        fm.store_aligned(phi_m);
-        guess((fm + B(kPi)) * B(np / kTwoPi), np, gm);
+      const B x = xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x));
+      M near;
+      if (uniform) {
+        const B t = xsimd::asin(x);
+        t.store_aligned(at);
+        near = index((t + B(0.5 * kPi)) * B(nt / kPi), nt, ai);
+      } else {
+        x.store_aligned(at);  // asin only where a lane is near an edge
+        near = index((x + B(1.0)) * B(0.5 * nt), nt, ai);
       }
+      const B f = xsimd::atan2(o.z, o.y) - B(phi_i_);
+      near = near | index((wrap(f) + B(kPi)) * B(np / kTwoPi), np, aj);
+      unsigned settle = lane_bits(near);
+      alignas(64) double phi[W];
+      if (settle & bits) f.store_aligned(phi);
       for (int c = 0; c < C_; ++c) e.w[p][c].store_aligned(w[c]);
+      const double s = scale_[p];
+      const int lobe = lobe_index(p, L_);
       for (; bits != 0; bits &= bits - 1) {
         const int l = std::countr_zero(bits);
-        const int i = settle(grid_.theta_edges, static_cast<int>(gi[l]), theta[l]);
-        const int j = settle(grid_.phi_edges, static_cast<int>(gj[l]), phi[l]);
-        const double s = scale_[p];
-        double* b = bin(lobe_index(p, L_), i, j);
-        if (!mirror_) {
-          for (int c = 0; c < C_; ++c) b[c] += s * w[c][l];
-          continue;
+        int i = static_cast<int>(ai[l]), j = static_cast<int>(aj[l]);
+        if (settle >> l & 1) {
+          i = grid_.theta_bin(uniform ? at[l] : std::asin(at[l]));
+          j = grid_.phi_bin(wrap_angle(phi[l]));
         }
-        double* m = bin(lobe_index(p, L_), i, settle(grid_.phi_edges, static_cast<int>(gm[l]), phi_m[l]));
-        for (int c = 0; c < C_; ++c) {
-          b[c] += 0.5 * s * w[c][l];
-          m[c] += 0.5 * s * w[c][l];
-        }
+        double* b = bin(lobe, i, j);
+        for (int c = 0; c < C_; ++c) b[c] += s * w[c][l];
       }
     }
     if (v_ >= kMinExactResidualV) {
@@ -653,26 +659,10 @@ class BinSink : public Sink {
     const B w = x - B(kTwoPi) * xsimd::floor(x * B(1.0 / kTwoPi)) - B(kPi);
     return xsimd::select(w >= B(kPi), B(-kPi), w);
   }
-  // The bin of x among `edges` from a guess at most one off (BinGrid's rule).
-  static int settle(const std::vector<double>& edges, int i, double x) {
-    const int n = static_cast<int>(edges.size()) - 1;
-    if (i > 0 && x < edges[i]) return i - 1;
-    if (i < n - 1 && x >= edges[i + 1]) return i + 1;
-    return i;
-  }
   void deposit(int p, double theta, double phi, const double* w) {
     const int i = grid_.theta_bin(theta), j = grid_.phi_bin(wrap_angle(phi));
     double* b = bin(lobe_index(p, L_), i, j);
-    const double s = scale_[p];
-    if (!mirror_) {
-      for (int c = 0; c < C_; ++c) b[c] += s * w[c];
-      return;
-    }
-    double* m = bin(lobe_index(p, L_), i, grid_.phi_bin(wrap_angle(-phi)));
-    for (int c = 0; c < C_; ++c) {
-      b[c] += 0.5 * s * w[c];
-      m[c] += 0.5 * s * w[c];
-    }
+    for (int c = 0; c < C_; ++c) b[c] += scale_[p] * w[c];
   }
   void residual(const double* w, double u1, double u2) override {
     const int i = v_ < kMinExactResidualV ? grid_.theta_bin(residual_theta(theta_i_, v_, u1, u2)) : 0;
@@ -683,6 +673,15 @@ class BinSink : public Sink {
   // Spreads the residual (call once, after the points).
   void finish() {
     const int np = grid_.n_phi(), nt = grid_.n_theta();
+    // The mirror image of phi bin j is bin np - 1 - j (the phi edges are
+    // uniform on [-pi, pi), symmetric about 0).
+    if (mirror_)
+      for (int l = 0; l < L_; ++l)
+        for (int i = 0; i < nt; ++i)
+          for (int j = 0; j < np / 2; ++j) {
+            double *a = bin(l, i, j), *b = bin(l, i, np - 1 - j);
+            for (int c = 0; c < C_; ++c) a[c] = b[c] = 0.5 * (a[c] + b[c]);
+          }
     std::vector<double> per_theta(residual_);
     if (v_ >= kMinExactResidualV) {
       const std::vector<double> mass = residual_theta_masses(grid_, theta_i_, v_);

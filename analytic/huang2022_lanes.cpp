@@ -78,18 +78,18 @@ B Tracer::leaving(const B& cos_in, const B& cos_out) const {
   return (B(1.0) + li) / (B(1.0) + li + lo);
 }
 
-// Surface::normal of huang2022.cpp: the frame (the fiber axis in the facet
-// plane, its cross product with nf, nf) and Heitz 2018's VNDF map
-// (common/ggx.cpp's sample_visible) per lane.
-V3 Tracer::normal(const V3& nf, const V3& w, const B& u1, const B& u2) const {
+// Surface::normal of huang2022.cpp for the facing normal nf = side * ns at
+// h: the frame (the fiber axis u in the facet plane, nf x that, nf) and
+// Heitz 2018's VNDF map (common/ggx.cpp's sample_visible) per lane. With
+// ns = (-sin tilt, cos tilt n0) and n0 _|_ u, u - (u.nf) nf normalised is
+// x = (cos tilt, sin tilt n0) and nf x x = side (0, n0_w, -n0_v): no
+// square root.
+V3 Tracer::normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const {
+  const V3 nf = B(side) * h.ns;
   if (alpha_ == 0.0) return nf;
   const B a(alpha_);
-  V3 x = V3{B(1.0), B(0.0), B(0.0)} - nf.x * nf;
-  const V3 x_alt = V3{B(0.0), B(1.0), B(0.0)} - nf.y * nf;
-  const M degenerate = dot(x, x) < B(1e-20);
-  x = normalized(V3{xsimd::select(degenerate, x_alt.x, x.x), xsimd::select(degenerate, x_alt.y, x.y),
-                    xsimd::select(degenerate, x_alt.z, x.z)});
-  const V3 y = cross(nf, x);
+  const V3 x{B(ct_), B(st_) * h.n0.y, B(st_) * h.n0.z};
+  const V3 y{B(0.0), B(side) * h.n0.z, B(-side) * h.n0.y};
   const V3 vh = normalized(V3{a * dot(w, x), a * dot(w, y), dot(w, nf)});
   const B len2 = vh.x * vh.x + vh.y * vh.y;
   const M flat = len2 > B(0.0);
@@ -130,7 +130,7 @@ void Tracer::trace(const B* u, const B& base, Exits& out) const {
   if (!xsimd::any(alive)) return;
 
   const V3 d0 = -wi;
-  const V3 m = normal(h.ns, wi, u[1], u[2]);
+  const V3 m = normal(h, 1.0, wi, u[1], u[2]);
   const B ci = dot(wi, m);
   const auto fr = fresnel_reflectance(ci, B(eta_), B(inv_eta_));
   const B F = fr.F;
@@ -202,7 +202,7 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
     add_where(out.stopped, alive & !facing, w, C);
     alive = alive & facing;
     if (!xsimd::any(alive)) return;
-    const V3 m = normal(nf, wv, u[2 * k + 1], u[2 * k + 2]);
+    const V3 m = normal(at, -1.0, wv, u[2 * k + 1], u[2 * k + 2]);
     const B ci = dot(wv, m);
     const auto fr = fresnel_reflectance(ci, B(inv_eta_), B(eta_));
     const B F = fr.F;
