@@ -65,17 +65,21 @@ Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
   return h;
 }
 
-B Tracer::lambda(const B& c_in) const {
-  const B c = xsimd::min(B(1.0), xsimd::abs(c_in)), c2 = c * c;
-  return B(0.5) * (xsimd::sqrt(B(1.0) + (alpha_ * alpha_) * (B(1.0) - c2) / c2) - B(1.0));
+// Smith's Lambda (Surface::lambda) through 1 + 2 Lambda = q / c with
+// q = sqrt(c^2 + alpha^2 (1 - c^2)), c = min(1, |cos|), so that each
+// masking factor below takes one division.
+B Tracer::lambda_root(const B& c) const {
+  return xsimd::sqrt(c * c + B(alpha_ * alpha_) * (B(1.0) - c * c));
 }
 
+// Surface::leaving: separable G1(o) = 1 / (1 + L_o) = 2 c_o / (c_o + q_o);
+// correlated (1 + L_i) / (1 + L_i + L_o) = c_o (c_i + q_i) / (q_i c_o + q_o c_i).
 B Tracer::leaving(const B& cos_in, const B& cos_out) const {
   if (masking_ == HuangMasking::None || alpha_ == 0.0) return B(1.0);
-  const B lo = lambda(cos_out);
-  if (masking_ == HuangMasking::Separable) return B(1.0) / (B(1.0) + lo);
-  const B li = lambda(cos_in);
-  return (B(1.0) + li) / (B(1.0) + li + lo);
+  const B co = xsimd::min(B(1.0), xsimd::abs(cos_out)), qo = lambda_root(co);
+  if (masking_ == HuangMasking::Separable) return B(2.0) * co / (co + qo);
+  const B ci = xsimd::min(B(1.0), xsimd::abs(cos_in)), qi = lambda_root(ci);
+  return co * (ci + qi) / (qi * co + qo * ci);
 }
 
 // Surface::normal of huang2022.cpp for the facing normal nf = side * ns at
@@ -188,9 +192,9 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
     add_where(out.stopped, alive & !runs, w, C);
     alive = alive & runs;
     const B len = xsimd::max(B(0.0), -qb / qa);
-    const B pv = at.pv + len * d.y, pw = at.pw + len * d.z;
-    const B s = B(1.0) / xsimd::sqrt(pv * pv * irv2_ + pw * pw * irw2_);
-    at = hit(pv * s, pw * s);
+    // (The scalar Fiber::next also rescales the point onto the ellipse: a
+    // change in the last bits only.)
+    at = hit(at.pv + len * d.y, at.pw + len * d.z);
     B a[kMaxChannels];
     for (int c = 0; c < C; ++c) {
       a[c] = sigma_[c] == 0.0 ? B(1.0) : xsimd::exp(B(-sigma_[c]) * len);  // SPEC s4

@@ -61,7 +61,7 @@ class Tracer {
   Hit hit(const B& pv, const B& pw) const;
   V3 normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const;
   B leaving(const B& cos_in, const B& cos_out) const;
-  B lambda(const B& c) const;
+  B lambda_root(const B& c) const;
   void inside(const B* u, const Hit& from, const V3& d, const M& alive, const B* w, const B& t1,
               const B& cycles_weight, Exits& out) const;
 
