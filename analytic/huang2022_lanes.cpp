@@ -59,7 +59,7 @@ Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
   cycles_scale_ = 2.0 / (std::cos(theta_i) * width);
 }
 
-Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
+inline Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
   Hit h{pv, pw, normalized(V3{B(0.0), pv * irv2_, pw * irw2_}), V3{}};
   h.ns = V3{B(-st_), B(ct_) * h.n0.y, B(ct_) * h.n0.z};
   return h;
@@ -68,13 +68,13 @@ Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
 // Smith's Lambda (Surface::lambda) through 1 + 2 Lambda = q / c with
 // q = sqrt(c^2 + alpha^2 (1 - c^2)), c = min(1, |cos|), so that each
 // masking factor below takes one division.
-B Tracer::lambda_root(const B& c) const {
+inline B Tracer::lambda_root(const B& c) const {
   return xsimd::sqrt(c * c + B(alpha_ * alpha_) * (B(1.0) - c * c));
 }
 
 // Surface::leaving: separable G1(o) = 1 / (1 + L_o) = 2 c_o / (c_o + q_o);
 // correlated (1 + L_i) / (1 + L_i + L_o) = c_o (c_i + q_i) / (q_i c_o + q_o c_i).
-B Tracer::leaving(const B& cos_in, const B& cos_out) const {
+inline B Tracer::leaving(const B& cos_in, const B& cos_out) const {
   if (masking_ == HuangMasking::None || alpha_ == 0.0) return B(1.0);
   const B co = xsimd::min(B(1.0), xsimd::abs(cos_out)), qo = lambda_root(co);
   if (masking_ == HuangMasking::Separable) return B(2.0) * co / (co + qo);
@@ -88,7 +88,7 @@ B Tracer::leaving(const B& cos_in, const B& cos_out) const {
 // ns = (-sin tilt, cos tilt n0) and n0 _|_ u, u - (u.nf) nf normalised is
 // x = (cos tilt, sin tilt n0) and nf x x = side (0, n0_w, -n0_v): no
 // square root.
-V3 Tracer::normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const {
+inline V3 Tracer::normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const {
   const V3 nf = B(side) * h.ns;
   if (alpha_ == 0.0) return nf;
   const B a(alpha_);

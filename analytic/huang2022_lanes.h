@@ -58,10 +58,10 @@ class Tracer {
     B pv, pw;
     V3 n0, ns;
   };
-  Hit hit(const B& pv, const B& pw) const;
-  V3 normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const;
-  B leaving(const B& cos_in, const B& cos_out) const;
-  B lambda_root(const B& c) const;
+  [[gnu::always_inline]] Hit hit(const B& pv, const B& pw) const;
+  [[gnu::always_inline]] V3 normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const;
+  [[gnu::always_inline]] B leaving(const B& cos_in, const B& cos_out) const;
+  [[gnu::always_inline]] B lambda_root(const B& c) const;
   void inside(const B* u, const Hit& from, const V3& d, const M& alive, const B* w, const B& t1,
               const B& cycles_weight, Exits& out) const;
 

@@ -11,7 +11,7 @@ in the config's N-photon simulation), its square root (the RMS error in
 standard errors) and the largest |error| / SE.
 
 Usage: scripts/huang2022_quadrature_error.py CONFIG [--fiberlab BIN]
-         [--points N] [--reference N] [--white] [--workdir DIR]
+         [--points N [N ...]] [--reference N] [--white] [--workdir DIR]
 """
 import argparse
 import itertools
@@ -51,7 +51,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config")
     ap.add_argument("--fiberlab", default="build/cli/fiberlab")
-    ap.add_argument("--points", type=int, default=1 << 18)
+    ap.add_argument("--points", type=int, nargs="+", default=[1 << 18],
+                    help="one or more point counts to measure (one reference each fiber)")
     ap.add_argument("--reference", type=int, default=1 << 22)
     ap.add_argument("--white", action="store_true", help="only the sweep's sigma_a 0 fibers")
     ap.add_argument("--workdir", default=None)
@@ -60,29 +61,32 @@ def main():
         cfg = yaml.safe_load(f)
     work = a.workdir or tempfile.mkdtemp()
     n = float(cfg["photons"])
-    worst = {l: [0.0, 0.0, 0.0] for l in LOBES}
+    worst = {(p, l): [0.0, 0.0, 0.0] for p in a.points for l in LOBES}
     for k, fc in enumerate(fibers(cfg, a.white)):
         path = os.path.join(work, f"fiber{k}.yaml")
         fc["output"] = os.path.join(work, f"fiber{k}.h5")
         with open(path, "w") as f:
             yaml.safe_dump(fc, f)
         ref = predict(a.fiberlab, path, a.reference, os.path.join(work, f"fiber{k}_ref.h5"))
-        x = predict(a.fiberlab, path, a.points, os.path.join(work, f"fiber{k}_test.h5"))
-        row = []
-        for l, name in enumerate(LOBES[:ref.shape[1]]):
-            r, y = ref[:, l], x[:, l]
-            m = r * n >= 10
-            if not m.any():
-                row.append(f"{name} -")
-                continue
-            z = (y - r)[m] / np.sqrt(r[m] / n)
-            ms, mx = float(np.mean(z ** 2)), float(np.max(np.abs(z)))
-            w = worst[name]
-            w[0], w[1], w[2] = max(w[0], ms), max(w[1], np.sqrt(ms)), max(w[2], mx)
-            row.append(f"{name} {ms:.3f}/{np.sqrt(ms):.3f}/{mx:.3f}")
-        print(f"{fc['roughness']} {fc['fiber']}: " + "  ".join(row), flush=True)
-    print("largest over the fibers (mean squared / RMS / max |error| in SE): " +
-          "  ".join(f"{l} {w[0]:.3f}/{w[1]:.3f}/{w[2]:.3f}" for l, w in worst.items() if w != [0.0, 0.0, 0.0]))
+        for points in a.points:
+            x = predict(a.fiberlab, path, points, os.path.join(work, f"fiber{k}_test.h5"))
+            row = []
+            for l, name in enumerate(LOBES[:ref.shape[1]]):
+                r, y = ref[:, l], x[:, l]
+                m = r * n >= 10
+                if not m.any():
+                    row.append(f"{name} -")
+                    continue
+                z = (y - r)[m] / np.sqrt(r[m] / n)
+                ms, mx = float(np.mean(z ** 2)), float(np.max(np.abs(z)))
+                w = worst[(points, name)]
+                w[0], w[1], w[2] = max(w[0], ms), max(w[1], np.sqrt(ms)), max(w[2], mx)
+                row.append(f"{name} {ms:.3f}/{np.sqrt(ms):.3f}/{mx:.3f}")
+            print(f"{points} {fc['roughness']} {fc['fiber']}: " + "  ".join(row), flush=True)
+    for points in a.points:
+        print(f"{points} points, largest over the fibers (mean squared / RMS / max |error| in SE): " +
+              "  ".join(f"{l} {w[0]:.3f}/{w[1]:.3f}/{w[2]:.3f}" for (p, l), w in worst.items()
+                        if p == points and w != [0.0, 0.0, 0.0]))
 
 
 if __name__ == "__main__":
