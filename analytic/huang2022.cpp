@@ -819,7 +819,7 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
   const Paths paths(params_, theta_i, phi_i);
   BinSink sink(paths, grid, theta_i, phi_i, out);
-  if (scalar_paths_) {
+  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
     integrate(paths, params_.quadrature_points, sink);
   } else {
     const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
@@ -834,7 +834,7 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   HuangEnergies e;
   const Paths paths(params_, theta_i, phi_i);
   EnergySink sink(paths, e);
-  if (scalar_paths_) {
+  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
     integrate(paths, params_.quadrature_points, sink);
   } else {
     const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
@@ -1001,7 +1001,7 @@ ModelInfo huang2022_info() {
       "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
       "sampler", {"sampler", "cycles_eval"}, &P::residual);
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
-                                  "integer", "4194304", "an integer in [1024, 1073741824]",
+                                  "integer", "8388608", "an integer in [1024, 1073741824]",
                                   &P::quadrature_points, [](double x) {
                                     return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
                                   });

@@ -36,6 +36,13 @@ void add_where(B* acc, const M& m, const B* x, int C) {
 
 }  // namespace
 
+bool Tracer::supports(const Huang2022Params& p) {
+  // Every field of Huang2022Params that changes the transport: the masking,
+  // the flux, the residual (each value), tilt, eccentricity, roughness,
+  // sigma_a (up to kMaxChannels), lobe_scale (the TRT gate).
+  return static_cast<int>(p.sigma_a.size()) <= kMaxChannels;
+}
+
 Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
     : eta_(p.eta), inv_eta_(1.0 / p.eta), alpha_(p.roughness), ct_(std::cos(p.tilt)), st_(std::sin(p.tilt)),
       C_(static_cast<int>(p.sigma_a.size())), masking_(p.masking), mesonormal_flux_(p.mesonormal_flux),

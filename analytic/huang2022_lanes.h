@@ -46,6 +46,11 @@ struct Exits {
 
 class Tracer {
  public:
+  // Whether the lanes implement every option of p (else huang2022.cpp uses
+  // its scalar paths): a transport option added to the scalar Paths is
+  // refused here until the lanes follow it and LanesEqualTheScalarPaths
+  // covers it.
+  static bool supports(const Huang2022Params& p);
   Tracer(const Huang2022Params& p, double theta_i, double phi_i);
   // u[k]: coordinate k of the W points (0 the entry angle, 1-2 / 3-4 / 5-6
   // the normals of interfaces 1 / 2 / 3); base: each point's share of the
