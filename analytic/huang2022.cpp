@@ -487,6 +487,9 @@ void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposi
 // Bit l set where lane l of m is.
 unsigned lane_bits(const huang_lanes::M& m) {
   using huang_lanes::B;
+#if defined(__AVX512F__)
+  if constexpr (huang_lanes::kWidth == 8) return static_cast<unsigned>(static_cast<__mmask8>(m.data));
+#endif
   alignas(64) double f[huang_lanes::kWidth];
   xsimd::select(m, B(1.0), B(0.0)).store_aligned(f);
   unsigned bits = 0;
@@ -627,18 +630,20 @@ class BinSink : public Sink {
       unsigned settle = lane_bits(near);
       alignas(64) double phi[W];
       if (settle & bits) f.store_aligned(phi);
-      for (int c = 0; c < C_; ++c) e.w[p][c].store_aligned(w[c]);
       const double s = scale_[p];
+      for (int c = 0; c < C_; ++c) (B(s) * e.w[p][c]).store_aligned(w[c]);
       const int lobe = lobe_index(p, L_);
+      // The bins' offsets in out_ (exact in doubles).
+      alignas(64) double offset[W];
+      ((B(static_cast<double>(lobe) * nt) + B::load_aligned(ai)) * B(static_cast<double>(np) * C_) +
+       B::load_aligned(aj) * B(C_))
+          .store_aligned(offset);
       for (; bits != 0; bits &= bits - 1) {
         const int l = std::countr_zero(bits);
-        int i = static_cast<int>(ai[l]), j = static_cast<int>(aj[l]);
-        if (settle >> l & 1) {
-          i = grid_.theta_bin(uniform ? at[l] : std::asin(at[l]));
-          j = grid_.phi_bin(wrap_angle(phi[l]));
-        }
-        double* b = bin(lobe, i, j);
-        for (int c = 0; c < C_; ++c) b[c] += s * w[c][l];
+        double* b = settle >> l & 1 ? bin(lobe, grid_.theta_bin(uniform ? at[l] : std::asin(at[l])),
+                                         grid_.phi_bin(wrap_angle(phi[l])))
+                                    : &out_[static_cast<std::size_t>(offset[l])];
+        for (int c = 0; c < C_; ++c) b[c] += w[c][l];
       }
     }
     if (v_ >= kMinExactResidualV) {
