@@ -119,13 +119,14 @@
 // the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
 // smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
 // `quadrature_points` (2^23 by default); bin_probabilities() and energies()
-// trace 8 points at a time in SIMD lanes (huang2022_lanes.h, the same
-// transport as the scalar paths that density() uses). The quadrature error of R, TT and
-// TRT falls about 4x per 4x points (a push-forward of a fixed point set
-// into bins converges like an estimate from as many independent paths, a
-// little better; the error comes from the facet normals' coordinates, not
-// from h: an Owen-scrambled Sobol' set, or 16 to 256 entry points h per
-// sample of the normals, did no better at the same number of paths): at the
+// trace 8 points at a time in SIMD lanes (4 without AVX-512;
+// huang2022_lanes.h, the same transport as the scalar paths that density()
+// uses). The quadrature error of R, TT and TRT falls about 4x per 4x
+// points (a push-forward of a fixed point set into bins converges like an
+// estimate from as many independent paths, a little better; the error
+// comes from the facet normals' coordinates, not from h: an
+// Owen-scrambled Sobol' set, or 16 to 256 entry points h per sample of the
+// normals, did no better at the same number of paths): at the
 // atlas's grid (24 x 36 bins) and photon count (300k) the mean squared bin
 // error over the simulated bin's variance is about N_photons / N_points
 // times 0.10-0.26 for TT and TRT on mirror-symmetric fibers (every fiber of
