@@ -2,8 +2,9 @@
 // paths (huang2022.cpp's Paths, the ones density() uses): the same point set
 // through both must give the same lobe energies, losses and bins up to
 // rounding, in every mode of the model (roughness 0 and > 0, each masking,
-// both fluxes, both residuals, tilt, ellipse, absorbing channels, a point
-// count that is not a multiple of the lane width, mirror-averaged and not).
+// both fluxes, both residuals, tilt, ellipse, absorbing channels, 2 to 4
+// lobes, a point count that is not a multiple of the lane width,
+// mirror-averaged and not).
 // A peer test: the scalar paths are held to the physics oracles in
 // test_huang2022.cpp, these to the scalar paths.
 // Mutations caught: the correlated masking's (1 + L_i) dropped in the lanes
@@ -55,11 +56,13 @@ std::vector<Case> cases() {
   p.tilt = deg_to_rad(-5.0);
   p.mesonormal_flux = false;
   p.eccentricity = 0.7;
-  out.push_back({"ggx 0.1 macro flux ellipse", p, 75.0, 90.0});
+  p.lobes = 2;  // R, then every p >= 1 in one lobe
+  out.push_back({"ggx 0.1 macro flux ellipse, 2 lobes", p, 75.0, 90.0});
   p = base();
   p.roughness = 0.0;
   p.sigma_a = {0.5};
-  out.push_back({"smooth absorbing (sampled residual spread)", p, 30.0, 0.0});
+  p.lobes = 3;
+  out.push_back({"smooth absorbing (sampled residual spread), 3 lobes", p, 30.0, 0.0});
   p = base();
   p.roughness = 0.2;
   p.residual = HuangResidual::CyclesEval;
