@@ -134,6 +134,11 @@ enum class HuangMasking { Separable, Correlated, None };
 // or its eval()'s (from the second interface; see huang2022.cpp).
 enum class HuangResidual { Sampler, CyclesEval };
 
+// The transport: the paper's (and Cycles' sampler's), or that of Cycles'
+// eval() as shipped (its inner mesonormal cosine ratios, its exit-side
+// tests; see huang2022.cpp, Paths).
+enum class HuangForm { Paper, CyclesEval };
+
 // The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
 // `--set` keys to these fields).
 struct Huang2022Params {
@@ -143,6 +148,9 @@ struct Huang2022Params {
   double tilt = 0.0;                       // radians, SPEC's scale_tilt sign
   double eccentricity = 1.0;               // minor/major in (0, 1]
   std::vector<double> lobe_scale{1.0, 1.0, 1.0};  // R, TT, TRT (>= 0)
+  // Set before masking, flux and residual: `form=cycles_eval` in the table
+  // also sets those to Cycles' eval()'s (correlated, mesonormal, cycles_eval).
+  HuangForm form = HuangForm::Paper;
   HuangMasking masking = HuangMasking::Separable;
   // true (the paper, Cycles' eval): the light reaching an arc element is
   // (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
