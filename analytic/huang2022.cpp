@@ -412,16 +412,15 @@ class Paths {
   // of a chord along d from interface `from` to interface `to`. Cycles
   // (bsdf_principled_hair_huang.h, bsdf_hair_huang_eval_residual) weights a
   // TT path by cos_mi1 / cos_mo1 times the exit's arc length per entry arc
-  // angle, and a TRT path also by cos_mi2 / cos_mo2, where cos_mo is the
-  // leaving direction's cosine to the mesonormal of the interface it leaves
-  // and cos_mi the arriving one's at the next; the paper's transport (the
-  // paths here) carries the flux onto the entry arc, and the last interface's
-  // VNDF holds 1 / cos_mi. The exit arc per entry arc of a bundle of parallel
-  // chords is (d.n0_from) / (d.n0_to) (flux through the cross-section, the
-  // fiber invariant along u), so per chord Cycles' eval() is the paper's
-  // transport times (d.n0 / d.ns) at `from` and (d.ns / d.n0) at `to`
-  // (SPEC's n0 and tilted n_s; 1 on an untilted fiber). Where the chord
-  // meets the mesonormal of `to` from behind, 0 (the path ends there).
+  // angle, a TRT path also by cos_mi2 / cos_mo2 (cos_mo: the leaving
+  // direction's cosine to the mesonormal of the interface it leaves, cos_mi:
+  // the arriving one's at the next); the paper's transport carries the flux
+  // onto the entry arc, and its last interface's VNDF holds 1 / cos_mi.
+  // Parallel chords keep their flux through the cross-section, so the exit
+  // arc per entry arc is (d.n0_from) / (d.n0_to), and per chord Cycles'
+  // eval() is the paper's transport times (d.n0 / d.ns) at `from` and
+  // (d.ns / d.n0) at `to` (SPEC s2's n0 and n_s; 1 without tilt). 0 where
+  // the chord meets the mesonormal of `to` from behind (the path ends).
   static double cycles_eval_chord_ratio(const Hit& from, const Hit& to, const Vec3& d) {
     const double leave = d.dot(from.n0) / d.dot(from.ns), arrive = d.dot(to.ns) / d.dot(to.n0);
     return arrive > 0.0 && leave > 0.0 ? leave * arrive : 0.0;
