@@ -26,6 +26,7 @@ constexpr int kResidualP = 3;              // every order p >= 3 in one lobe (Cy
 constexpr double kMinDensityRoughness = 1e-3;  // density(): Cycles' clamp of the roughness
 constexpr int kArcNodes = 4096;            // density(): midpoint nodes over the arc (R)
 constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta in theta_r
+constexpr double kCyclesEvalMaxImpact = 0.999;  // form=cycles_eval: Cycles' eval() clamps |h| / r to this
 
 // ---- The point set ---------------------------------------------------------------
 // Halton's point set: coordinate k of point i is the radical inverse of i in
@@ -275,6 +276,9 @@ class Paths {
     sink.incident(w0);
     if (!(macro > 0.0) || w0 == 0.0) return;
     if (!(meso > 0.0)) return sink.lost(false, w.c);  // macro flux only: no visible scale
+    // Cycles' eval() (bsdf_hair_huang_eval) integrates over |h| <= 0.999 of
+    // the projected width only, normalised by the whole width.
+    if (cycles_eval_ && std::abs(std::sin(g)) > kCyclesEvalMaxImpact) return sink.lost(false, w.c);
     const Vec3 m = surface_.normal(h.ns, wi_, pt.u[1], pt.u[2]);
     const double ci = wi_.dot(m);
     const double F = fresnel_dielectric(ci, p_.eta);
@@ -636,10 +640,16 @@ double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
   const Vec3 hv = (wi + wr).normalized();
   const double F = fresnel_dielectric(wi.dot(hv), p.eta);
   const double dt = kTwoPi / kArcNodes;
+  // form=cycles_eval: the impact parameter across the projected width (unit
+  // half width), which Cycles' eval() clamps (Paths::trace).
+  const double bn = std::hypot(wi.y(), wi.z()), half = 0.5 * fb.projected_width(wi.y(), wi.z());
+  const double across_v = -wi.z() / bn / half, across_w = wi.y() / bn / half;
   double sum = 0.0;
   for (int k = 0; k < kArcNodes; ++k) {
     const double t = (k + 0.5) * dt;
     const Hit h = fb.at(t);
+    if (p.form == HuangForm::CyclesEval && std::abs(h.pv * across_v + h.pw * across_w) > kCyclesEvalMaxImpact)
+      continue;
     const double in = wi.dot(h.ns), out = wr.dot(h.ns), c = hv.dot(h.ns);
     // Cycles' eval_r tests wr against the macro normal only (form=cycles_eval).
     const bool out_ok = out > 0.0 || p.form == HuangForm::CyclesEval;
@@ -733,7 +743,8 @@ std::vector<std::string> huang_approximations(const Huang2022Params& p) {
   if (cycles_eval) {
     a.push_back("form=cycles_eval: Cycles' eval() transport: each inner chord's light rescaled by (d.n0/d.ns) at the "
                 "interface it leaves and (d.ns/d.n0) at the one it meets (not energy-conserving once tilted); TT exits "
-                "not tested against the exit's normals; R's exit tested against the macro normal only");
+                "not tested against the exit's normals; R's exit tested against the macro normal only; only impact "
+                "parameters |h| <= 0.999 of the projected width, normalised by the whole width");
     a.push_back("form=cycles_eval: not reproduced: R's half vectors behind the mesonormal (Cycles' D counts them), "
                 "TT where the exit's mesonormal faces away from the chord (Cycles still evaluates it), the "
                 "Monte Carlo-Simpson quadrature itself");
@@ -831,8 +842,8 @@ ModelInfo huang2022_info() {
       "form",
       "transport: paper (the paper's, Cycles' sampler's; masking, flux, residual as set) or cycles_eval (Cycles' "
       "eval() as shipped: inner chords rescaled by mesonormal cosine ratios, TT exits unchecked, R checked against "
-      "the macro normal only; also sets masking=correlated, flux=mesonormal, residual=cycles_eval, which later keys "
-      "may change)",
+      "the macro normal only, impact parameters |h| <= 0.999; also sets masking=correlated, flux=mesonormal, "
+      "residual=cycles_eval, which later keys may change)",
       "paper", {"paper", "cycles_eval"},
       [](P& p, int i) {
         p.form = static_cast<HuangForm>(i);

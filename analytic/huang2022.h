@@ -50,8 +50,10 @@
 // bsdf_hair_huang_eval_residual): it rescales the light of each inner chord
 // by mesonormal cosine ratios (Paths::cycles_eval_chord_ratio), does not
 // test TT light against the exit's normals, tests R's exit against the
-// macro normal only, and sets its masking (correlated), flux (mesonormal)
-// and p >= 3 formula (residual=cycles_eval). Not reproduced: eval_r's half
+// macro normal only, integrates over the impact parameters |h| <= 0.999 of
+// the projected width only (normalised by the whole width), and sets its
+// masking (correlated), flux (mesonormal) and p >= 3 formula
+// (residual=cycles_eval). Not reproduced: eval_r's half
 // vectors behind the mesonormal (its D is even in the cosine), TT where the
 // exit's mesonormal faces away from the chord (eval still evaluates it).
 // - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
