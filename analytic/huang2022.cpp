@@ -746,8 +746,9 @@ std::vector<std::string> huang_approximations(const Huang2022Params& p) {
                 "not tested against the exit's normals; R's exit tested against the macro normal only; only impact "
                 "parameters |h| <= 0.999 of the projected width, normalised by the whole width");
     a.push_back("form=cycles_eval: not reproduced: R's half vectors behind the mesonormal (Cycles' D counts them), "
-                "TT where the exit's mesonormal faces away from the chord (Cycles still evaluates it), the "
-                "Monte Carlo-Simpson quadrature itself");
+                "TT where the exit's mesonormal faces away from the chord (Cycles still evaluates it), Cycles' zero "
+                "for exits with tan(tilt) tan(theta_r) > 1, its roughness floor 1e-3 (bins), the Monte Carlo-Simpson "
+                "quadrature itself");
     if (p.masking != HuangMasking::Correlated || !p.mesonormal_flux || p.residual != HuangResidual::CyclesEval)
       a.push_back("form=cycles_eval with masking, flux or residual not Cycles' eval()'s: not Cycles as shipped");
   }

@@ -55,7 +55,10 @@
 // masking (correlated), flux (mesonormal) and p >= 3 formula
 // (residual=cycles_eval). Not reproduced: eval_r's half
 // vectors behind the mesonormal (its D is even in the cosine), TT where the
-// exit's mesonormal faces away from the chord (eval still evaluates it).
+// exit's mesonormal faces away from the chord (eval still evaluates it),
+// eval's zero for exits with tan(tilt) tan(theta_r) > 1 (a band within
+// `tilt` of the axis), Cycles' roughness floor 1e-3 (bsdf_hair_huang_setup;
+// here only in density()).
 // - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
 //   integral over the lit arc of F(wi.h) D(h) G2(wi, wr) / 4 dl, h the half
 //   vector, D and G about the mesonormal, the arc length dl of the ellipse;
