@@ -28,6 +28,7 @@ constexpr int kResidualP = 3;              // every order p >= 3 in one lobe (Cy
 constexpr double kMinDensityRoughness = 1e-3;  // density(): Cycles' clamp of the roughness
 constexpr int kArcNodes = 4096;            // density(): midpoint nodes over the arc (R)
 constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta in theta_r
+constexpr double kCyclesEvalMaxImpact = 0.999;  // form=cycles_eval: Cycles' eval() clamps |h| / r to this
 
 // ---- The point set ---------------------------------------------------------------
 // Halton's point set: coordinate k of point i is the radical inverse of i in
@@ -284,11 +285,17 @@ struct Sink {
   virtual bool arrive(int, const Hit&, const Vec3&, const double*) { return true; }
 };
 
+// Which sides of an interface's normals a leaving direction must take:
+// both the mesonormal's and the macro normal's (the paper), the macro
+// normal's only, or none (form=cycles_eval, see Paths::branch).
+enum class Sides { Both, Macro, None };
+
 class Paths {
  public:
   Paths(const Huang2022Params& p, double theta_i, double phi_i)
       : p_(p), fiber_(p.eccentricity, p.tilt), surface_(p.roughness, p.masking),
         wi_(direction_from_angles(theta_i, phi_i)), cycles_residual_(p.residual == HuangResidual::CyclesEval),
+        cycles_eval_(p.form == HuangForm::CyclesEval),
         cos_i_(std::cos(theta_i)),
         cycles_width_(fiber_.projected_width(wi_.y(), wi_.z()) * std::sqrt(p.eccentricity)),
         C_(static_cast<int>(p.sigma_a.size())) {}
@@ -315,13 +322,17 @@ class Paths {
     sink.incident(w0);
     if (!(macro > 0.0) || w0 == 0.0) return;
     if (!(meso > 0.0)) return sink.lost(false, w.c);  // macro flux only: no visible scale
+    // Cycles' eval() (bsdf_hair_huang_eval) integrates over |h| <= 0.999 of
+    // the projected width only, normalised by the whole width.
+    if (cycles_eval_ && std::abs(std::sin(g)) > kCyclesEvalMaxImpact) return sink.lost(false, w.c);
     const Vec3 m = surface_.normal(h.ns, wi_, pt.u[1], pt.u[2]);
     const double ci = wi_.dot(m);
     const double F = fresnel_dielectric(ci, p_.eta);
-    // R: reflection about m.
+    // R: reflection about m (Cycles' eval() tests its side of the macro
+    // normal only).
     branch(0, d0, reflect(d0, m), h, +1, F, w, sink, [&](const Vec3& o, const double* wr) {
       sink.exit(0, o, wr);
-    });
+    }, cycles_eval_ ? Sides::Macro : Sides::Both);
     // T: into the fiber.
     Vec3 t;
     if (!refract(d0, m, p_.eta, t)) return;
@@ -340,14 +351,16 @@ class Paths {
   // the macro normal (else stopped), applies the leaving masking, continues.
   // `side` of the arrival: the facing normals are side * ns, side * n0 with
   // side = +1 outside (arriving along d0 from outside) and -1 inside.
+  // `sides` relaxes the check for Cycles' eval() (form=cycles_eval).
   template <class Next>
   void branch(int inside_events, const Vec3& d, const Vec3& o, const Hit& h, int cross,
-              double prob, const Weights& w, Sink& sink, Next next) const {
+              double prob, const Weights& w, Sink& sink, Next next, Sides sides = Sides::Both) const {
     const double side = inside_events == 0 ? 1.0 : -1.0;
     const Vec3 nf = side * h.ns, nm = side * h.n0;
     Weights wo, lost;
     const double on = o.dot(nf) * cross, om = o.dot(nm) * cross;
-    if (!(on > 0.0) || !(om > 0.0)) {
+    const bool meso_ok = on > 0.0 || sides != Sides::Both, macro_ok = om > 0.0 || sides == Sides::None;
+    if (!meso_ok || !macro_ok) {
       for (int c = 0; c < C_; ++c) lost.c[c] = w.c[c] * prob;
       if (prob > 0.0) sink.lost(false, lost.c);
       return;
@@ -377,9 +390,10 @@ class Paths {
     Weights wa, a;
     for (int c = 0; c < C_; ++c) wa.c[c] = w[c];
     if (!fiber_.next(from, d, h, len)) return sink.lost(false, wa.c);
+    const double ratio = cycles_eval_ ? cycles_eval_chord_ratio(from, h, d) : 1.0;
     for (int c = 0; c < C_; ++c) {
       a.c[c] = std::exp(-p_.sigma_a[c] * len);  // the chord's 3D length (SPEC s4)
-      wa.c[c] *= a.c[c];
+      wa.c[c] *= a.c[c] * ratio;
     }
     if (!sink.arrive(k - 1, h, d, wa.c)) return;
     const Vec3 nf = -h.ns;
@@ -390,9 +404,11 @@ class Paths {
     // Out: order p = k.
     Vec3 t;
     if (refract(d, m, 1.0 / p_.eta, t)) {
+      // Cycles' eval() lets TT light leave on either side of the exit's normals.
+      const Sides sides = cycles_eval_ && k == 1 ? Sides::None : Sides::Both;
       branch(1, d, t, h, -1, 1.0 - F, wa, sink, [&](const Vec3& o, const double* wo) {
         sink.exit(k, o, wo);
-      });
+      }, sides);
     }
     // Internal reflection: order k + 1 and beyond.
     const Vec3 r = reflect(d, m);
@@ -442,11 +458,29 @@ class Paths {
     sink.residual(e.c, pt.u[7], pt.u[8]);
   }
 
+  // form=cycles_eval: the factor by which Cycles' eval() rescales the light
+  // of a chord along d from interface `from` to interface `to`. Cycles
+  // (bsdf_principled_hair_huang.h, bsdf_hair_huang_eval_residual) weights a
+  // TT path by cos_mi1 / cos_mo1 times the exit's arc length per entry arc
+  // angle, a TRT path also by cos_mi2 / cos_mo2 (cos_mo: the leaving
+  // direction's cosine to the mesonormal of the interface it leaves, cos_mi:
+  // the arriving one's at the next); the paper's transport carries the flux
+  // onto the entry arc, and its last interface's VNDF holds 1 / cos_mi.
+  // Parallel chords keep their flux through the cross-section, so the exit
+  // arc per entry arc is (d.n0_from) / (d.n0_to), and per chord Cycles'
+  // eval() is the paper's transport times (d.n0 / d.ns) at `from` and
+  // (d.ns / d.n0) at `to` (SPEC s2's n0 and n_s; 1 without tilt). 0 where
+  // the chord meets the mesonormal of `to` from behind (the path ends).
+  static double cycles_eval_chord_ratio(const Hit& from, const Hit& to, const Vec3& d) {
+    const double leave = d.dot(from.n0) / d.dot(from.ns), arrive = d.dot(to.ns) / d.dot(to.n0);
+    return arrive > 0.0 && leave > 0.0 ? leave * arrive : 0.0;
+  }
+
   const Huang2022Params& p_;
   Fiber fiber_;
   Surface surface_;
   Vec3 wi_;
-  bool cycles_residual_;
+  bool cycles_residual_, cycles_eval_;
   double cos_i_, cycles_width_;
   int C_;
 };
@@ -772,7 +806,9 @@ class LastInterfaceSink : public Sink {
     const double eta = paths_.params().eta;
     const Vec3 nf = -h.ns, wv = -d;
     const double wn = wv.dot(nf), on = wr_.dot(nf);
-    if (!(wn > 0.0) || !(on < 0.0) || !(wr_.dot(h.n0) > 0.0)) return false;
+    // Cycles' eval() has no exit-side test for TT (form=cycles_eval).
+    const bool any_side = stop_at_ == 0 && paths_.params().form == HuangForm::CyclesEval;
+    if (!(wn > 0.0) || (!any_side && (!(on < 0.0) || !(wr_.dot(h.n0) > 0.0)))) return false;
     const Vec3 m = (wr_ - eta * d).normalized();
     const double om = wr_.dot(m), wm = wv.dot(m);
     if (!(om < 0.0) || !(wm > 0.0)) return false;
@@ -801,12 +837,20 @@ double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
   const Vec3 hv = (wi + wr).normalized();
   const double F = fresnel_dielectric(wi.dot(hv), p.eta);
   const double dt = kTwoPi / kArcNodes;
+  // form=cycles_eval: the impact parameter across the projected width (unit
+  // half width), which Cycles' eval() clamps (Paths::trace).
+  const double bn = std::hypot(wi.y(), wi.z()), half = 0.5 * fb.projected_width(wi.y(), wi.z());
+  const double across_v = -wi.z() / bn / half, across_w = wi.y() / bn / half;
   double sum = 0.0;
   for (int k = 0; k < kArcNodes; ++k) {
     const double t = (k + 0.5) * dt;
     const Hit h = fb.at(t);
+    if (p.form == HuangForm::CyclesEval && std::abs(h.pv * across_v + h.pw * across_w) > kCyclesEvalMaxImpact)
+      continue;
     const double in = wi.dot(h.ns), out = wr.dot(h.ns), c = hv.dot(h.ns);
-    if (!(wi.dot(h.n0) > 0.0) || !(wr.dot(h.n0) > 0.0) || !(in > 0.0) || !(out > 0.0) || !(c > 0.0))
+    // Cycles' eval_r tests wr against the macro normal only (form=cycles_eval).
+    const bool out_ok = out > 0.0 || p.form == HuangForm::CyclesEval;
+    if (!(wi.dot(h.n0) > 0.0) || !(wr.dot(h.n0) > 0.0) || !(in > 0.0) || !out_ok || !(c > 0.0))
       continue;
     const double D = ggx::D(Vec3(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c), sf.alpha(), sf.alpha());
     const double G = sf.leaving(in, out) / (1.0 + sf.lambda(in));
@@ -897,11 +941,26 @@ std::vector<std::string> huang_approximations(const Huang2022Params& p) {
   else
     a.push_back("p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, "
                 "uniform in phi), not Cycles' eval()'s");
+  const bool cycles_eval = p.form == HuangForm::CyclesEval;
   if (p.mesonormal_flux)
-    a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
-        "also rescales at the inner interfaces, not done here)");
+    a.push_back(cycles_eval ? "flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted "
+                              "(paper, Cycles' eval())"
+                            : "flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted "
+                              "(paper; Cycles' eval() also rescales at the inner interfaces: form=cycles_eval)");
   if (p.masking == HuangMasking::Correlated)
     a.push_back("masking: height-correlated G2 (Cycles' code)");
+  if (cycles_eval) {
+    a.push_back("form=cycles_eval: Cycles' eval() transport: each inner chord's light rescaled by (d.n0/d.ns) at the "
+                "interface it leaves and (d.ns/d.n0) at the one it meets (not energy-conserving once tilted); TT exits "
+                "not tested against the exit's normals; R's exit tested against the macro normal only; only impact "
+                "parameters |h| <= 0.999 of the projected width, normalised by the whole width");
+    a.push_back("form=cycles_eval: not reproduced: R's half vectors behind the mesonormal (Cycles' D counts them), "
+                "TT where the exit's mesonormal faces away from the chord (Cycles still evaluates it), Cycles' zero "
+                "for exits with tan(tilt) tan(theta_r) > 1, its roughness floor 1e-3 (bins), the Monte Carlo-Simpson "
+                "quadrature itself");
+    if (p.masking != HuangMasking::Correlated || !p.mesonormal_flux || p.residual != HuangResidual::CyclesEval)
+      a.push_back("form=cycles_eval with masking, flux or residual not Cycles' eval()'s: not Cycles as shipped");
+  }
   return a;
 }
 
@@ -989,6 +1048,22 @@ ModelInfo huang2022_info() {
   ParamSpec scale = list_param("lobe_scale", "factors of the R, TT, TRT lobes (Cycles' modulation; 1 = physical)",
                                "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &P::lobe_scale,
                                [](double x) { return x >= 0.0; });
+  ParamSpec form = choice_param<P>(
+      "form",
+      "transport: paper (the paper's, Cycles' sampler's; masking, flux, residual as set) or cycles_eval (Cycles' "
+      "eval() as shipped: inner chords rescaled by mesonormal cosine ratios, TT exits unchecked, R checked against "
+      "the macro normal only, impact parameters |h| <= 0.999; also sets masking=correlated, flux=mesonormal, "
+      "residual=cycles_eval, which later keys may change)",
+      "paper", {"paper", "cycles_eval"},
+      [](P& p, int i) {
+        p.form = static_cast<HuangForm>(i);
+        if (p.form == HuangForm::CyclesEval) {
+          p.masking = HuangMasking::Correlated;
+          p.mesonormal_flux = true;
+          p.residual = HuangResidual::CyclesEval;
+        }
+      },
+      [](const P& p) { return static_cast<int>(p.form); });
   ParamSpec masking = enum_param(
       "masking",
       "Smith masking: separable G1(i) G1(o) (the paper's ground truth, simulator smith_g1); correlated "
@@ -1012,7 +1087,7 @@ ModelInfo huang2022_info() {
                                   });
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param<P>(), sigma_a_param<P>(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
-              ecc,            scale,              masking,
+              ecc,            scale,              form,               masking,
               flux,           residual,           lobes_param<P>(), points};
   m.make = [](const P& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;

@@ -43,13 +43,22 @@
 //
 // What follows the paper and what Cycles (equation numbers are not quoted:
 // the paper was learnt through its Cycles implementation and abstract):
-// What fiberlab follows where the paper and Cycles' eval() differ: the
-// paper's and Cycles' sampler's transport (every interface one microfacet
-// event, light onto the arc by flux=mesonormal at the entry only); Cycles'
-// eval() also rescales the light at the inner interfaces by ratios of
-// mesonormal cosines, does not require TT light to leave on the outer side
-// of the exit normal, and uses its own p >= 3 formula: none of these is
-// here.
+// Where the paper and Cycles' eval() differ, `form=paper` (the default)
+// follows the paper's and Cycles' sampler's transport (every interface one
+// microfacet event, light onto the arc by flux=mesonormal at the entry
+// only); `form=cycles_eval` is Cycles' eval() (bsdf_hair_huang_eval_r,
+// bsdf_hair_huang_eval_residual): it rescales the light of each inner chord
+// by mesonormal cosine ratios (Paths::cycles_eval_chord_ratio), does not
+// test TT light against the exit's normals, tests R's exit against the
+// macro normal only, integrates over the impact parameters |h| <= 0.999 of
+// the projected width only (normalised by the whole width), and sets its
+// masking (correlated), flux (mesonormal) and p >= 3 formula
+// (residual=cycles_eval). Not reproduced: eval_r's half
+// vectors behind the mesonormal (its D is even in the cosine), TT where the
+// exit's mesonormal faces away from the chord (eval still evaluates it),
+// eval's zero for exits with tan(tilt) tan(theta_r) > 1 (a band within
+// `tilt` of the axis), Cycles' roughness floor 1e-3 (bsdf_hair_huang_setup;
+// here only in density()).
 // - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
 //   integral over the lit arc of F(wi.h) D(h) G2(wi, wr) / 4 dl, h the half
 //   vector, D and G about the mesonormal, the arc length dl of the ellipse;
@@ -93,9 +102,8 @@
 //   it is kept for every exit direction (an over-count of that cone's share
 //   of such paths); where the second interface's mesonormal faces away from
 //   the arriving light (tilted fibers only) Cycles still samples a normal,
-//   here the path ends without a residual. Only the residual: Cycles' eval()'s TT and TRT (its inner
-//   mesonormal cosine ratios, its TT without the exit-side test) are not
-//   variants here.
+//   here the path ends without a residual. Cycles' eval()'s TT and TRT are
+//   `form=cycles_eval` (which also sets this residual).
 // - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
 //   1 = the physical model); the residual is not scaled (as in Cycles).
 // - Left out (Cycles): the GGX glass albedo correction (energy_scale, a
@@ -152,6 +160,11 @@ enum class HuangMasking { Separable, Correlated, None };
 // or its eval()'s (from the second interface; see huang2022.cpp).
 enum class HuangResidual { Sampler, CyclesEval };
 
+// The transport: the paper's (and Cycles' sampler's), or that of Cycles'
+// eval() as shipped (its inner mesonormal cosine ratios, its exit-side
+// tests; see huang2022.cpp, Paths).
+enum class HuangForm { Paper, CyclesEval };
+
 // The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
 // `--set` keys to these fields).
 struct Huang2022Params {
@@ -161,9 +174,12 @@ struct Huang2022Params {
   double tilt = 0.0;                       // radians, SPEC's scale_tilt sign
   double eccentricity = 1.0;               // minor/major in (0, 1]
   std::vector<double> lobe_scale{1.0, 1.0, 1.0};  // R, TT, TRT (>= 0)
+  // Set before masking, flux and residual: `form=cycles_eval` in the table
+  // also sets those to Cycles' eval()'s (correlated, mesonormal, cycles_eval).
+  HuangForm form = HuangForm::Paper;
   HuangMasking masking = HuangMasking::Separable;
-  // true (the paper, Cycles' eval): the light reaching an arc element is
-  // (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
+  // true (the paper, Cycles' eval() at the entry): the light reaching an
+  // arc element is (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
   // projected width's (every photon that meets the fiber scatters; Cycles'
   // sampler). They differ by up to tan(tilt) tan(theta_i) (see below).
   bool mesonormal_flux = true;

@@ -37,8 +37,8 @@ void add_where(B* acc, const M& m, const B* x, int C) {
 }  // namespace
 
 bool Tracer::supports(const Huang2022Params& p) {
-  // Every field of Huang2022Params that changes the transport: the masking,
-  // the flux, the residual (each value), tilt, eccentricity, roughness,
+  // Every field of Huang2022Params that changes the transport: the form, the
+  // masking, the flux, the residual (each value), tilt, eccentricity, roughness,
   // sigma_a (up to kMaxChannels), lobe_scale (the TRT gate).
   return static_cast<int>(p.sigma_a.size()) <= kMaxChannels;
 }
@@ -47,7 +47,7 @@ Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
     : eta_(p.eta), inv_eta_(1.0 / p.eta), alpha_(p.roughness), ct_(std::cos(p.tilt)), st_(std::sin(p.tilt)),
       C_(static_cast<int>(p.sigma_a.size())), masking_(p.masking), mesonormal_flux_(p.mesonormal_flux),
       cycles_residual_(p.residual == HuangResidual::CyclesEval),
-      cycles_trt_gate_(for_lobe(p.lobe_scale, 2) > 0.0) {
+      cycles_trt_gate_(for_lobe(p.lobe_scale, 2) > 0.0), cycles_eval_(p.form == HuangForm::CyclesEval) {
   rv_ = 1.0 / std::sqrt(p.eccentricity);
   rw_ = std::sqrt(p.eccentricity);
   irv2_ = 1.0 / (rv_ * rv_);
@@ -138,6 +138,13 @@ void Tracer::trace(const B* u, const B& base, Exits& out) const {
   const M facing = meso > B(0.0);
   for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & !facing, w0);
   alive = alive & facing;
+  if (cycles_eval_) {
+    // Cycles' eval() integrates over |h| <= 0.999 of the projected width only
+    // (Paths::trace, kCyclesEvalMaxImpact).
+    const M outside = xsimd::abs(sg) > B(0.999);
+    for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & outside, w0);
+    alive = alive & !outside;
+  }
   if (!xsimd::any(alive)) return;
 
   const V3 d0 = -wi;
@@ -149,7 +156,8 @@ void Tracer::trace(const B* u, const B& base, Exits& out) const {
   {
     const V3 o = reflect(d0, m);
     const B on = dot(o, h.ns), om = dot(o, h.n0);
-    const M ok = (on > B(0.0)) & (om > B(0.0));
+    // (form=cycles_eval: Cycles' eval_r tests the macro normal only.)
+    const M ok = cycles_eval_ ? om > B(0.0) : (on > B(0.0)) & (om > B(0.0));
     const B gl = leaving(meso, on), wf = w0 * F;
     const M live = alive & ok;
     for (int c = 0; c < C_; ++c) {
@@ -201,11 +209,19 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
     const B len = xsimd::max(B(0.0), -qb / qa);
     // (The scalar Fiber::next also rescales the point onto the ellipse: a
     // change in the last bits only.)
+    const Hit before = at;
     at = hit(at.pv + len * d.y, at.pw + len * d.z);
     B a[kMaxChannels];
     for (int c = 0; c < C; ++c) {
       a[c] = sigma_[c] == 0.0 ? B(1.0) : xsimd::exp(B(-sigma_[c]) * len);  // SPEC s4
       w[c] = w[c] * a[c];
+    }
+    if (cycles_eval_) {
+      // Paths::cycles_eval_chord_ratio: (d.n0 / d.ns) where the chord leaves,
+      // (d.ns / d.n0) where it arrives, 0 where either is not positive.
+      const B leave = dot(d, before.n0) / dot(d, before.ns), arrive = dot(d, at.ns) / dot(d, at.n0);
+      const B ratio = zero_unless((leave > B(0.0)) & (arrive > B(0.0)), leave * arrive);
+      for (int c = 0; c < C; ++c) w[c] = w[c] * ratio;
     }
     const V3 nf = -at.ns, wv = -d;
     const B wn = dot(wv, nf);
@@ -222,7 +238,8 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
       const M leaving_side = alive & !fr.tir;
       const V3 o = refract(d, m, ci, fr.cos_t, eta_);
       const B on = dot(o, at.ns), om = dot(o, at.n0);
-      const M ok = (on > B(0.0)) & (om > B(0.0));
+      // (form=cycles_eval: Cycles' eval() does not test TT's exit side.)
+      const M ok = cycles_eval_ && k == 1 ? M(true) : (on > B(0.0)) & (om > B(0.0));
       const B gl = leaving(wn, on), prob = B(1.0) - F;
       const M live = leaving_side & ok;
       for (int c = 0; c < C; ++c) {

@@ -74,7 +74,7 @@ class Tracer {
   double sigma_[kMaxChannels];
   int C_;
   HuangMasking masking_;
-  bool mesonormal_flux_, cycles_residual_, cycles_trt_gate_;
+  bool mesonormal_flux_, cycles_residual_, cycles_trt_gate_, cycles_eval_;
   double wi_[3], gv_, gw_, cycles_scale_;
 };
 

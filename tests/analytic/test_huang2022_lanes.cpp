@@ -72,6 +72,15 @@ std::vector<Case> cases() {
   out.push_back({"cycles_eval residual", p, 50.0, 10.0});
   p.lobe_scale = {1.0, 1.0, 0.0};
   out.push_back({"cycles_eval residual, TRT factor 0", p, 50.0, 10.0});
+  p = base();
+  p.roughness = 0.3;
+  p.form = HuangForm::CyclesEval;
+  p.masking = HuangMasking::Correlated;
+  p.residual = HuangResidual::CyclesEval;
+  p.tilt = deg_to_rad(8.0);
+  p.eccentricity = 0.8;
+  p.sigma_a = {0.3};
+  out.push_back({"form cycles_eval, tilt 8, ellipse", p, 60.0, 20.0});
   return out;
 }
 
