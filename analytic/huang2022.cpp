@@ -3,11 +3,13 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
 #include <variant>
 
+#include "analytic/huang2022_lanes.h"
 #include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
@@ -26,6 +28,7 @@ constexpr int kResidualP = 3;              // every order p >= 3 in one lobe (Cy
 constexpr double kMinDensityRoughness = 1e-3;  // density(): Cycles' clamp of the roughness
 constexpr int kArcNodes = 4096;            // density(): midpoint nodes over the arc (R)
 constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta in theta_r
+constexpr double kCyclesEvalMaxImpact = 0.999;  // form=cycles_eval: Cycles' eval() clamps |h| / r to this
 
 // ---- The point set ---------------------------------------------------------------
 // Halton's point set: coordinate k of point i is the radical inverse of i in
@@ -72,6 +75,39 @@ class Halton {
     u[0] += half_cell_;  // midpoints in dimension 0
     if (u[0] >= 1.0) u[0] -= 1.0;
   }
+  // The W points from the current one (coordinate k of point l in
+  // u[k][l]), then advanced past them. The same values as W calls of
+  // get() and advance(): within a block the lowest digits of W consecutive
+  // indices are consecutive table entries over the same higher blocks.
+  template <int W>
+  void get_lanes(double (*u)[W]) {
+    for (int k = 0; k < kDims; ++k) {
+      Digits& d = digits_[k];
+      if (d.c[0] + W > d.block) {  // a carry inside the group: point by point
+        for (int l = 0; l < W; ++l) {
+          u[k][l] = value(d);
+          step(d);
+        }
+        continue;
+      }
+      double hi = 0.0;
+      for (int q = d.used - 1; q > 0; --q) hi = (hi + d.table[d.c[q]]) * d.inv_block;
+      const double* t = &d.table[d.c[0]];
+      for (int l = 0; l < W; ++l) u[k][l] = hi + t[l];
+      d.c[0] += W;
+      if (d.c[0] == d.block) {
+        d.c[0] = 0;
+        for (int q = 1; q < kMaxBlocks; ++q) {
+          if (++d.c[q] < d.block) break;
+          d.c[q] = 0;
+        }
+      }
+    }
+    for (int l = 0; l < W; ++l) {
+      u[0][l] += half_cell_;
+      if (u[0][l] >= 1.0) u[0][l] -= 1.0;
+    }
+  }
   void advance() {
     for (Digits& d : digits_)
       for (int q = 0; q < kMaxBlocks; ++q) {
@@ -90,6 +126,17 @@ class Halton {
     std::vector<double> table;
     unsigned c[kMaxBlocks] = {};
   };
+  static double value(const Digits& d) {
+    double r = 0.0;
+    for (int q = d.used - 1; q >= 0; --q) r = (r + d.table[d.c[q]]) * (q > 0 ? d.inv_block : 1.0);
+    return r;
+  }
+  static void step(Digits& d) {
+    for (int q = 0; q < kMaxBlocks; ++q) {
+      if (++d.c[q] < d.block) break;
+      d.c[q] = 0;
+    }
+  }
   Digits digits_[kDims];
   double half_cell_;
 };
@@ -238,11 +285,17 @@ struct Sink {
   virtual bool arrive(int, const Hit&, const Vec3&, const double*) { return true; }
 };
 
+// Which sides of an interface's normals a leaving direction must take:
+// both the mesonormal's and the macro normal's (the paper), the macro
+// normal's only, or none (form=cycles_eval, see Paths::branch).
+enum class Sides { Both, Macro, None };
+
 class Paths {
  public:
   Paths(const Huang2022Params& p, double theta_i, double phi_i)
       : p_(p), fiber_(p.eccentricity, p.tilt), surface_(p.roughness, p.masking),
         wi_(direction_from_angles(theta_i, phi_i)), cycles_residual_(p.residual == HuangResidual::CyclesEval),
+        cycles_eval_(p.form == HuangForm::CyclesEval),
         cos_i_(std::cos(theta_i)),
         cycles_width_(fiber_.projected_width(wi_.y(), wi_.z()) * std::sqrt(p.eccentricity)),
         C_(static_cast<int>(p.sigma_a.size())) {}
@@ -269,13 +322,17 @@ class Paths {
     sink.incident(w0);
     if (!(macro > 0.0) || w0 == 0.0) return;
     if (!(meso > 0.0)) return sink.lost(false, w.c);  // macro flux only: no visible scale
+    // Cycles' eval() (bsdf_hair_huang_eval) integrates over |h| <= 0.999 of
+    // the projected width only, normalised by the whole width.
+    if (cycles_eval_ && std::abs(std::sin(g)) > kCyclesEvalMaxImpact) return sink.lost(false, w.c);
     const Vec3 m = surface_.normal(h.ns, wi_, pt.u[1], pt.u[2]);
     const double ci = wi_.dot(m);
     const double F = fresnel_dielectric(ci, p_.eta);
-    // R: reflection about m.
+    // R: reflection about m (Cycles' eval() tests its side of the macro
+    // normal only).
     branch(0, d0, reflect(d0, m), h, +1, F, w, sink, [&](const Vec3& o, const double* wr) {
       sink.exit(0, o, wr);
-    });
+    }, cycles_eval_ ? Sides::Macro : Sides::Both);
     // T: into the fiber.
     Vec3 t;
     if (!refract(d0, m, p_.eta, t)) return;
@@ -294,14 +351,16 @@ class Paths {
   // the macro normal (else stopped), applies the leaving masking, continues.
   // `side` of the arrival: the facing normals are side * ns, side * n0 with
   // side = +1 outside (arriving along d0 from outside) and -1 inside.
+  // `sides` relaxes the check for Cycles' eval() (form=cycles_eval).
   template <class Next>
   void branch(int inside_events, const Vec3& d, const Vec3& o, const Hit& h, int cross,
-              double prob, const Weights& w, Sink& sink, Next next) const {
+              double prob, const Weights& w, Sink& sink, Next next, Sides sides = Sides::Both) const {
     const double side = inside_events == 0 ? 1.0 : -1.0;
     const Vec3 nf = side * h.ns, nm = side * h.n0;
     Weights wo, lost;
     const double on = o.dot(nf) * cross, om = o.dot(nm) * cross;
-    if (!(on > 0.0) || !(om > 0.0)) {
+    const bool meso_ok = on > 0.0 || sides != Sides::Both, macro_ok = om > 0.0 || sides == Sides::None;
+    if (!meso_ok || !macro_ok) {
       for (int c = 0; c < C_; ++c) lost.c[c] = w.c[c] * prob;
       if (prob > 0.0) sink.lost(false, lost.c);
       return;
@@ -331,9 +390,10 @@ class Paths {
     Weights wa, a;
     for (int c = 0; c < C_; ++c) wa.c[c] = w[c];
     if (!fiber_.next(from, d, h, len)) return sink.lost(false, wa.c);
+    const double ratio = cycles_eval_ ? cycles_eval_chord_ratio(from, h, d) : 1.0;
     for (int c = 0; c < C_; ++c) {
       a.c[c] = std::exp(-p_.sigma_a[c] * len);  // the chord's 3D length (SPEC s4)
-      wa.c[c] *= a.c[c];
+      wa.c[c] *= a.c[c] * ratio;
     }
     if (!sink.arrive(k - 1, h, d, wa.c)) return;
     const Vec3 nf = -h.ns;
@@ -344,9 +404,11 @@ class Paths {
     // Out: order p = k.
     Vec3 t;
     if (refract(d, m, 1.0 / p_.eta, t)) {
+      // Cycles' eval() lets TT light leave on either side of the exit's normals.
+      const Sides sides = cycles_eval_ && k == 1 ? Sides::None : Sides::Both;
       branch(1, d, t, h, -1, 1.0 - F, wa, sink, [&](const Vec3& o, const double* wo) {
         sink.exit(k, o, wo);
-      });
+      }, sides);
     }
     // Internal reflection: order k + 1 and beyond.
     const Vec3 r = reflect(d, m);
@@ -396,11 +458,29 @@ class Paths {
     sink.residual(e.c, pt.u[7], pt.u[8]);
   }
 
+  // form=cycles_eval: the factor by which Cycles' eval() rescales the light
+  // of a chord along d from interface `from` to interface `to`. Cycles
+  // (bsdf_principled_hair_huang.h, bsdf_hair_huang_eval_residual) weights a
+  // TT path by cos_mi1 / cos_mo1 times the exit's arc length per entry arc
+  // angle, a TRT path also by cos_mi2 / cos_mo2 (cos_mo: the leaving
+  // direction's cosine to the mesonormal of the interface it leaves, cos_mi:
+  // the arriving one's at the next); the paper's transport carries the flux
+  // onto the entry arc, and its last interface's VNDF holds 1 / cos_mi.
+  // Parallel chords keep their flux through the cross-section, so the exit
+  // arc per entry arc is (d.n0_from) / (d.n0_to), and per chord Cycles'
+  // eval() is the paper's transport times (d.n0 / d.ns) at `from` and
+  // (d.ns / d.n0) at `to` (SPEC s2's n0 and n_s; 1 without tilt). 0 where
+  // the chord meets the mesonormal of `to` from behind (the path ends).
+  static double cycles_eval_chord_ratio(const Hit& from, const Hit& to, const Vec3& d) {
+    const double leave = d.dot(from.n0) / d.dot(from.ns), arrive = d.dot(to.ns) / d.dot(to.n0);
+    return arrive > 0.0 && leave > 0.0 ? leave * arrive : 0.0;
+  }
+
   const Huang2022Params& p_;
   Fiber fiber_;
   Surface surface_;
   Vec3 wi_;
-  bool cycles_residual_;
+  bool cycles_residual_, cycles_eval_;
   double cos_i_, cycles_width_;
   int C_;
 };
@@ -416,6 +496,41 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
+// The same points W at a time through the lanes' paths (huang2022_lanes.h):
+// deposit(exits, u) takes each group's exits and coordinates. The last
+// group's lanes past point n - 1 carry weight 0 (their paths end at the
+// entry).
+template <class Deposit>
+void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposit) {
+  using huang_lanes::B;
+  constexpr int W = huang_lanes::kWidth;
+  const double base = 1.0 / static_cast<double>(n);
+  Halton set(0, n, static_cast<std::uint64_t>(n) + W);
+  alignas(64) double u[kDims][W], share[W];
+  B ub[kDims];
+  huang_lanes::Exits exits;
+  for (long i0 = 0; i0 < n; i0 += W) {
+    set.get_lanes<W>(u);
+    for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? base : 0.0;
+    for (int k = 0; k < kDims; ++k) ub[k] = B::load_aligned(u[k]);
+    tracer.trace(ub, B::load_aligned(share), exits);
+    deposit(exits, u);
+  }
+}
+
+// Bit l set where lane l of m is.
+unsigned lane_bits(const huang_lanes::M& m) {
+  using huang_lanes::B;
+#if defined(__AVX512F__)
+  if constexpr (huang_lanes::kWidth == 8) return static_cast<unsigned>(static_cast<__mmask8>(m.data));
+#endif
+  alignas(64) double f[huang_lanes::kWidth];
+  xsimd::select(m, B(1.0), B(0.0)).store_aligned(f);
+  unsigned bits = 0;
+  for (int l = 0; l < huang_lanes::kWidth; ++l) bits |= (f[l] != 0.0 ? 1u : 0u) << l;
+  return bits;
+}
+
 // The residual's inclination for the point (u1, u2): a von Mises-Fisher
 // spread (kappa = 1/v) of the specular direction at inclination -theta_i,
 // whose theta-marginal is d'Eon's M_p(v) (SPEC s3).
@@ -429,6 +544,17 @@ double residual_theta(double theta_i, double v, double u1, double u2) {
 }
 
 int lobe_index(int p, int lobes) { return lobe_of(std::min(p, kResidualP), lobes); }
+
+// Whether the model is symmetric under the mirror through the fiber axis u
+// and the light's direction (relative azimuth phi -> -phi): that plane must
+// be a symmetry plane of the cross-section, i.e. any plane on a circle and
+// the planes of the ellipse's axes v (phi_i = 0, 180 deg) and w (+-90 deg)
+// on an ellipse. The mirror keeps u, so the tilted mesonormal
+// cos(tilt) n0 - sin(tilt) u maps to the mirrored point's, and isotropic
+// GGX facets, Fresnel, masking and absorption are mirror-invariant.
+bool mirror_symmetric(const Huang2022Params& p, double phi_i) {
+  return p.eccentricity == 1.0 || std::abs(std::sin(2.0 * phi_i)) < 1e-12;
+}
 
 }  // namespace
 
@@ -482,19 +608,100 @@ std::vector<double> residual_theta_masses(const BinGrid& grid, double theta_i, d
 // spread over the theta bins by its M_p (or, for v below
 // kMinExactResidualV, lands in the theta bin of its sampled inclination),
 // evenly over phi (finish()).
+//
+// Where the model is mirror-symmetric (mirror_symmetric()), each exit lands
+// half in its bin and half in the bin of its mirror image (relative azimuth
+// -phi; done once after the points, finish(), as the average of every phi
+// bin with its mirror bin): the mirrored path has the same weight and the same density, so
+// this averages the push-forward of the point set and of its mirror image,
+// an estimate of the same integral from twice the paths (its quadrature
+// error about 1/sqrt(2) of the unmirrored one's at the same cost: measured
+// in analytic/huang2022.h).
 class BinSink : public Sink {
  public:
   BinSink(const Paths& paths, const BinGrid& grid, double theta_i, double phi_i, std::vector<double>& out)
       : paths_(paths), grid_(grid), theta_i_(theta_i), phi_i_(phi_i), out_(out),
         C_(paths.channels()), L_(paths.params().lobes), v_(4.0 * paths.params().roughness),
+        mirror_(mirror_symmetric(paths.params(), phi_i)),
         residual_(static_cast<std::size_t>(grid.n_theta()) * C_, 0.0) {
     for (int p = 0; p < kResidualP; ++p) scale_[p] = paths.scale(p);
   }
-  void exit(int p, const Vec3& o, const double* w) override {
-    const int i = grid_.theta_bin(inclination(o)), j = grid_.phi_bin(wrap_angle(azimuth(o) - phi_i_));
+  void exit(int p, const Vec3& o, const double* w) override { deposit(p, inclination(o), azimuth(o) - phi_i_, w); }
+  // W points' exits and residuals (integrate_lanes). Each exit's bin as
+  // BinGrid::theta_bin / phi_bin would give it: the closed-form index per
+  // lane (xsimd's asin and atan2), and where a lane lies within 1e-9 of a
+  // bin's width of an edge, BinGrid's own rule on that lane's angles; each
+  // live lane deposited as exit() does.
+  void lanes(const huang_lanes::Exits& e, const double (*u)[huang_lanes::kWidth]) {
+    using huang_lanes::B;
+    using huang_lanes::M;
+    constexpr int W = huang_lanes::kWidth;
+    const int nt = grid_.n_theta(), np = grid_.n_phi();
+    const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
+    alignas(64) double at[W], ai[W], aj[W], w[kMaxChannels][W];
+    // floor(g) clamped to [0, n - 1] into out; the lanes within 1e-9 of an integer.
+    auto index = [](const B& g, int n, double* out) {
+      const B f = xsimd::floor(g), r = g - f;
+      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), f)).store_aligned(out);
+      return (r < B(1e-9)) | (r > B(1.0 - 1e-9));
+    };
+    for (int p = 0; p < kResidualP; ++p) {
+      unsigned bits = lane_bits(e.live[p]);
+      if (bits == 0) continue;
+      const huang_lanes::V3& o = e.dir[p];
+      const B x = xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x));
+      M near;
+      if (uniform) {
+        const B t = xsimd::asin(x);
+        t.store_aligned(at);
+        near = index((t + B(0.5 * kPi)) * B(nt / kPi), nt, ai);
+      } else {
+        x.store_aligned(at);  // asin only where a lane is near an edge
+        near = index((x + B(1.0)) * B(0.5 * nt), nt, ai);
+      }
+      const B f = xsimd::atan2(o.z, o.y) - B(phi_i_);
+      near = near | index((wrap(f) + B(kPi)) * B(np / kTwoPi), np, aj);
+      unsigned settle = lane_bits(near);
+      alignas(64) double phi[W];
+      if (settle & bits) f.store_aligned(phi);
+      const double s = scale_[p];
+      for (int c = 0; c < C_; ++c) (B(s) * e.w[p][c]).store_aligned(w[c]);
+      const int lobe = lobe_index(p, L_);
+      // The bins' offsets in out_ (exact in doubles).
+      alignas(64) double offset[W];
+      ((B(static_cast<double>(lobe) * nt) + B::load_aligned(ai)) * B(static_cast<double>(np) * C_) +
+       B::load_aligned(aj) * B(C_))
+          .store_aligned(offset);
+      for (; bits != 0; bits &= bits - 1) {
+        const int l = std::countr_zero(bits);
+        double* b = settle >> l & 1 ? bin(lobe, grid_.theta_bin(uniform ? at[l] : std::asin(at[l])),
+                                         grid_.phi_bin(wrap_angle(phi[l])))
+                                    : &out_[static_cast<std::size_t>(offset[l])];
+        for (int c = 0; c < C_; ++c) b[c] += w[c][l];
+      }
+    }
+    if (v_ >= kMinExactResidualV) {
+      for (int c = 0; c < C_; ++c) residual_[c] += xsimd::hadd(e.residual[c]);
+      return;
+    }
+    for (int c = 0; c < C_; ++c) e.residual[c].store_aligned(w[c]);
+    for (int l = 0; l < W; ++l) {
+      double wl[kMaxChannels];
+      for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
+      residual(wl, u[7][l], u[8][l]);
+    }
+  }
+  // wrap_angle() per lane: to [-pi, pi).
+  static huang_lanes::B wrap(const huang_lanes::B& a) {
+    using huang_lanes::B;
+    const B x = a + B(kPi);
+    const B w = x - B(kTwoPi) * xsimd::floor(x * B(1.0 / kTwoPi)) - B(kPi);
+    return xsimd::select(w >= B(kPi), B(-kPi), w);
+  }
+  void deposit(int p, double theta, double phi, const double* w) {
+    const int i = grid_.theta_bin(theta), j = grid_.phi_bin(wrap_angle(phi));
     double* b = bin(lobe_index(p, L_), i, j);
-    const double s = scale_[p];
-    for (int c = 0; c < C_; ++c) b[c] += s * w[c];
+    for (int c = 0; c < C_; ++c) b[c] += scale_[p] * w[c];
   }
   void residual(const double* w, double u1, double u2) override {
     const int i = v_ < kMinExactResidualV ? grid_.theta_bin(residual_theta(theta_i_, v_, u1, u2)) : 0;
@@ -505,6 +712,15 @@ class BinSink : public Sink {
   // Spreads the residual (call once, after the points).
   void finish() {
     const int np = grid_.n_phi(), nt = grid_.n_theta();
+    // The mirror image of phi bin j is bin np - 1 - j (the phi edges are
+    // uniform on [-pi, pi), symmetric about 0).
+    if (mirror_)
+      for (int l = 0; l < L_; ++l)
+        for (int i = 0; i < nt; ++i)
+          for (int j = 0; j < np / 2; ++j) {
+            double *a = bin(l, i, j), *b = bin(l, i, np - 1 - j);
+            for (int c = 0; c < C_; ++c) a[c] = b[c] = 0.5 * (a[c] + b[c]);
+          }
     std::vector<double> per_theta(residual_);
     if (v_ >= kMinExactResidualV) {
       const std::vector<double> mass = residual_theta_masses(grid_, theta_i_, v_);
@@ -528,6 +744,7 @@ class BinSink : public Sink {
   std::vector<double>& out_;
   int C_, L_;
   double v_;
+  bool mirror_;
   double scale_[kResidualP];
   std::vector<double> residual_;  // per theta bin (sampled spread) or in row 0 (the total)
 };
@@ -546,8 +763,22 @@ class EnergySink : public Sink {
     for (int c = 0; c < C_; ++c) (masked ? e_.masked : e_.stopped)[c] += w[c];
   }
   void incident(double w) override { e_.incident += w; }
+  // W points' paths (integrate_lanes): the same sums.
+  void lanes(const huang_lanes::Exits& x) {
+    for (int p = 0; p < kResidualP; ++p) add_lanes(p, x.w[p], paths_.scale(p));
+    add_lanes(kResidualP, x.residual, 1.0);
+    for (int c = 0; c < C_; ++c) {
+      e_.masked[c] += xsimd::hadd(x.masked[c]);
+      e_.stopped[c] += xsimd::hadd(x.stopped[c]);
+    }
+    e_.incident += xsimd::hadd(x.incident);
+  }
 
  private:
+  void add_lanes(int p, const huang_lanes::B* w, double s) {
+    double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
+    for (int c = 0; c < C_; ++c) l[c] += s * xsimd::hadd(w[c]);
+  }
   void add(int p, const double* w, double s) {
     double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
     for (int c = 0; c < C_; ++c) l[c] += s * w[c];
@@ -575,7 +806,9 @@ class LastInterfaceSink : public Sink {
     const double eta = paths_.params().eta;
     const Vec3 nf = -h.ns, wv = -d;
     const double wn = wv.dot(nf), on = wr_.dot(nf);
-    if (!(wn > 0.0) || !(on < 0.0) || !(wr_.dot(h.n0) > 0.0)) return false;
+    // Cycles' eval() has no exit-side test for TT (form=cycles_eval).
+    const bool any_side = stop_at_ == 0 && paths_.params().form == HuangForm::CyclesEval;
+    if (!(wn > 0.0) || (!any_side && (!(on < 0.0) || !(wr_.dot(h.n0) > 0.0)))) return false;
     const Vec3 m = (wr_ - eta * d).normalized();
     const double om = wr_.dot(m), wm = wv.dot(m);
     if (!(om < 0.0) || !(wm > 0.0)) return false;
@@ -604,12 +837,20 @@ double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
   const Vec3 hv = (wi + wr).normalized();
   const double F = fresnel_dielectric(wi.dot(hv), p.eta);
   const double dt = kTwoPi / kArcNodes;
+  // form=cycles_eval: the impact parameter across the projected width (unit
+  // half width), which Cycles' eval() clamps (Paths::trace).
+  const double bn = std::hypot(wi.y(), wi.z()), half = 0.5 * fb.projected_width(wi.y(), wi.z());
+  const double across_v = -wi.z() / bn / half, across_w = wi.y() / bn / half;
   double sum = 0.0;
   for (int k = 0; k < kArcNodes; ++k) {
     const double t = (k + 0.5) * dt;
     const Hit h = fb.at(t);
+    if (p.form == HuangForm::CyclesEval && std::abs(h.pv * across_v + h.pw * across_w) > kCyclesEvalMaxImpact)
+      continue;
     const double in = wi.dot(h.ns), out = wr.dot(h.ns), c = hv.dot(h.ns);
-    if (!(wi.dot(h.n0) > 0.0) || !(wr.dot(h.n0) > 0.0) || !(in > 0.0) || !(out > 0.0) || !(c > 0.0))
+    // Cycles' eval_r tests wr against the macro normal only (form=cycles_eval).
+    const bool out_ok = out > 0.0 || p.form == HuangForm::CyclesEval;
+    if (!(wi.dot(h.n0) > 0.0) || !(wr.dot(h.n0) > 0.0) || !(in > 0.0) || !out_ok || !(c > 0.0))
       continue;
     const double D = ggx::D(Vec3(std::sqrt(std::max(0.0, 1.0 - c * c)), 0.0, c), sf.alpha(), sf.alpha());
     const double G = sf.leaving(in, out) / (1.0 + sf.lambda(in));
@@ -627,7 +868,13 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
   const Paths paths(params_, theta_i, phi_i);
   BinSink sink(paths, grid, theta_i, phi_i, out);
-  integrate(paths, params_.quadrature_points, sink);
+  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
+    integrate(paths, params_.quadrature_points, sink);
+  } else {
+    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
+    integrate_lanes(tracer, params_.quadrature_points,
+                    [&](const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) { sink.lanes(e, u); });
+  }
   sink.finish();
   return out;
 }
@@ -636,7 +883,13 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   HuangEnergies e;
   const Paths paths(params_, theta_i, phi_i);
   EnergySink sink(paths, e);
-  integrate(paths, params_.quadrature_points, sink);
+  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
+    integrate(paths, params_.quadrature_points, sink);
+  } else {
+    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
+    integrate_lanes(tracer, params_.quadrature_points,
+                    [&](const huang_lanes::Exits& x, const double(*)[huang_lanes::kWidth]) { sink.lanes(x); });
+  }
   return e;
 }
 
@@ -688,11 +941,26 @@ std::vector<std::string> huang_approximations(const Huang2022Params& p) {
   else
     a.push_back("p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, "
                 "uniform in phi), not Cycles' eval()'s");
+  const bool cycles_eval = p.form == HuangForm::CyclesEval;
   if (p.mesonormal_flux)
-    a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
-        "also rescales at the inner interfaces, not done here)");
+    a.push_back(cycles_eval ? "flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted "
+                              "(paper, Cycles' eval())"
+                            : "flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted "
+                              "(paper; Cycles' eval() also rescales at the inner interfaces: form=cycles_eval)");
   if (p.masking == HuangMasking::Correlated)
     a.push_back("masking: height-correlated G2 (Cycles' code)");
+  if (cycles_eval) {
+    a.push_back("form=cycles_eval: Cycles' eval() transport: each inner chord's light rescaled by (d.n0/d.ns) at the "
+                "interface it leaves and (d.ns/d.n0) at the one it meets (not energy-conserving once tilted); TT exits "
+                "not tested against the exit's normals; R's exit tested against the macro normal only; only impact "
+                "parameters |h| <= 0.999 of the projected width, normalised by the whole width");
+    a.push_back("form=cycles_eval: not reproduced: R's half vectors behind the mesonormal (Cycles' D counts them), "
+                "TT where the exit's mesonormal faces away from the chord (Cycles still evaluates it), Cycles' zero "
+                "for exits with tan(tilt) tan(theta_r) > 1, its roughness floor 1e-3 (bins), the Monte Carlo-Simpson "
+                "quadrature itself");
+    if (p.masking != HuangMasking::Correlated || !p.mesonormal_flux || p.residual != HuangResidual::CyclesEval)
+      a.push_back("form=cycles_eval with masking, flux or residual not Cycles' eval()'s: not Cycles as shipped");
+  }
   return a;
 }
 
@@ -780,6 +1048,22 @@ ModelInfo huang2022_info() {
   ParamSpec scale = list_param("lobe_scale", "factors of the R, TT, TRT lobes (Cycles' modulation; 1 = physical)",
                                "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &P::lobe_scale,
                                [](double x) { return x >= 0.0; });
+  ParamSpec form = choice_param<P>(
+      "form",
+      "transport: paper (the paper's, Cycles' sampler's; masking, flux, residual as set) or cycles_eval (Cycles' "
+      "eval() as shipped: inner chords rescaled by mesonormal cosine ratios, TT exits unchecked, R checked against "
+      "the macro normal only, impact parameters |h| <= 0.999; also sets masking=correlated, flux=mesonormal, "
+      "residual=cycles_eval, which later keys may change)",
+      "paper", {"paper", "cycles_eval"},
+      [](P& p, int i) {
+        p.form = static_cast<HuangForm>(i);
+        if (p.form == HuangForm::CyclesEval) {
+          p.masking = HuangMasking::Correlated;
+          p.mesonormal_flux = true;
+          p.residual = HuangResidual::CyclesEval;
+        }
+      },
+      [](const P& p) { return static_cast<int>(p.form); });
   ParamSpec masking = enum_param(
       "masking",
       "Smith masking: separable G1(i) G1(o) (the paper's ground truth, simulator smith_g1); correlated "
@@ -797,13 +1081,13 @@ ModelInfo huang2022_info() {
       "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
       "sampler", {"sampler", "cycles_eval"}, &P::residual);
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
-                                  "integer", "4194304", "an integer in [1024, 1073741824]",
+                                  "integer", "8388608", "an integer in [1024, 1073741824]",
                                   &P::quadrature_points, [](double x) {
                                     return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
                                   });
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param<P>(), sigma_a_param<P>(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
-              ecc,            scale,              masking,
+              ecc,            scale,              form,               masking,
               flux,           residual,           lobes_param<P>(), points};
   m.make = [](const P& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;

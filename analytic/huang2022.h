@@ -43,13 +43,22 @@
 //
 // What follows the paper and what Cycles (equation numbers are not quoted:
 // the paper was learnt through its Cycles implementation and abstract):
-// What fiberlab follows where the paper and Cycles' eval() differ: the
-// paper's and Cycles' sampler's transport (every interface one microfacet
-// event, light onto the arc by flux=mesonormal at the entry only); Cycles'
-// eval() also rescales the light at the inner interfaces by ratios of
-// mesonormal cosines, does not require TT light to leave on the outer side
-// of the exit normal, and uses its own p >= 3 formula: none of these is
-// here.
+// Where the paper and Cycles' eval() differ, `form=paper` (the default)
+// follows the paper's and Cycles' sampler's transport (every interface one
+// microfacet event, light onto the arc by flux=mesonormal at the entry
+// only); `form=cycles_eval` is Cycles' eval() (bsdf_hair_huang_eval_r,
+// bsdf_hair_huang_eval_residual): it rescales the light of each inner chord
+// by mesonormal cosine ratios (Paths::cycles_eval_chord_ratio), does not
+// test TT light against the exit's normals, tests R's exit against the
+// macro normal only, integrates over the impact parameters |h| <= 0.999 of
+// the projected width only (normalised by the whole width), and sets its
+// masking (correlated), flux (mesonormal) and p >= 3 formula
+// (residual=cycles_eval). Not reproduced: eval_r's half
+// vectors behind the mesonormal (its D is even in the cosine), TT where the
+// exit's mesonormal faces away from the chord (eval still evaluates it),
+// eval's zero for exits with tan(tilt) tan(theta_r) > 1 (a band within
+// `tilt` of the axis), Cycles' roughness floor 1e-3 (bsdf_hair_huang_setup;
+// here only in density()).
 // - R (paper: the analytical R lobe for GGX): S_R = 1/(W cos theta_i)
 //   integral over the lit arc of F(wi.h) D(h) G2(wi, wr) / 4 dl, h the half
 //   vector, D and G about the mesonormal, the arc length dl of the ellipse;
@@ -93,9 +102,8 @@
 //   it is kept for every exit direction (an over-count of that cone's share
 //   of such paths); where the second interface's mesonormal faces away from
 //   the arriving light (tilted fibers only) Cycles still samples a normal,
-//   here the path ends without a residual. Only the residual: Cycles' eval()'s TT and TRT (its inner
-//   mesonormal cosine ratios, its TT without the exit-side test) are not
-//   variants here.
+//   here the path ends without a residual. Cycles' eval()'s TT and TRT are
+//   `form=cycles_eval` (which also sets this residual).
 // - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
 //   1 = the physical model); the residual is not scaled (as in Cycles).
 // - Left out (Cycles): the GGX glass albedo correction (energy_scale, a
@@ -107,20 +115,38 @@
 // point of the point set (h uniform over the projected width, the
 // microfacet normals of up to three interfaces) is one path whose exit
 // direction lands in one bin, with weight 1/N times its Fresnel, masking
-// and absorption factors; the residual's weight is spread over the theta
+// and absorption factors (where the fiber is mirror-symmetric about the
+// plane of the light and the fiber axis, a circle or an ellipse lit along
+// one of its axes, phi_i a multiple of 90 deg: half of it in that bin and
+// half in the bin of its mirror image, relative azimuth -phi, the push-
+// forward of the mirrored point set averaged in); the residual's weight is spread over the theta
 // bins by the integral of its M_p over each bin (Gauss-Legendre, exact to
 // the rule) and evenly over phi (for v = 4 alpha below 1e-6 the spread is
 // sampled by two more coordinates of the point set). Each lobe's total is
 // therefore the model's energy up to the quadrature error, and alpha = 0 is
 // the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
 // smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
-// `quadrature_points` (2^22 by default). The quadrature error of R, TT and
-// TRT falls about 4x per 4x points (a push-forward of a fixed point set
-// into bins converges like an estimate from as many independent paths, a
-// little better): at the atlas's grid (24 x 36 bins) and photon count (300k)
-// the mean squared bin error over the simulated bin's variance is about
-// N_photons / N_points times 0.2-0.5 for TT and TRT. Lower it for quick
-// looks, raise it for long simulations.
+// `quadrature_points` (2^23 by default); bin_probabilities() and energies()
+// trace 8 points at a time in SIMD lanes (4 without AVX-512;
+// huang2022_lanes.h, the same transport as the scalar paths that density()
+// uses). The quadrature error of R, TT and TRT falls about 4x per 4x
+// points (a push-forward of a fixed point set into bins converges like an
+// estimate from as many independent paths, a little better; the error
+// comes from the facet normals' coordinates, not from h: an
+// Owen-scrambled Sobol' set, or 16 to 256 entry points h per sample of the
+// normals, did no better at the same number of paths): at the
+// atlas's grid (24 x 36 bins) and photon count (300k) the mean squared bin
+// error over the simulated bin's variance is about N_photons / N_points
+// times 0.10-0.26 for TT and TRT on mirror-symmetric fibers (every fiber of
+// configs/atlas.yaml: `scripts/huang2022_quadrature_error.py
+// configs/atlas.yaml --white`), about twice that without the mirror. At the
+// default 2^23 points, over the 32 fibers and 3 directions of
+// configs/atlas.yaml, the RMS bin error of a fiber is at most 0.011
+// standard errors for R, 0.071 for TT, 0.083 for TRT and 0.002 for p >= 3,
+// single bins up to 0.06, 0.30, 0.31 and 0.004
+// (`scripts/huang2022_quadrature_error.py configs/atlas.yaml --points
+// 8388608 --reference 33554432`; the reference's own error included). Lower
+// it for quick looks, raise it for long simulations.
 #include <memory>
 #include <vector>
 
@@ -134,6 +160,11 @@ enum class HuangMasking { Separable, Correlated, None };
 // or its eval()'s (from the second interface; see huang2022.cpp).
 enum class HuangResidual { Sampler, CyclesEval };
 
+// The transport: the paper's (and Cycles' sampler's), or that of Cycles'
+// eval() as shipped (its inner mesonormal cosine ratios, its exit-side
+// tests; see huang2022.cpp, Paths).
+enum class HuangForm { Paper, CyclesEval };
+
 // The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
 // `--set` keys to these fields).
 struct Huang2022Params {
@@ -143,15 +174,18 @@ struct Huang2022Params {
   double tilt = 0.0;                       // radians, SPEC's scale_tilt sign
   double eccentricity = 1.0;               // minor/major in (0, 1]
   std::vector<double> lobe_scale{1.0, 1.0, 1.0};  // R, TT, TRT (>= 0)
+  // Set before masking, flux and residual: `form=cycles_eval` in the table
+  // also sets those to Cycles' eval()'s (correlated, mesonormal, cycles_eval).
+  HuangForm form = HuangForm::Paper;
   HuangMasking masking = HuangMasking::Separable;
-  // true (the paper, Cycles' eval): the light reaching an arc element is
-  // (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
+  // true (the paper, Cycles' eval() at the entry): the light reaching an
+  // arc element is (wi.ns) dl, the flux onto the mesonormal; false: (wi.n0) dl, the
   // projected width's (every photon that meets the fiber scatters; Cycles'
   // sampler). They differ by up to tan(tilt) tan(theta_i) (see below).
   bool mesonormal_flux = true;
   HuangResidual residual = HuangResidual::Sampler;
   int lobes = 4;                           // 1..4 (p >= 3 is one residual lobe)
-  long quadrature_points = 1L << 22;       // in [1024, 2^30]
+  long quadrature_points = 1L << 23;       // in [1024, 2^30]
 };
 
 // The energy a path integration gives, per channel c: lobe energies
@@ -184,10 +218,15 @@ class Huang2022 : public Model {
   const Huang2022Params& params() const { return params_; }
   // Points of density()'s set for the interfaces before the last (tests).
   void set_density_points(long n) { density_points_ = n; }
+  // bin_probabilities() and energies() by the scalar paths (the ones
+  // density() uses) instead of the SIMD lanes' (huang2022_lanes.h): tests
+  // compare the two.
+  void set_scalar_paths(bool scalar) { scalar_paths_ = scalar; }
 
  private:
   Huang2022Params params_;
   long density_points_ = 1L << 16;
+  bool scalar_paths_ = false;
 };
 
 std::unique_ptr<Model> make_huang2022(const Huang2022Params& params);

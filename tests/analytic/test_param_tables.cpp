@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <functional>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -113,9 +114,13 @@ TEST(ParamTables, AnotherModelsParametersAreRefused) {
 
 // Every entry of every table: --set text -> show gives the text back, the
 // file attribute holds the value in file units (radians for "deg"), and no
-// other entry of the table moves (each key has its own field of the struct).
+// other entry of the table moves (each key has its own field of the struct)
+// but a preset's documented keys (huang2022's form=cycles_eval sets masking,
+// flux and residual to Cycles' eval()'s).
 // Mutation tried and caught: deon2011's beta_azim bound to the beta_long field.
 TEST(ParamTables, EveryEntryRoundTripsOnItsOwnField) {
+  const std::set<std::string> preset_moves = {"huang2022 form masking", "huang2022 form flux",
+                                              "huang2022 form residual"};
   for (const ModelInfo& m : registered_models()) {
     for (const ParamSpec& spec : m.params) {
       ModelParameters p = default_params(m.name);
@@ -126,7 +131,7 @@ TEST(ParamTables, EveryEntryRoundTripsOnItsOwnField) {
       apply_setting(m.name, p, spec.key + "=" + value);
       EXPECT_EQ(spec.show(p), value) << m.name << " " << spec.key;
       for (const ParamSpec& s : m.params) {
-        if (s.key != spec.key) {
+        if (s.key != spec.key && !preset_moves.count(m.name + " " + spec.key + " " + s.key)) {
           EXPECT_EQ(s.show(p), before[s.key]) << m.name << ": " << spec.key << " moved " << s.key;
         }
       }

@@ -9,6 +9,11 @@ set_tests_properties(atlas_cli PROPERTIES TIMEOUT 300)
 add_test(NAME atlas_variants_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_variants.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
 set_tests_properties(atlas_variants_cli PROPERTIES TIMEOUT 300)
+# huang2022's `form: cycles_eval` (Cycles' eval()) as an atlas variant beside
+# the paper's form: named in file, report and info; only TT and TRT move.
+add_test(NAME atlas_huang_cycles_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_huang_cycles.sh $<TARGET_FILE:fiberlab>)
+set_tests_properties(atlas_huang_cycles_cli PROPERTIES TIMEOUT 300)
 # `mpirun -np 2 fiberlab atlas` (and its --resume of a one-process
 # checkpoint) bit-identical to one process; skipped without mpirun.
 add_test(NAME atlas_mpi_cli

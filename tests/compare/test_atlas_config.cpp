@@ -135,13 +135,15 @@ TEST(AtlasConfig, ModelParametersApplyOnTopOfThePhysicalDefaults) {
 // atlas's grid and photon count. Checked on the config's own ggx 0.3 fiber
 // (tilt 3 deg, e 0.85, white) at theta_i 45 deg against 4x the points: the
 // mean over bins with >= 10 expected photons of (bin error)^2 / (p / N) (the
-// simulated bin's variance, weights 1) is below 0.1 for R (measured 0.014),
+// simulated bin's variance, weights 1) is below 0.1 for R (measured 0.006),
 // below 1e-3 for p >= 3 (its M_p integrated per theta bin: only its total
 // carries quadrature error; measured 1.3e-7 here, up to 1.3e-4 on the
 // config's other white fibers; spreading it by sampled points gave 0.003,
-// which this bound catches) and below 0.6 for
-// TT and TRT (measured 0.43 and 0.40: RMS errors of 0.65 standard errors, as
-// the config's comment says).
+// which this bound catches) and below 0.33 for
+// TT and TRT (measured 0.24 and 0.21: RMS errors of 0.5 standard errors, as
+// the config's comment says; without the mirror-averaging of this
+// mirror-symmetric fiber's bins, analytic/huang2022.cpp's BinSink, 0.43 and
+// 0.40, which this bound catches).
 TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
   const AtlasConfig c = load_atlas_config(FIBERLAB_SOURCE_DIR "/configs/atlas.yaml");
   const AtlasFiber& fiber = c.fibers.at(27);
@@ -169,7 +171,7 @@ TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
     }
     ASSERT_GT(n, 0) << "lobe " << lobe;
     std::printf("lobe %d: mean squared quadrature error / simulated variance %.3f (%d bins)\n", lobe, sum / n, n);
-    EXPECT_LT(sum / n, lobe == 1 || lobe == 2 ? 0.6 : lobe == 3 ? 1e-3 : 0.1) << "lobe " << lobe;
+    EXPECT_LT(sum / n, lobe == 1 || lobe == 2 ? 0.33 : lobe == 3 ? 1e-3 : 0.1) << "lobe " << lobe;
   }
 }
 
