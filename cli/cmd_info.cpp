@@ -45,9 +45,10 @@ void result_info(const std::string& path) {
   else
     fmt::print("roughness: {}, beta_long {} deg, beta_azim {} deg\n", sim::to_string(s.roughness.model),
                degrees(s.roughness.beta_long), degrees(s.roughness.beta_azim));
-  fmt::print("tally: {} x {} bins ({} theta), {} lobes, {} channels; max_segments {}, polarization {}\n",
+  fmt::print("tally: {} x {} bins ({} theta), {} lobes, {} channels; max_segments {}, polarization {}, "
+             "estimator {}\n",
              r.grid.n_theta(), r.grid.n_phi(), to_string(r.grid.theta_binning), r.lobes, r.channels,
-             s.max_segments, sim::to_string(s.polarization));
+             s.max_segments, sim::to_string(s.polarization), sim::to_string(s.estimator));
   print_summary(stdout, r);
 }
 

@@ -34,7 +34,9 @@ struct Pool {
     kPhiI, kScalarColumns,
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
-  enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
+  // kSlot: the photon's slot, for the scorer (sim/life/finished_photons.h;
+  // used with expected-value scoring only).
+  enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kSlot, kBitColumns };
   // W spare lanes past the end: new photons, and the photons in flight
   // packed to the front, are written a whole vector at a time from any lane
   // (BatchTracer::trace_with).
@@ -124,7 +126,8 @@ void exit_angles(FinishedPhotons& f) {
 // them; a model's exit_direction needs each photon's own stream.
 template <class Model, class Light>
 void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, const Lanes& phi_i,
-               const life::BitsOf<Lanes>& photon, std::uint64_t lanes, FinishedPhotons& f) {
+               const life::BitsOf<Lanes>& photon, const life::BitsOf<Lanes>& slot,
+               std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
   if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
   const int n = f.n, k = std::popcount(lanes);
@@ -135,6 +138,8 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   pack_store(s.weight, lanes, f.weight + n);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
+  alignas(64) std::uint64_t slots[W];
+  pack_store(slot, lanes, slots);
   // Fates as fate_of (sim/life/tracer.h) gives them, from the code's mask bits.
   const std::uint64_t exited =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
@@ -147,6 +152,8 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = (lost >> j) & 1;
+    f.last[n + j] = true;
+    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
   }
   // No exit direction for a photon that did not exit.
   for (std::uint64_t rest = ~exited & ((std::uint64_t{1} << k) - 1); rest != 0; rest &= rest - 1) {
@@ -159,6 +166,51 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     for (int j = 0; j < k; ++j) {
       if (!f.exited[n + j]) continue;
       PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
+      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                       f.segments[n + j], rng);
+      f.dx[n + j] = d.x();
+      f.dy[n + j] = d.y();
+      f.dz[n + j] = d.z();
+    }
+  }
+  f.n = n + k;
+}
+
+// The exits that the lanes `lanes` scored by expected value this step
+// (PhotonState::scored), appended to the block f as rows that are not the
+// photon's last (sim/life/finished_photons.h). A model's exit direction draws
+// from the stream scored_exit_stream derives (sim/life/tracer.h), as the
+// reference Tracer does.
+template <class Model, class Light>
+void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>& s,
+                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
+                      const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+  using life::pack_store;
+  if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
+  const int n = f.n, k = std::popcount(lanes);
+  pack_store(s.scored.d.x, lanes, f.dx + n);
+  pack_store(s.scored.d.y, lanes, f.dy + n);
+  pack_store(s.scored.d.z, lanes, f.dz + n);
+  pack_store(s.scored.path, lanes, f.path + n);
+  pack_store(s.scored.weight, lanes, f.weight + n);
+  pack_store(phi_i, lanes, f.phi_i + n);
+  pack_store(photon, lanes, f.photon + n);
+  alignas(64) std::uint64_t slots[W];
+  pack_store(slot, lanes, slots);
+  alignas(64) double segments[W];
+  pack_store(s.scored.segments, lanes, segments);
+  for (int j = 0; j < k; ++j) {
+    f.segments[n + j] = static_cast<int>(segments[j]);
+    f.exited[n + j] = true;
+    f.lost[n + j] = false;
+    f.last[n + j] = false;
+    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
+  }
+  if constexpr (HasExitHook<Model>) {
+    alignas(64) std::uint64_t w[4][W];
+    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
+    for (int j = 0; j < k; ++j) {
+      PhotonRandom rng = scored_exit_stream(w[0][j], w[1][j], w[2][j], w[3][j]);
       const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
                                        f.segments[n + j], rng);
       f.dx[n + j] = d.x();
@@ -202,6 +254,14 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const Eigen::Vector2d beam = ellipse.beam_direction(-direction_from_angles(theta_i, phi_i));
   const Lanes iota = lane_index();
   life::LifeCounts<Lanes> counts;
+  // Free photon slots (expected-value scoring: sim/life/finished_photons.h).
+  const bool expected_value = config_.expected_value;
+  std::vector<std::uint32_t> free_slots(kPoolLanes);
+  for (int i = 0; i < kPoolLanes; ++i) free_slots[i] = static_cast<std::uint32_t>(kPoolLanes - 1 - i);
+  auto take_slot = [&](int lane) {
+    pool.bits[Pool::kSlot][lane] = free_slots.back();
+    free_slots.pop_back();
+  };
 
   // New photons into lanes [o, o + W), photons first, first + 1, ...: the
   // Source's streams and impact parameters and the life's start, a vector at
@@ -238,7 +298,9 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   };
   // A pass over the pool appends at most every lane it holds, and a vector's
   // worth of scratch past them (sim/simd/lane_packing.h).
-  constexpr int kFlushAbove = FinishedPhotons::kCapacity - (kPoolLanes + W);
+  // With expected-value scoring every lane may also hand over an exit it
+  // scored: twice that.
+  constexpr int kFlushAbove = FinishedPhotons::kCapacity - 2 * (kPoolLanes + W);
   static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
 
   // Photons [next, end) of the current run are still to launch.
@@ -260,11 +322,16 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         launch_vector(n_active, next);
         const int n = static_cast<int>(std::min<std::uint64_t>(
             std::min(W, kPoolLanes - n_active), end - next));
+        if (expected_value)
+          for (int j = 0; j < n; ++j) take_slot(n_active + j);
         n_active += n;
         next += n;
       }
     } else {
-      while (n_active < kPoolLanes && more_to_launch()) launch(n_active++, next++);
+      while (n_active < kPoolLanes && more_to_launch()) {
+        if (expected_value) take_slot(n_active);
+        launch(n_active++, next++);
+      }
     }
     if (n_active == 0) break;
     if (done->n > kFlushAbove) flush();
@@ -280,14 +347,27 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       // A fixed incident direction keeps phi_i out of the pool.
       const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
       const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
+      const life::BitsOf<Lanes> slot = load_bits<Lanes>(pool.bits[Pool::kSlot] + o);
       life::step(config_, model, s, live, counts, kRoundsPerStep);
       const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
-      if (finished != 0) hand_over(model, s, phi_lanes, photon, finished, *done);
+      if (expected_value) {
+        // A photon's scored exit goes before its end, if it ended this step.
+        const std::uint64_t scored = life::lane_bits(live & (s.scored.weight > Lanes(0.0)));
+        if (scored != 0) hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
+        if (finished != 0) {
+          alignas(64) std::uint64_t freed[W];
+          life::pack_store(slot, finished, freed);
+          for (int j = 0; j < std::popcount(finished); ++j)
+            free_slots.push_back(static_cast<std::uint32_t>(freed[j]));
+        }
+      }
+      if (finished != 0) hand_over(model, s, phi_lanes, photon, slot, finished, *done);
       pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
       if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
       life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
+      if (expected_value) life::pack_store(slot, in_flight, pool.bits[Pool::kSlot] + kept);
       kept += std::popcount(in_flight);
     }
     n_active = kept;

@@ -1,10 +1,12 @@
 #include "sim/life/exit_scoring.h"
 
+#include <fmt/format.h>
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include "common/error.h"
 #include "common/units.h"
 #include "common/bin_grid.h"
 
@@ -85,10 +87,11 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
 
 }  // namespace
 
-ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes)
+ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
+                       bool expected_value)
     : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
-      kept_(sigma_a_.size()),
+      kept_(sigma_a_.size()), expected_value_(expected_value),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -137,6 +140,10 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
                              static_cast<int>(phi_bin[i]));
     tally.prefetch(bin[i]);
   }
+  if (expected_value_) {
+    score_rows_expected_value(f, bin, tally);
+    return;
+  }
   double* weight = one_photon_.data();
   for (int i = 0; i < f.n; ++i) {
     if (f.exited[i]) {
@@ -159,6 +166,97 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     for (int c = 0; c < channels; ++c) kept[c] = weights_[static_cast<std::size_t>(c) * kCap + slot];
     tally.score_lost(weight, kept);
   }
+}
+
+// A photon's rows in order (sim/life/finished_photons.h): its exits added up
+// per bin, each row's weight booked in fixed point within the room its
+// earlier rows left of its unit weight, and its masking losses (at its last
+// row) booked against all it kept.
+void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin,
+                                           Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const int channels = static_cast<int>(sigma_a_.size());
+  double* weight = one_photon_.data();
+  std::size_t j = 0;  // the next of f.losses (in row order)
+  for (int i = 0; i < f.n; ++i) {
+    OpenPhoton& p = open_photon(f.slot[i]);
+    if (f.exited[i]) {
+      score_scored_exit(bin[i], weights_.data() + i, kCap, p, tally);
+    } else if (!f.lost[i]) {
+      book(weights_.data() + i, kCap, p);
+      tally.score_truncated_fixed(fixed_.data());
+    }
+    if (!f.last[i]) continue;
+    if (j < f.losses.size() && f.losses[j].slot == i) {
+      std::fill(weight, weight + channels, 0.0);
+      for (; j < f.losses.size() && f.losses[j].slot == i; ++j) {
+        const WeightLoss& l = f.losses[j].loss;
+        for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
+      }
+      tally.score_lost(weight, p.booked.data());
+    }
+    p.bins.clear();
+    p.totals.clear();
+    std::fill(p.booked.begin(), p.booked.end(), Tally::Fixed{0});
+  }
+}
+
+ExitScorer::OpenPhoton& ExitScorer::open_photon(std::uint32_t slot) {
+  if (slot >= open_.size()) {
+    open_.resize(slot + 1);
+    for (OpenPhoton& p : open_) p.booked.resize(sigma_a_.size(), Tally::Fixed{0});
+  }
+  return open_[slot];
+}
+
+// One row's weight in fixed point, into fixed_: at most the room the
+// photon's earlier rows left of its unit weight. The parts of a split weight
+// (w P and w (1 - P)) are rounded products whose sum can exceed w by a few
+// 2^-53, and each part rounds to fixed point: on a white fiber that would
+// leave the ledger's absorbed (the complement) a few units below 0. More
+// than rounding (Tally::kRoundingAllowance) is a booking error: an internal
+// error, never clamped.
+void ExitScorer::book(const double* weight, std::size_t stride, OpenPhoton& p) {
+  const std::size_t channels = sigma_a_.size();
+  fixed_.resize(channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
+    const Tally::Fixed room = Tally::kOne - p.booked[c];
+    if (w > room) {
+      if (w - room > Tally::kRoundingAllowance)
+        throw Error(fmt::format("internal error: a photon's exits and truncated weight exceed 1 "
+                                "(channel {}) by more than rounding", c));
+      w = room;
+    }
+    p.booked[c] += w;
+    fixed_[c] = w;
+  }
+}
+
+void ExitScorer::score_scored_exit(std::size_t bin, const double* weight, std::size_t stride,
+                                   OpenPhoton& p, Tally& tally) {
+  const std::size_t channels = sigma_a_.size();
+  book(weight, stride, p);
+  growth_.resize(channels);
+  for (std::size_t e = 0; e < p.bins.size(); ++e) {
+    if (p.bins[e] != bin) continue;
+    // (t + w)^2 - t^2 = w (2 t + w): S2 ends with the square of the photon's total.
+    double* total = p.totals.data() + e * channels;
+    for (std::size_t c = 0; c < channels; ++c) {
+      const double w = weight[c * stride];
+      growth_[c] = w * (2.0 * total[c] + w);
+      total[c] += w;
+    }
+    tally.score_exit_fixed(bin, fixed_.data(), growth_.data(), false);
+    return;
+  }
+  for (std::size_t c = 0; c < channels; ++c) {
+    const double w = weight[c * stride];
+    growth_[c] = w * w;
+    p.totals.push_back(w);
+  }
+  p.bins.push_back(bin);
+  tally.score_exit_fixed(bin, fixed_.data(), growth_.data(), true);
 }
 
 }  // namespace fiberlab::sim

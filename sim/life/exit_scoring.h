@@ -3,6 +3,10 @@
 // Beer-Lambert weight exp(-sigma_a[c] l) per channel along the whole internal
 // path (times the photon's masking throughput), the lobe min(p, L - 1) and the
 // (theta_r, phi_r - phi_i) bin; weight removed by masking as the ledger's lost.
+// With expected-value scoring a photon may leave in one bin more than once
+// (the last lobe collects every p >= L - 1, and a rough point may score
+// twice): its exits are added up per bin as they come (per slot,
+// sim/life/finished_photons.h), so that S2 gains the square of its total.
 #include <cstdint>
 #include <vector>
 
@@ -14,7 +18,7 @@ namespace fiberlab::sim {
 
 class ExitScorer {
  public:
-  ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes);
+  ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes, bool expected_value = false);
   // Weights are computed for a whole block at once (vectorised), the tally
   // cells of the exits are located and prefetched, then added.
   void score(const FinishedPhotons& f, Tally& tally);
@@ -29,6 +33,23 @@ class ExitScorer {
   std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
+  bool expected_value_;
+  // Per slot, the photon in it so far: the bins it left in with its total
+  // weight there ([entry][channel]), and its exited weight ([channel]).
+  // weight so far in fixed point ([channel]: what it booked in the tally).
+  struct OpenPhoton {
+    std::vector<std::size_t> bins;
+    std::vector<double> totals;
+    std::vector<Tally::Fixed> booked;
+  };
+  std::vector<OpenPhoton> open_;
+  std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
+  std::vector<double> growth_;        // [channel]: one row's S2 growth
+  OpenPhoton& open_photon(std::uint32_t slot);
+  void book(const double* weight, std::size_t stride, OpenPhoton& p);
+  void score_scored_exit(std::size_t bin, const double* weight, std::size_t stride, OpenPhoton& p,
+                         Tally& tally);
+  void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within
   // a margin), so that most vectors of bins need no settling on the edges.
   bool theta_closed_form_, phi_closed_form_;

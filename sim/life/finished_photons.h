@@ -2,6 +2,14 @@
 // Photons that a tracer has finished, handed to the scorer a block at a time
 // (structure of arrays), so that weights are computed vectorised and the
 // tally's cells fetched ahead, instead of one call per photon.
+//
+// A row is a photon's end (exited, truncated or lost; `last`), or, with
+// expected-value scoring (Settings::estimator), an exit it scored on the
+// way (exited, not `last`). A photon's rows come in the order it made them,
+// its end last, and carry the tracer's `slot` for the photon: no other
+// photon uses that slot until the photon's last row, so the scorer can add
+// up a photon's exits per bin (SPEC section 6: S2 holds the square of a
+// photon's total in a bin). A photon's rows may span blocks.
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -11,7 +19,7 @@
 namespace fiberlab::sim {
 
 struct FinishedPhotons {
-  static constexpr int kCapacity = 512;  // a multiple of every SIMD width
+  static constexpr int kCapacity = 1024;  // a multiple of every SIMD width
   static_assert(kCapacity % kBatchWidth == 0);
   int n = 0;
   alignas(64) double path[kCapacity] = {};  // internal 3D path length
@@ -22,6 +30,8 @@ struct FinishedPhotons {
   int segments[kCapacity];
   bool exited[kCapacity];
   bool lost[kCapacity];  // killed by masking (its weight is in `losses`)
+  bool last[kCapacity];  // the photon's end (false: an exit scored on the way)
+  std::uint32_t slot[kCapacity];  // the photon's slot in its tracer
   // Weight removed by masking from the block's photons (empty
   // without masking): photon slot, weight, path length at the removal.
   struct Loss {
@@ -40,9 +50,32 @@ struct FinishedPhotons {
     for (double* column : {path, weight, phi_i, dx, dy, dz})
       std::fill(column + n, column + end, 0.0);
   }
+  // An exit that photon `index` scored by expected value (one photon at a
+  // time: slot 0).
+  void add_scored(std::uint64_t index, double incident_phi, const ScoredExitOutcome& e) {
+    if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
+    weight[n] = e.weight;
+    lost[n] = false;
+    last[n] = false;
+    slot[n] = 0;
+    photon[n] = index;
+    phi_i[n] = incident_phi;
+    path[n] = e.path_length;
+    segments[n] = e.segments;
+    exited[n] = true;
+    theta[n] = inclination(e.direction);
+    phi[n] = azimuth(e.direction);
+    dx[n] = e.direction.x();
+    dy[n] = e.direction.y();
+    dz[n] = e.direction.z();
+    ++n;
+  }
+  // Photon `index`'s end (its scored exits added before it).
   void add(std::uint64_t index, double incident_phi, const PhotonOutcome& o) {
     if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
     for (const WeightLoss& l : o.losses) losses.push_back({n, l});
+    last[n] = true;
+    slot[n] = 0;
     weight[n] = o.weight;
     lost[n] = o.fate == PhotonFate::Lost;
     photon[n] = index;

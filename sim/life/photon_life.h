@@ -27,6 +27,16 @@
 
 namespace fiberlab::sim::life {
 
+// Expected-value scoring of exits (Settings::estimator, SPEC section 5) runs
+// while the photon's throughput weight is at least this; below it the
+// photon's choices are analog, so that its path ends by an exit as in the
+// analog estimator instead of running on at ever smaller weight (this is
+// the unbiased end of the path that docs/PHYSICS.md "Estimator" names: no
+// Russian roulette, and the ledger closes per photon to rounding). Each
+// event's choice between the two rules depends only on the weight before
+// it, so the expectation is unchanged.
+inline constexpr double kExpectedValueMinWeight = 0x1.0p-7;
+
 // What a photon does next.
 enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kLost = 4 };
 
@@ -35,11 +45,25 @@ struct LifeConfig {
   explicit LifeConfig(const Settings& s)
       : ellipse(s.fiber.eccentricity), eta(s.fiber.eta), cos_tilt(std::cos(s.fiber.scale_tilt)),
         sin_tilt(std::sin(s.fiber.scale_tilt)), max_segments(s.max_segments),
-        max_events(s.max_events_per_point) {}
+        max_events(s.max_events_per_point),
+        expected_value(s.estimator == Estimator::ExpectedValue) {}
   EllipseCrossSection ellipse;
   double eta;
   double cos_tilt, sin_tilt;  // cuticle tilt towards the root (SPEC section 2)
   int max_segments, max_events;
+  bool expected_value;  // expected-value scoring of exits (kExpectedValueMinWeight)
+};
+
+// The exit a photon scored at its last interface event by expected value
+// (weight 0: none), before its next segment: where and how it left. Not
+// part of the photon's lasting state (the batched tracer hands it over after
+// each step and does not keep it).
+template <class T>
+struct ScoredExit {
+  T weight;       // throughput before absorption: weight times the leaving probability
+  Vec3Of<T> d;    // the leaving direction
+  T path;         // internal path length so far
+  T segments;     // the lobe index p
 };
 
 template <class T, class Light>
@@ -56,6 +80,7 @@ struct PhotonState {
   LaneRandom<T> rng;
   Light light;
   LossRecord<T> losses;  // weight removed by the model's event weights
+  ScoredExit<T> scored;  // expected-value scoring: this step's exit (set only then)
 };
 
 // Photons arriving along d at the entry points (pv, pw), with their streams.
@@ -63,7 +88,8 @@ template <class Light, class T>
 PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
-  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {}};
+  return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
+          {zero, d, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -76,6 +102,26 @@ concept HasEventWeight = requires(const Model& m, const EventGeometry<T>& e, con
                                   LaneRandom<T>& r) {
   { m.event_weight(e, a, r) } -> std::same_as<EventWeight<T>>;
 };
+
+// Expected-value scoring (SPEC section 5) where r.scored: the leaving
+// branch is the photon's scored exit, with the weight times its probability
+// (times its own masking factor: G1 weights both branches), and the photon
+// goes on along the other branch with the weight times one minus it.
+template <class T, class Model, class Light>
+void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const EventResult<T>& r,
+                          const BoundaryFrame<T>& frame, const Vec3Of<T>& m,
+                          const MaskOf<T>& inside) {
+  T exit_weight = select(r.scored, s.weight * r.p_leave, T(0.0));
+  if constexpr (HasEventWeight<Model, T>) {
+    // The leaving branch refracts when the photon is inside.
+    const EventWeight<T> w =
+        model.event_weight(EventGeometry<T>{s.d, r.leave_direction, m, frame, inside}, r.scored, s.rng);
+    s.losses.add(r.scored & (w.factor < T(1.0)), exit_weight * (T(1.0) - w.factor), s.path);
+    exit_weight = select(r.scored, select(w.lost, T(0.0), exit_weight * w.factor), T(0.0));
+  }
+  s.scored = {exit_weight, r.leave_direction, s.path, s.segments};
+  s.weight = select(r.scored, s.weight * (T(1.0) - r.p_leave), s.weight);
+}
 
 // One interface event for the photons in `live` at a boundary point (SPEC
 // section 3): draw the normal, reflect or refract, apply the consistency
@@ -97,8 +143,11 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   const MaskOf<T> act = f.ready;  // never failed too (sim/roughness/roughness_model.h)
   const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
                                 select(inside, T(c.eta), T(1.0 / c.eta))};
-  const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng);
+  const MaskOf<T> eligible = act & (s.weight >= T(kExpectedValueMinWeight));
+  const ExitScoring<T> scoring{c.expected_value, eligible, inside, n0};
+  const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng, scoring);
   const Vec3Of<T> d = select(act, r.direction, s.d);
+  if (c.expected_value) score_leaving_branch(model, s, r, frame, f.m, inside);
   MaskOf<T> lost(false);
   if constexpr (HasEventWeight<Model, T>) {
     const EventWeight<T> w =

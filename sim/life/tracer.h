@@ -16,6 +16,15 @@ namespace fiberlab::sim {
 // Lost: a roughness model ended the path (its weight is booked as lost).
 enum class PhotonFate { Exited, Truncated, Lost };
 
+// An exit scored by expected value (Settings::estimator) before the
+// photon's life ended: it left along `direction` after `segments` segments
+// and `path_length` inside, with throughput `weight` (before absorption).
+struct ScoredExitOutcome {
+  Vec3 direction;
+  int segments;
+  double path_length, weight;
+};
+
 struct PhotonOutcome {
   PhotonFate fate = PhotonFate::Exited;
   Vec3 direction = Vec3::Zero();  // exit direction wr (when Exited)
@@ -26,6 +35,9 @@ struct PhotonOutcome {
   // without masking, 0 when Lost). Channel c carries weight exp(-sigma_a[c] l).
   double weight = 1.0;
   std::vector<WeightLoss> losses;  // what masking removed, in order (empty without masking)
+  // Exits scored by expected value along the way, in order (empty with the
+  // analog estimator); `fate` and `weight` are then what is left at the end.
+  std::vector<ScoredExitOutcome> scored;
 };
 
 // Work counters, for benchmarks and notes.
@@ -65,6 +77,15 @@ template <class Model>
 Vec3 exit_direction_of(const Model& model, const Vec3& d, int segments, PhotonRandom& rng) {
   if constexpr (HasExitHook<Model>) return model.exit_direction(d, segments, rng);
   else return d;
+}
+
+// The stream an exit scored by expected value draws its exit direction
+// from (exit_blur): derived from the photon's stream state after the step
+// that scored it, so that the photon's own stream, and with it its path, is
+// the same whether or not its exits are blurred; both tracers derive it so.
+inline PhotonRandom scored_exit_stream(std::uint64_t w0, std::uint64_t w1, std::uint64_t w2,
+                                       std::uint64_t w3) {
+  return PhotonRandom(life::splitmix(w0 ^ life::splitmix(w1 ^ life::splitmix(w2))), w3);
 }
 
 // The outcome of a photon whose life ended with `code`.

@@ -20,6 +20,14 @@ enum class RoughnessModel { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
 // ground truth); the removed weight is the ledger's `lost`.
 enum class Masking { None, SmithG1 };
 enum class Polarization { Scalar, Stokes };
+// How a photon's exits are scored (SPEC section 5; docs/PHYSICS.md
+// "Estimator"). `analog`: at every event the photon reflects with
+// probability F and refracts otherwise, and scores its whole weight where it
+// finally leaves. `expected_value`: at an event where one branch leaves the
+// fiber at once, that branch is scored with the weight times its probability
+// and the photon goes on along the other with the weight times one minus it
+// (analog once the weight is below life::kExpectedValueMinWeight).
+enum class Estimator { Analog, ExpectedValue };
 
 struct FiberSettings {
   double eta = 1.55;           // relative index, > 1
@@ -85,6 +93,7 @@ struct Settings {
   int max_segments = 1000;
   int max_events_per_point = 1000;  // consistency-rule bound (SPEC section 5)
   Polarization polarization = Polarization::Scalar;
+  Estimator estimator = Estimator::ExpectedValue;
 
   // The incident configurations: every theta_i combined with every phi_i
   // (theta-major order). phi_i is NaN when uniform.
@@ -103,6 +112,10 @@ struct Settings {
 // the allowed range.
 Settings parse_settings_yaml(const std::string& yaml_text, const std::string& origin);
 Settings load_settings(const std::string& path);
+// A result file's stored config_yaml: as parse_settings_yaml, except that a
+// config without an `estimator` key was written before the key existed, by
+// the analog estimator.
+Settings parse_stored_settings_yaml(const std::string& yaml_text, const std::string& origin);
 
 // A command-line integer (--photons, --seed, --threads) read by the config's
 // rules: 100000 or an exactly integral 1e5; not -1, 1.5, nan or anything
@@ -121,5 +134,6 @@ std::vector<double> sigma_a_from_melanin(double eumelanin, double pheomelanin);
 std::string to_string(RoughnessModel m);
 std::string to_string(Masking m);
 std::string to_string(Polarization p);
+std::string to_string(Estimator e);
 
 }  // namespace fiberlab::sim

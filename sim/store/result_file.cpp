@@ -38,6 +38,7 @@ void write_parameters(h5::File& f, const Settings& s) {
   }
   f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
   f.set_attr("/source", "polarization", to_string(s.polarization));
+  f.set_attr("/source", "estimator", to_string(s.estimator));
   f.set_attr("/source", "phi_i_uniform", static_cast<std::int64_t>(s.source.phi_i_uniform));
 }
 
@@ -124,7 +125,7 @@ Settings load_settings_or_result(const std::string& path) {
   const h5::File f = h5::File::open_read(path);
   if (!f.has_attr("/", "config_yaml"))
     throw Error(fmt::format("{}: HDF5 file without a config_yaml root attribute (not a fiberlab result)", path));
-  return parse_settings_yaml(f.attr_string("/", "config_yaml"), path + ":/config_yaml");
+  return parse_stored_settings_yaml(f.attr_string("/", "config_yaml"), path + ":/config_yaml");
 }
 
 Estimate bin_estimate(double s1, double s2, std::uint64_t n) {

@@ -293,7 +293,7 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   version_ = read_format_version(f, path);
   ResultFile& h = header_;
   h.config_yaml = f.attr_string("/", "config_yaml");
-  h.settings = parse_settings_yaml(h.config_yaml, path + ":/config_yaml");
+  h.settings = parse_stored_settings_yaml(h.config_yaml, path + ":/config_yaml");
   h.software_version = f.attr_string("/", "software_version");
   h.created_utc = f.attr_string("/", "created_utc");
   if (f.has_attr("/", "merged_seeds")) {
@@ -364,7 +364,8 @@ ExactTally ResultReader::read(std::size_t k) const {
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
   if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
   // Sums that break a tally's identities were damaged or edited: never added.
-  if (const std::string why = tally_inconsistency(t); !why.empty())
+  if (const std::string why = tally_inconsistency(t, header_.settings.estimator == Estimator::Analog);
+      !why.empty())
     throw Error(fmt::format("{}: incident direction {}: {}", path_, k, why));
   return t;
 }

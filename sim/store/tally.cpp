@@ -39,17 +39,23 @@ void Tally::score_truncated(const double* weight) {
 }
 
 void Tally::score_lost(const double* lost, const double* kept) {
-  constexpr Fixed one = Fixed{1} << 60;
+  std::vector<Fixed> kept_fixed(channels_);
+  for (int c = 0; c < channels_; ++c) kept_fixed[c] = to_fixed(kept[c]);
+  score_lost(lost, kept_fixed.data());
+}
+
+void Tally::score_lost(const double* lost, const Fixed* kept) {
+  constexpr Fixed one = kOne;
   // Rounding of a photon's products: a few 2^-53 per event, so 2^-40 (about
   // 1e-12 of the photon's weight) is far beyond it, and far below any real
   // double booking (of the order of the weight itself).
-  constexpr Fixed rounding_allowance = Fixed{1} << 20;
+  constexpr Fixed rounding_allowance = kRoundingAllowance;
   for (int c = 0; c < channels_; ++c) {
-    const Fixed room = one - to_fixed(kept[c]), booked = to_fixed(lost[c]);
+    const Fixed room = one - kept[c], booked = to_fixed(lost[c]);
     if (booked - room > rounding_allowance)
       throw Error(fmt::format("internal error: a photon's lost weight {} plus its kept weight {} exceeds 1 "
                               "(channel {}) by more than rounding",
-                              lost[c], kept[c], c));
+                              lost[c], static_cast<double>(kept[c]) / kScale, c));
     lost_[c] += std::min(booked, room);
   }
 }

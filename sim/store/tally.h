@@ -59,6 +59,29 @@ class Tally {
       s2[c] += to_fixed(w * w);
     }
   }
+  // Expected-value scoring (sim/life/exit_scoring.h): one of a photon's
+  // exits, its S1 already in fixed point (s1[c], booked so that the photon's
+  // parts never exceed its unit weight: see ExitScorer), S2 growing by
+  // s2_growth[c] (the growth of the square of the photon's total in the bin),
+  // the count by one when this is the photon's first exit in the bin.
+  void score_exit_fixed(std::size_t bin, const Fixed* s1, const double* s2_growth, bool first) {
+    touched_[bin / kPageBins] = 1;
+    Fixed* cell = cells() + bin * block();
+    cell[0] += first ? 1 : 0;
+    for (int c = 0; c < channels_; ++c) {
+      cell[1 + c] += s1[c];
+      cell[1 + channels_ + c] += to_fixed(s2_growth[c]);
+    }
+  }
+  // A photon's truncated weight, already in fixed point.
+  void score_truncated_fixed(const Fixed* weight) {
+    for (int c = 0; c < channels_; ++c) truncated_[c] += weight[c];
+  }
+  static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
+  static constexpr Fixed kOne = Fixed{1} << 60;
+  // What a photon's parts may exceed its unit weight by, in fixed point, as
+  // rounding (2^-40: see score_lost).
+  static constexpr Fixed kRoundingAllowance = Fixed{1} << 20;
   // Every sum back to zero (only the touched pages are written): a thread's
   // tally is reused across rounds and incident directions.
   void clear();
@@ -82,6 +105,8 @@ class Tally {
   // rounding (2^-40) is a booking error: an internal error is thrown, never
   // clamped.
   void score_lost(const double* lost, const double* kept);
+  // The same with the kept weight in fixed point (as booked).
+  void score_lost(const double* lost, const Fixed* kept);
   // Every launched photon must have been scored (exited, truncated, lost): what
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
@@ -125,7 +150,6 @@ class Tally {
   std::size_t page_begin(std::size_t p) const { return p * kPageBins * block(); }
   std::size_t page_end(std::size_t p) const { return std::min((p + 1) * kPageBins, bins()) * block(); }
   Fixed* cells() const { return static_cast<Fixed*>(memory_.data()); }
-  static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
   // that scoring a photon touches one or two cache lines, not three arrays.

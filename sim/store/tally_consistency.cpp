@@ -13,7 +13,7 @@ double as_double(Word w) { return static_cast<double>(w) / ExactTally::kScale; }
 
 }  // namespace
 
-std::string tally_inconsistency(const ExactTally& t) {
+std::string tally_inconsistency(const ExactTally& t, bool one_exit_per_photon) {
   const TallyShape& s = t.shape;
   const std::size_t L = s.lobes, C = s.channels;
   const std::size_t bins_per_lobe = static_cast<std::size_t>(s.n_theta) * s.n_phi;
@@ -39,7 +39,7 @@ std::string tally_inconsistency(const ExactTally& t) {
       bin_s1[(b / bins_per_lobe) * C + c] += s1;
     }
   }
-  if (counted > t.photons)
+  if (one_exit_per_photon && counted > t.photons)
     return fmt::format("its bins count {} exits, more than the {} photons launched",
                        static_cast<double>(counted), t.photons);
   for (std::size_t i = 0; i < L * C; ++i)

@@ -1,0 +1,139 @@
+// Expected-value scoring of exits (Settings::estimator, SPEC sections 5 and
+// 6; docs/PHYSICS.md "Estimator"):
+// - every photon's scored exits, its end and its masking losses add up to
+//   its starting weight, to rounding (no Russian roulette: the ledger closes
+//   per photon), with scalar and Stokes light and with Smith G1 masking;
+// - the reported standard errors agree with the spread of the estimates over
+//   many seeds, lobe by lobe, the last lobe (which collects several exits of
+//   one photon in one bin) included. Mutations caught: S2 as the sum of the
+//   squares of a photon's parts (ExitScorer::score_scored_exit calling
+//   score_exit for a repeated bin) fails ErrorsMatchSpreadOverSeeds on the
+//   last lobe; the photon going on at its full weight instead of weight x
+//   (1 - P) (score_leaving_branch) fails LedgerClosesPerPhoton.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "sim/life/source.h"
+#include "sim/life/tracer.h"
+#include "tests/sim/sim_test_support.h"
+
+namespace fiberlab::sim {
+namespace {
+
+// Each photon's scored exits + its final weight (exited or truncated) + its
+// losses = 1 (white fiber: nothing absorbed), to rounding.
+void expect_ledger_closes(const Settings& s, const char* what) {
+  const Tracer tracer(s);
+  const auto inc = s.incidences().front();
+  double worst = 0.0;
+  std::size_t scored = 0;
+  for (std::uint64_t i = 0; i < 20000; ++i) {
+    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, false);
+    const PhotonOutcome o = tracer.trace(p.wi, p.h, p.rng);
+    double total = o.fate == PhotonFate::Lost ? 0.0 : o.weight;
+    for (const ScoredExitOutcome& e : o.scored) total += e.weight;
+    for (const WeightLoss& l : o.losses) total += l.weight;
+    scored += o.scored.size();
+    worst = std::max(worst, std::abs(total - 1.0));
+  }
+  std::printf("%s: %zu scored exits, worst |sum - 1| = %.3g\n", what, scored, worst);
+  EXPECT_GT(scored, 20000u) << what;  // every photon scores R at its first event
+  EXPECT_LE(worst, 1e-12) << what;
+}
+
+TEST(Estimator, LedgerClosesPerPhoton) {
+  Settings s = testing::smooth_circle(30.0, 1);
+  s.estimator = Estimator::ExpectedValue;
+  testing::make_rough(s, 10.0, 3.0);
+  s.fiber.eccentricity = 0.8;
+  expect_ledger_closes(s, "gaussian 10, tilt 3, e 0.8");
+  s.polarization = Polarization::Stokes;
+  expect_ledger_closes(s, "stokes");
+  s.polarization = Polarization::Scalar;
+  s.roughness.model = RoughnessModel::GGX;
+  s.roughness.alpha_long = s.roughness.alpha_azim = 0.3;
+  s.roughness.masking = Masking::SmithG1;
+  expect_ledger_closes(s, "ggx 0.3 smith_g1");
+}
+
+// The file's ledger: exited + truncated + lost = launched on a white fiber,
+// to rounding (absorbed is its complement).
+TEST(Estimator, FileLedgerClosesOnWhiteFiber) {
+  Settings s = testing::smooth_circle(30.0, 20000);
+  s.estimator = Estimator::ExpectedValue;
+  testing::make_rough(s, 10.0, 3.0);
+  const ResultFile r = testing::run(s, 2);
+  EXPECT_NEAR(r.absorbed[0], 0.0, 1e-9);
+}
+
+// The spread of P_b over M seeds against the mean reported SE_b^2, summed
+// over a lobe's bins with an effective sample size of at least 30 per seed
+// (SPEC section 10). For Gaussian estimates (M - 1) s_b^2 / sigma_b^2 is
+// chi-square with M - 1 degrees of freedom, so the ratio of the sums has
+// relative standard deviation at most sqrt(2 / (M - 1)) = 0.1 at M = 201
+// (bins fully correlated; less otherwise); the reported SE^2 are themselves
+// averages over M seeds. Accepted: ratio within [0.6, 1.5] (4 standard
+// deviations below, 5 above).
+void expect_errors_match_spread(Settings s, const char* what) {
+  constexpr int kSeeds = 201;
+  const int lobes = s.tally.lobes, bins = s.tally.n_theta * s.tally.n_phi;
+  std::vector<double> sum(lobes * bins, 0.0), sum_sq(lobes * bins, 0.0), se2(lobes * bins, 0.0),
+      ess(lobes * bins, 1e300);
+  for (int seed = 0; seed < kSeeds; ++seed) {
+    s.seed = 1000 + seed;
+    const ResultFile r = testing::run(s, 1);
+    const double n = static_cast<double>(r.photons[0]);
+    for (int l = 0; l < lobes; ++l)
+      for (int b = 0; b < bins; ++b) {
+        const std::size_t c = r.cell(0, l, b / s.tally.n_phi, b % s.tally.n_phi, 0);
+        const double p = r.weight_sum[c] / n;
+        sum[l * bins + b] += p;
+        sum_sq[l * bins + b] += p * p;
+        se2[l * bins + b] += (r.weight_sq_sum[c] / n - p * p) / (n - 1.0) / kSeeds;
+        const double e = r.weight_sq_sum[c] > 0 ? r.weight_sum[c] * r.weight_sum[c] / r.weight_sq_sum[c] : 0.0;
+        ess[l * bins + b] = std::min(ess[l * bins + b], e);
+      }
+  }
+  for (int l = 0; l < lobes; ++l) {
+    double spread = 0.0, reported = 0.0;
+    int used = 0;
+    for (int b = 0; b < bins; ++b) {
+      const int i = l * bins + b;
+      if (ess[i] < 30.0) continue;
+      const double mean = sum[i] / kSeeds;
+      spread += (sum_sq[i] - kSeeds * mean * mean) / (kSeeds - 1);
+      reported += se2[i];
+      ++used;
+    }
+    ASSERT_GT(used, 0) << what << ", lobe " << l;
+    const double ratio = spread / reported;
+    std::printf("%s, lobe %d: %d bins, spread / reported SE^2 = %.3f\n", what, l, used, ratio);
+    EXPECT_GT(ratio, 0.6) << what << ", lobe " << l;
+    EXPECT_LT(ratio, 1.5) << what << ", lobe " << l;
+  }
+}
+
+TEST(Estimator, ErrorsMatchSpreadOverSeeds) {
+  Settings s = testing::smooth_circle(30.0, 4000);
+  s.estimator = Estimator::ExpectedValue;
+  testing::make_rough(s, 10.0, 3.0);
+  s.fiber.sigma_a = {0.3};
+  // Coarse bins and three lobes: R, TT and p >= 2.
+  s.tally.n_theta = 3;
+  s.tally.n_phi = 2;
+  s.tally.lobes = 3;
+  expect_errors_match_spread(s, "3 lobes, 3 x 2 bins");
+  // Two lobes, one bin: TT, TRT, TRRT, ... of each photon all add to the
+  // last lobe's one bin, where the square of the photon's total differs
+  // most from the sum of the squares of its parts.
+  s.tally.n_theta = 1;
+  s.tally.n_phi = 1;
+  s.tally.lobes = 2;
+  expect_errors_match_spread(s, "2 lobes, 1 bin");
+}
+
+}  // namespace
+}  // namespace fiberlab::sim
