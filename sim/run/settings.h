@@ -93,7 +93,9 @@ struct Settings {
   int max_segments = 1000;
   int max_events_per_point = 1000;  // consistency-rule bound (SPEC section 5)
   Polarization polarization = Polarization::Scalar;
-  Estimator estimator = Estimator::ExpectedValue;
+  // analog: the one with more error per CPU second on bench/configs cases b,
+  // c and ggx (bench/figure_of_merit.py; docs/PHYSICS.md "Estimator").
+  Estimator estimator = Estimator::Analog;
 
   // The incident configurations: every theta_i combined with every phi_i
   // (theta-major order). phi_i is NaN when uniform.

@@ -16,6 +16,7 @@
 #include <cstdio>
 #include <string>
 
+#include "common/error.h"
 #include "sim/life/source.h"
 #include "sim/life/tracer.h"
 #include "tests/sim/sim_test_support.h"
@@ -133,6 +134,23 @@ TEST(Estimator, ErrorsMatchSpreadOverSeeds) {
   s.tally.n_phi = 1;
   s.tally.lobes = 2;
   expect_errors_match_spread(s, "2 lobes, 1 bin");
+}
+
+// The config key: a word of two, stored in config_yaml; an older file's
+// config_yaml without it reads as analog (what wrote it).
+TEST(Estimator, ConfigKey) {
+  EXPECT_EQ(parse_settings_yaml("photons: 10\n", "t").estimator, Estimator::Analog);
+  const Settings s = parse_settings_yaml("estimator: expected_value\n", "t");
+  EXPECT_EQ(s.estimator, Estimator::ExpectedValue);
+  EXPECT_EQ(parse_settings_yaml(to_yaml(s), "t"), s);
+  EXPECT_EQ(parse_stored_settings_yaml(to_yaml(s), "t").estimator, Estimator::ExpectedValue);
+  EXPECT_EQ(parse_stored_settings_yaml("photons: 10\n", "t").estimator, Estimator::Analog);
+  try {
+    parse_settings_yaml("estimator: roulette\n", "t");
+    FAIL() << "estimator: roulette was accepted";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("estimator"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
