@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "analytic/deon2011.h"
+#include "analytic/azimuthal_lobes.h"
+#include "analytic/bin_integration.h"
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
 #include "analytic/pbrt_v4_mp.h"
@@ -26,29 +28,6 @@ double longitudinal_variance(double beta_m) {
 double logistic_scale(double beta_n) {
   return std::sqrt(kPi / 8.0) *
          (0.265 * beta_n + 1.194 * beta_n * beta_n + 5.372 * std::pow(beta_n, 22));
-}
-
-namespace {
-// 1 / (1 + exp(-t)) without overflow for either sign of t.
-double sigmoid(double t) {
-  if (t >= 0.0) return 1.0 / (1.0 + std::exp(-t));
-  const double e = std::exp(t);
-  return e / (1.0 + e);
-}
-// Mass of the logistic on [-pi, pi]: sigmoid(pi/s) - sigmoid(-pi/s).
-double trimmed_mass(double s) { return std::tanh(0.5 * kPi / s); }
-}  // namespace
-
-double trimmed_logistic(double x, double s) {
-  // Logistic density exp(-|x|/s) / (s (1 + exp(-|x|/s))^2), symmetric in x.
-  const double e = std::exp(-std::abs(x) / s);
-  return e / (s * (1.0 + e) * (1.0 + e)) / trimmed_mass(s);
-}
-
-double trimmed_logistic_cumulative(double x, double s) {
-  const double k = std::floor((x + kPi) / kTwoPi);
-  const double r = x - kTwoPi * k;  // [-pi, pi)
-  return k + (sigmoid(r / s) - sigmoid(-kPi / s)) / trimmed_mass(s);
 }
 
 namespace {
@@ -77,7 +56,6 @@ constexpr double kDeltaV = 1e-10;        // v below this: M_p is a delta
 constexpr double kSmoothS = 1e-12;       // s below this: the logistic is a delta
 constexpr double kDensityMinV = 1e-8;    // density(): floor of v
 constexpr double kDensityMinS = 1e-6;    // density(): floor of s
-constexpr double kTailWidth = 40.0;      // logistic tail beyond 40 s: e^-40
 constexpr double kWindow = 12.0;         // M_p cos beyond 12 sqrt(v): < e^-70
 constexpr int kOrder = 8;                // Gauss-Legendre points per panel
 constexpr int kResidualP = 3;            // p_max: orders >= 3 in one residual lobe
@@ -128,7 +106,7 @@ std::vector<double> branches(int p, double eta_p) {
 void logistic_nodes(int p, double eta_p, double s, const std::vector<double>& centres,
                     bool skip_far, double refine, std::vector<HNode>& out) {
   out.clear();
-  const double W = kTailWidth * s;
+  const double W = azimuthal::kLogisticWindow * s;
   // max |dPhi/dgamma| over gamma: from 2p/eta' - 2 (gamma = 0) to -2 (|gamma| -> pi/2).
   const double slope = std::max(2.0, std::abs(2.0 * p / eta_p - 2.0));
   const double fine_len = std::min(kPi / 64, 2.0 * s / slope) / refine;
@@ -205,12 +183,14 @@ void order_energy(const cylinder::Attenuation& att, int p, std::vector<double>& 
   }
 }
 
-// Integral of M_p(v, theta_eff, theta_r) cos(theta_r) over every theta bin,
-// added to out[i].
-// log M_p: d'Eon's (the paper's) or pbrt-v4's as shipped (pbrt_v4_mp.h).
+// log M_p: d'Eon 2011 Eq. 7 (the paper's) or pbrt-v4's as shipped (pbrt_v4_mp.h).
 double log_mp(bool pbrt, double v, double theta_i, double theta_r) {
-  return pbrt ? pbrt_v4::log_M_p(v, theta_i, theta_r) : deon2011::log_M_p(v, theta_i, theta_r);
+  return pbrt ? pbrt_v4::log_M_p(v, theta_i, theta_r) : longitudinal::vmf_log_M_p(v, theta_i, theta_r);
 }
+
+// Integral of M_p(v, theta_eff, theta_r) cos(theta_r) over every theta bin,
+// added to out[i]: Gauss-Legendre on panels below sqrt(v)/3 within
+// kWindow sqrt(v) of the peak.
 
 void theta_bin_integrals(bool pbrt, double v, double theta_eff, const BinGrid& grid, double refine,
                          std::vector<double>& out) {
@@ -223,42 +203,9 @@ void theta_bin_integrals(bool pbrt, double v, double theta_eff, const BinGrid& g
   const double sv = std::sqrt(v);
   const double lo = std::max(-kPi / 2, peak - kWindow * sv), hi = std::min(kPi / 2, peak + kWindow * sv);
   const double max_len = std::min(sv / 3.0, 0.05) / refine;
-  const GaussLegendre& gl = gauss_legendre(kOrder);
-  for (int i = 0; i < grid.n_theta(); ++i) {
-    const double t0 = std::max(lo, grid.theta_edges[i]), t1 = std::min(hi, grid.theta_edges[i + 1]);
-    if (!(t1 > t0)) continue;
-    const int m = std::max(1, static_cast<int>(std::ceil((t1 - t0) / max_len)));
-    const double half = 0.5 * (t1 - t0) / m;
-    double sum = 0.0;
-    for (int k = 0; k < m; ++k) {
-      const double mid = t0 + (2 * k + 1) * half;
-      for (int q = 0; q < kOrder; ++q) {
-        const double tr = mid + half * gl.x[q];
-        sum += half * gl.w[q] * std::exp(log_mp(pbrt, v, theta_eff, tr)) * std::cos(tr);
-      }
-    }
-    out[i] += sum;
-  }
-}
-
-// Adds mass[c] times the wrapped trimmed logistic's mass (centre phi,
-// scale s) in every one of n uniform bins on [-pi, pi) to res[j * C + c].
-void deposit_logistic(double phi, double s, const double* mass, int C, int n,
-                      std::vector<double>& res) {
-  const double delta = kTwoPi / n, W = kTailWidth * s;
-  long j0 = static_cast<long>(std::floor((phi - W + kPi) / delta));
-  long j1 = static_cast<long>(std::floor((phi + W + kPi) / delta));
-  if (j1 - j0 + 1 >= n) j0 = 0, j1 = n - 1;  // every bin, each once
-  double prev = chiang2016::trimmed_logistic_cumulative(-kPi + j0 * delta - phi, s);
-  for (long j = j0; j <= j1; ++j) {
-    const double next = chiang2016::trimmed_logistic_cumulative(-kPi + (j + 1) * delta - phi, s);
-    const double frac = next - prev;
-    prev = next;
-    long jj = j % n;
-    if (jj < 0) jj += n;
-    double* r = &res[static_cast<std::size_t>(jj) * C];
-    for (int c = 0; c < C; ++c) r[c] += frac * mass[c];
-  }
+  add_theta_bin_integrals(
+      grid.theta_edges, lo, hi, max_len,
+      [&](double tr, double w) { return w * std::exp(log_mp(pbrt, v, theta_eff, tr)) * std::cos(tr); }, out);
 }
 
 }  // namespace
@@ -312,7 +259,7 @@ void Chiang2016::density(int lobe, double theta_i, double, double theta_r, doubl
       logistic_nodes(p, att.eta_p(), s, {phi}, true, 1.0, nodes);
       for (const HNode& nd : nodes) {
         att.A(p, nd.gamma, a.data());
-        const double l = chiang2016::trimmed_logistic(wrap_angle(phi - nd.phi), s);
+        const double l = azimuthal::trimmed_logistic(wrap_angle(phi - nd.phi), s);
         for (int c = 0; c < C; ++c) n[c] += nd.weight * a[c] * l;
       }
     } else {
@@ -360,10 +307,12 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
       cylinder::add_smooth_lobe(att, p, np, phi_w);
     } else {
       logistic_nodes(p, att.eta_p(), s_, edges, false, refine_, nodes);
+      const double s = s_;
+      auto cdf = [s](double x) { return azimuthal::trimmed_logistic_cumulative(x, s); };
       for (const HNode& nd : nodes) {
         att.A(p, nd.gamma, a.data());
         for (int c = 0; c < C; ++c) a[c] *= nd.weight;
-        deposit_logistic(nd.phi, s_, a.data(), C, np, phi_w);
+        deposit_wrapped(cdf, nd.phi, s_, azimuthal::kLogisticWindow, true, a.data(), C, np, phi_w);
       }
     }
     double* lobe_out = &out[static_cast<std::size_t>(lobe_of(p, L)) * nt * np * C];
@@ -440,7 +389,7 @@ ModelInfo chiang2016_info() {
               lobes_param()};
   m.make = [](const ModelParams& p) { return make_chiang2016(p); };
   m.approximations = chiang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     if (f.eccentricity != 1.0)
       throw Error(fmt::format("model chiang2016: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));
@@ -448,7 +397,7 @@ ModelInfo chiang2016_info() {
     p.scale_tilt = f.scale_tilt;
     // Widths as for d'Eon's M_p (the same function), then through the
     // inverse mappings: an approximate width match; smooth gives 0 exactly.
-    apply_fiber_roughness(f, p, deon2011_width_calibration());
+    apply_fiber_roughness(f, p, deon2011_width_calibration(), mapping);
     p.beta_m = chiang2016::beta_m_for_width(for_lobe(p.beta_long, 0));
     p.beta_n = chiang2016::beta_n_for_scale(for_lobe(p.beta_azim, 0) * std::sqrt(3.0) / kPi);
   };

@@ -10,7 +10,7 @@
 //   E_3      = 1/2 int_{-1}^{1} A_3(theta_i, h) dh
 //   density per d(theta_r) d(phi) = S cos(theta_r)                (SPEC s7)
 //
-// - M_p: d'Eon et al. 2011 Eq. 7 (deon2011::log_M_p, the same function).
+// - M_p: d'Eon et al. 2011 Eq. 7 (longitudinal_lobes.h, as deon2011 uses it).
 // - Roughness (Chiang et al. 2016, their longitudinal and azimuthal
 //   roughness mappings, fitted so that beta in [0, 1] feels linear):
 //     v   = (0.726 beta_m + 0.812 beta_m^2 + 3.7 beta_m^20)^2   for R,
@@ -57,6 +57,7 @@
 #include <memory>
 #include <vector>
 
+#include "analytic/azimuthal_lobes.h"
 #include "analytic/model.h"
 
 namespace fiberlab::analytic {
@@ -67,13 +68,10 @@ namespace chiang2016 {
 double longitudinal_variance(double beta_m);
 // Logistic scale s from beta_n in [0, 1].
 double logistic_scale(double beta_n);
-// The logistic trimmed to [-pi, pi]: density at x in [-pi, pi] (unit
-// integral over [-pi, pi]) for s > 0.
-double trimmed_logistic(double x, double s);
-// Its cumulative from -pi, extended periodically: G(x + 2 pi k) = G(x) + k,
-// so that the mass of the wrapped density on [a, b] is G(b) - G(a) for any
-// a <= b (closed form: logistic CDF 1 / (1 + exp(-x / s))).
-double trimmed_logistic_cumulative(double x, double s);
+// The logistic trimmed to [-pi, pi] and its periodic cumulative
+// (azimuthal_lobes.h).
+using azimuthal::trimmed_logistic;
+using azimuthal::trimmed_logistic_cumulative;
 
 // Inverses of the two mappings on [0, 1] (bisection; both are increasing):
 // beta_m whose R lobe has sqrt(v) = width, beta_n whose logistic has scale s.

@@ -55,6 +55,25 @@ void Attenuation::A_beyond(int P, double gamma_i, double* out) const {
   }
 }
 
+void energy_beyond(const Attenuation& att, int P, std::vector<double>& out) {
+  const int C = att.channels();
+  out.assign(C, 0.0);
+  const GaussLegendre& gl = gauss_legendre(64);
+  std::vector<double> buf(C);
+  for (int q = 0; q < 64; ++q) {
+    const double g = 0.5 * kPi * gl.x[q];
+    att.A_beyond(P, g, buf.data());
+    for (int c = 0; c < C; ++c) out[c] += 0.25 * kPi * gl.w[q] * std::cos(g) * buf[c];
+  }
+}
+
+int last_order(const Attenuation& att, int p_first, double tol, int max_p, std::vector<double>& energy) {
+  for (int P = p_first;; ++P) {
+    energy_beyond(att, P, energy);
+    if (*std::max_element(energy.begin(), energy.end()) <= tol || P >= max_p) return P;
+  }
+}
+
 int phi_bin(double phi, int n_phi) {
   const int j = static_cast<int>(std::floor((phi + kPi) / kTwoPi * n_phi));
   return std::clamp(j, 0, n_phi - 1);

@@ -105,6 +105,16 @@ class Attenuation {
   Absorption absorption_;
 };
 
+// Energy of every order p > P per channel, (1/2) int sum_{p>P} A dh, by
+// 64-point Gauss-Legendre over gamma_i (the closed-form sum A_beyond is
+// smooth in gamma).
+void energy_beyond(const Attenuation& att, int P, std::vector<double>& out);
+// The first order P >= p_first after which energy_beyond is at most tol in
+// every channel, or max_p; `energy` holds energy_beyond at that P. The
+// models that trace orders up to P and spread the rest uniformly in phi
+// (the exact model, d'Eon 2011) stop there.
+int last_order(const Attenuation& att, int p_first, double tol, int max_p, std::vector<double>& energy);
+
 // A quadrature node of (1/2) integral over h in (-1, 1) of g(h) dh, written
 // over gamma_i (h = sin gamma_i; weight includes cos(gamma_i) / 2), with the
 // exit azimuth Phi(p, gamma_i) wrapped to [-pi, pi).

@@ -36,24 +36,24 @@
 #include <memory>
 #include <vector>
 
+#include "analytic/azimuthal_lobes.h"
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model.h"
 
 namespace fiberlab::analytic {
 
 namespace deon2011 {
 
-// log I0(x), x >= 0: power series below 30, the asymptotic expansion
-// e^x / sqrt(2 pi x) (1 + 1/(8x) + 9/(2 (8x)^2) + ...) above (relative error
-// < 1e-15 of I0 everywhere; the asymptotic terms shrink until k ~ 2x).
-double log_I0(double x);
-// log csch(x) for x > 0: log 2 - x - log1p(-exp(-2x)).
-double log_csch(double x);
-// Eq. 7: log M_p(v, theta_i, theta_r) =
+// Eq. 7, M_p and its parts (longitudinal_lobes.h): log M_p(v, theta_i, theta_r) =
 //   log csch(1/v) - log(2v) - sin(theta_i) sin(theta_r)/v + log I0(cos(theta_i) cos(theta_r)/v).
-double log_M_p(double v, double theta_i, double theta_r);
-double M_p(double v, double theta_i, double theta_r);
-// Eq. 11: the Gaussian detector, unit-integral over one period.
-double D_p(double beta, double phi);
+using longitudinal::log_csch;
+using longitudinal::log_I0;
+inline double log_M_p(double v, double theta_i, double theta_r) {
+  return longitudinal::vmf_log_M_p(v, theta_i, theta_r);
+}
+inline double M_p(double v, double theta_i, double theta_r) { return longitudinal::vmf_M_p(v, theta_i, theta_r); }
+// Eq. 11: the Gaussian detector, unit-integral over one period (azimuthal_lobes.h).
+inline double D_p(double beta, double phi) { return azimuthal::wrapped_gaussian(beta, phi); }
 // Eq. 10 by Gauss-Legendre of `order` points over h (paper: 35), per channel.
 // r_half_angle: the R order uses Eq. 12 with the exit direction given by
 // (theta_i, theta_r, phi) (theta_d = (theta_r - theta_i) / 2).
@@ -86,7 +86,7 @@ class Deon2011 : public Model {
   // min(4 beta_p, 1). The Fourier series stops, per order p, at the term
   // beyond which the rest provably changes no bin by more than 1e-13 (the
   // order's energy times the tail of the coefficients, see FourierSums in
-  // the .cpp). The R lobe's azimuthal shape under Eq. 12,
+  // bin_integration.h). The R lobe's azimuthal shape under Eq. 12,
   // G_0 = D_0 * |cos(psi/2)| / 4, is its closed Fourier series (beta >= 0.005
   // rad; truncated where the terms are below 1e-17) or a quadrature below.
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
@@ -102,10 +102,8 @@ class Deon2011 : public Model {
   // Zero roughness reproduces the exact smooth cylinder bin for bin.
   // Tested against a slow direct evaluation of Eqs. 7 and 10-12 at 64 bins
   // of the four lobes (beta_azim 5 and 2 deg): within 1e-11 absolute.
-  // Speed (docs/PERFORMANCE.md): ~20 ms per incidence on 90 x 180 bins x 4
-  // lobes x 3 channels with beta_azim = 5 deg (Fourier deposit); narrower
-  // detectors (erfc deposit: beta_azim below ~3.9 deg at 180 phi bins) and
-  // white fibers (many orders) take 0.1 s to a few s.
+  // Its cost grows for narrow detectors (the erfc deposit) and for white
+  // fibers (many orders): docs/PERFORMANCE.md.
   //
   // Multiplies every node density of bin_probabilities() (Chebyshev nodes,
   // h panels, M panels) by `factor`, to measure convergence (tests).

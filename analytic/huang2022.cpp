@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdint>
 
-#include "analytic/deon2011.h"
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
 #include "analytic/model_registry.h"
 #include "analytic/physical_defaults.h"
@@ -240,7 +240,10 @@ class Paths {
  public:
   Paths(const Huang2022Params& p, double theta_i, double phi_i)
       : p_(p), fiber_(p.eccentricity, p.tilt), surface_(p.roughness, p.masking),
-        wi_(direction_from_angles(theta_i, phi_i)), C_(static_cast<int>(p.sigma_a.size())) {}
+        wi_(direction_from_angles(theta_i, phi_i)), cycles_residual_(p.residual == HuangResidual::CyclesEval),
+        cos_i_(std::cos(theta_i)),
+        cycles_width_(fiber_.projected_width(wi_.y(), wi_.z()) * std::sqrt(p.eccentricity)),
+        C_(static_cast<int>(p.sigma_a.size())) {}
 
   const Fiber& fiber() const { return fiber_; }
   const Surface& surface() const { return surface_; }
@@ -274,8 +277,12 @@ class Paths {
     // T: into the fiber.
     Vec3 t;
     if (!refract(d0, m, p_.eta, t)) return;
+    // Cycles' eval() residual: this point's share of its arc integral,
+    // (2 / pi) dgamma / (cos theta_i W), W the projected width with the
+    // major axis 1 (Cycles' 2r), dgamma = pi base.
+    const Entry entry{1.0 - F, 2.0 * base / (cos_i_ * cycles_width_)};
     branch(0, d0, t, h, -1, 1.0 - F, w, sink, [&](const Vec3& dt, const double* wt) {
-      inside(pt, 1, h, dt, wt, sink, nullptr, 1.0);
+      inside(pt, 1, h, dt, wt, sink, nullptr, 1.0, entry);
     });
   }
 
@@ -306,11 +313,17 @@ class Paths {
     if (prob > 0.0) next(o, wo.c);
   }
 
+  // What Cycles' eval() residual takes from the entry: the Fresnel
+  // transmittance T1 and the point's weight in its arc integral.
+  struct Entry {
+    double t1, weight;
+  };
+
   // Segment k (1 or 2) from `from` along d with weight w, then the event at
   // its end. For k = 2: a1 the first segment's transmittance, t2 the Fresnel
   // transmittance of interface 2 (both for the residual).
   void inside(const Point& pt, int k, const Hit& from, const Vec3& d, const double* w, Sink& sink,
-              const Weights* a1, double t2) const {
+              const Weights* a1, double t2, const Entry& entry) const {
     Hit h;
     double len;
     Weights wa, a;
@@ -336,10 +349,17 @@ class Paths {
     // Internal reflection: order k + 1 and beyond.
     const Vec3 r = reflect(d, m);
     if (k == 1) {
+      if (cycles_residual_) cycles_eval_residual(pt, entry, F, a, sink);
       branch(1, d, r, h, +1, F, wa, sink, [&](const Vec3& dr, const double* wr) {
-        inside(pt, 2, h, dr, wr, sink, &a, 1.0 - F);
+        inside(pt, 2, h, dr, wr, sink, &a, 1.0 - F, entry);
       });
       return;
+    }
+    if (cycles_residual_) {
+      // The TRT path's reflection here carries no residual in this form.
+      Weights gone;
+      for (int c = 0; c < C_; ++c) gone.c[c] = wa.c[c] * F;
+      return sink.lost(false, gone.c);
     }
     // k == 2: Cycles' residual for every p >= 3 from the weight reflected
     // here: the geometric series A_avg T_avg / (1 - A_avg (1 - T_avg)).
@@ -354,10 +374,32 @@ class Paths {
     });
   }
 
+  // Cycles' eval() residual (bsdf_hair_huang_eval_trrt): at the second
+  // interface, with R2 its Fresnel reflectance at the sampled normal and A
+  // the first chord's transmittance, T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)),
+  // T_avg = max(1 - R2, 1e-5), weighted by the point's share of the arc
+  // integral (Entry), without masking or the light's flux onto the arc.
+  // Cycles drops it where the reflection at this interface leaves on the
+  // wrong side (and the exit direction lies inside that reflected
+  // direction's refraction cone); here it is kept for every exit direction.
+  // None when the TRT factor is 0 (Cycles evaluates it in the TRT branch).
+  void cycles_eval_residual(const Point& pt, const Entry& entry, double r2, const Weights& a, Sink& sink) const {
+    if (!(for_lobe(p_.lobe_scale, 2) > 0.0)) return;
+    const double t_avg = std::max(1.0 - r2, 1e-5);
+    Weights e;
+    for (int c = 0; c < C_; ++c) {
+      const double A = a.c[c];
+      e.c[c] = entry.weight * entry.t1 * r2 * r2 * t_avg * A * A * A / (1.0 - A * (1.0 - t_avg));
+    }
+    sink.residual(e.c, pt.u[7], pt.u[8]);
+  }
+
   const Huang2022Params& p_;
   Fiber fiber_;
   Surface surface_;
   Vec3 wi_;
+  bool cycles_residual_;
+  double cos_i_, cycles_width_;
   int C_;
 };
 
@@ -428,7 +470,7 @@ std::vector<double> residual_theta_masses(const BinGrid& grid, double theta_i, d
     for (int k = 0; k < panels; ++k)
       for (std::size_t q = 0; q < gl.x.size(); ++q) {
         const double t = a + h * (k + 0.5 * (1.0 + gl.x[q]));
-        mass[i] += 0.5 * h * gl.w[q] * std::exp(deon2011::log_M_p(v, theta_i, t)) * std::cos(t);
+        mass[i] += 0.5 * h * gl.w[q] * std::exp(longitudinal::vmf_log_M_p(v, theta_i, t)) * std::cos(t);
       }
   }
   return mass;
@@ -618,7 +660,7 @@ void Huang2022::density(int lobe, double theta_i, double phi_i, double theta_r, 
       HuangEnergies e;
       EnergySink sink(paths, e);
       integrate(paths, density_points_, sink);
-      const double m = std::exp(deon2011::log_M_p(4.0 * q.roughness, theta_i, theta_r)) / kTwoPi;
+      const double m = std::exp(longitudinal::vmf_log_M_p(4.0 * q.roughness, theta_i, theta_r)) / kTwoPi;
       for (int c = 0; c < C; ++c) s[c] = e.lobe[static_cast<std::size_t>(lobe) * C + c] * m;
     }
     const double scale = paths.scale(p) * std::cos(theta_r);
@@ -640,6 +682,7 @@ std::unique_ptr<Model> make_huang2022(const ModelParams& mp) {
   p.lobe_scale = mp.lobe_scale;
   p.masking = static_cast<HuangMasking>(mp.huang_masking);
   p.mesonormal_flux = mp.mesonormal_flux;
+  p.residual = static_cast<HuangResidual>(mp.huang_residual);
   p.lobes = mp.lobes;
   p.quadrature_points = static_cast<long>(mp.quadrature_points);
   return std::make_unique<Huang2022>(p);
@@ -651,15 +694,66 @@ std::vector<std::string> huang_approximations(const ModelParams& p) {
   std::vector<std::string> a = {
       "far field: Cycles' wi read as our wi (the light); S normalised by the light's projected width",
       "TT, TRT: the paper's sampled microfacet normals as a fixed Halton point set (deterministic quadrature)",
-      "p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, uniform "
-      "in phi), not Cycles' eval()'s",
       "no GGX glass albedo correction (Cycles' energy_scale table)"};
+  if (p.huang_residual == static_cast<int>(HuangResidual::CyclesEval))
+    a.push_back("p >= 3: the residual of Cycles' eval() (T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second "
+                "interface, uniform over the arc angle; kept for every exit direction where Cycles drops it inside a "
+                "refraction cone when the second reflection leaves its side), M_p with v = 4 alpha, uniform in phi");
+  else
+    a.push_back("p >= 3: the residual of Cycles' sampler (geometric series from the TRT path, M_p with v = 4 alpha, "
+                "uniform in phi), not Cycles' eval()'s");
   if (p.mesonormal_flux)
     a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
         "also rescales at the inner interfaces, not done here)");
   if (p.huang_masking == static_cast<int>(HuangMasking::Correlated))
     a.push_back("masking: height-correlated G2 (Cycles' code)");
   return a;
+}
+
+// The GGX alpha of a simulated fiber (ModelInfo::from_fiber). The model's
+// facets are isotropic GGX with alpha in [0, 1]: a fiber it cannot represent
+// is refused, naming the field and what is allowed; an approximate rule is
+// noted in `mapping`.
+double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
+  auto refuse = [&](const std::string& why) -> double {
+    throw Error(fmt::format("model huang2022: roughness: {}; huang2022 allows a smooth or isotropic ggx fiber "
+                            "(alpha in [0, 1]), or --set roughness=A",
+                            why));
+  };
+  double alpha = 0.0;
+  switch (f.roughness) {
+    case PhysicalFiber::Roughness::Smooth: return 0.0;
+    case PhysicalFiber::Roughness::ExitBlur: return refuse("an exit_blur fiber has no microfacets");
+    case PhysicalFiber::Roughness::GGX:
+    case PhysicalFiber::Roughness::Beckmann:
+      if (f.alpha_long != f.alpha_azim)
+        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+      alpha = f.alpha_long;
+      if (f.roughness == PhysicalFiber::Roughness::Beckmann)
+        // Beckmann and GGX of the same alpha have the same density at the
+        // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
+        mapping.notes.push_back(fmt::format(
+            "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
+            "tails differ)",
+            f.roughness_text()));
+      break;
+    case PhysicalFiber::Roughness::Gaussian: {
+      const double bl = for_lobe(f.beta_long, 0), ba = f.beta_azim.empty() ? bl : for_lobe(f.beta_azim, 0);
+      if (bl != ba)
+        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+      // Equal density at the mean normal: a Gaussian tilt of sd beta per
+      // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+      alpha = std::sqrt(2.0) * std::tan(bl);
+      mapping.notes.push_back(fmt::format(
+          "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
+          "normal)",
+          f.roughness_text(), alpha));
+      break;
+    }
+  }
+  if (!(alpha >= 0.0 && alpha <= 1.0))
+    return refuse(fmt::format("{} gives alpha = {:g}, outside [0, 1]", f.roughness_text(), alpha));
+  return alpha;
 }
 
 }  // namespace
@@ -673,7 +767,9 @@ ModelInfo huang2022_info() {
   ParamSpec roughness = number_param("roughness", "GGX microfacet roughness alpha about the mesonormal (0: smooth)",
                                      "", "0.3", "a number in [0, 1]", &ModelParams::ggx_roughness,
                                      [](double x) { return x >= 0.0 && x <= 1.0; });
-  roughness.from_fiber = "roughness (smooth: 0; gaussian: sqrt(2) tan(beta_long), approximate)";
+  roughness.from_fiber =
+      "roughness (smooth: 0; ggx: alpha; beckmann: alpha, approximate; gaussian: sqrt(2) tan(beta), approximate; "
+      "an anisotropic fiber or exit_blur is refused unless --set roughness)";
   ParamSpec tilt = number_param("tilt",
                                 "cuticle scale tilt of the mesonormal, > 0 towards the root as fiber.scale_tilt "
                                 "(Cycles' Huang Tilt)",
@@ -697,6 +793,12 @@ ModelInfo huang2022_info() {
       "mesonormal", {"mesonormal", "macro"},
       [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
       [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });
+  ParamSpec residual = choice_param(
+      "residual",
+      "p >= 3: sampler (Cycles' sampler: the series from the TRT path's third interface) or cycles_eval (Cycles' "
+      "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
+      "sampler", {"sampler", "cycles_eval"},
+      [](ModelParams& p, int i) { p.huang_residual = i; }, [](const ModelParams& p) { return p.huang_residual; });
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
                                   "integer", "4194304", "an integer in [1024, 1073741824]",
                                   &ModelParams::quadrature_points, [](double x) {
@@ -705,23 +807,14 @@ ModelInfo huang2022_info() {
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param(),   sigma_a_param(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
               ecc,           scale,           masking,
-              flux,          lobes_param(),   points};
+              flux,          residual,        lobes_param(),   points};
   m.make = [](const ModelParams& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     apply_fiber_basics(f, p);
     p.eccentricity = f.eccentricity;
     p.scale_tilt = f.scale_tilt;
-    switch (f.roughness) {
-      case PhysicalFiber::Roughness::Smooth: p.ggx_roughness = 0.0; break;
-      case PhysicalFiber::Roughness::Gaussian:
-        // Equal density at the mean normal: a Gaussian tilt of sd beta per
-        // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
-        p.ggx_roughness = std::min(1.0, std::sqrt(2.0) * std::tan(for_lobe(f.beta_long, 0)));
-        break;
-      case PhysicalFiber::Roughness::ExitBlur:
-        throw Error("model huang2022: an exit_blur fiber has no microfacets; set --set roughness=A");
-    }
+    if (!mapping.user_sets("roughness")) p.ggx_roughness = huang_roughness(f, mapping);
   };
   return m;
 }

@@ -77,8 +77,25 @@
 //   v = 4 alpha (Cycles' choice) about theta_r = -theta_i and uniformly in
 //   phi. The third interface's reflection is also stopped when it leaves on
 //   the wrong side of the mesonormal or the macro normal (as every event
-//   here). Cycles' eval() uses another residual formula (larger on white
-//   fibers); it is not this one.
+//   here).
+//   `residual=cycles_eval`: the residual of Cycles' eval() instead
+//   (bsdf_hair_huang_eval_residual / _eval_trrt): at the second interface,
+//   T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)), T_avg = max(1 - R2, 1e-5), T1 the
+//   entry's Fresnel transmittance, R2 the second interface's reflectance, A
+//   the first chord's transmittance, integrated uniformly over the arc angle
+//   with weight (2/pi) / (cos theta_i W) (W Cycles' projected width 2r, the
+//   major axis 1): no masking, no flux onto the arc, so its energy grows as
+//   1/cos theta_i; the same M_p spread. On a smooth white circle it is
+//   (1/(pi cos theta_i)) integral of (1 - F) F^2 dgamma, 3.0-3.5x the
+//   sampler's (1/2) integral of (1 - F) F^2 cos gamma dgamma (tested). Cycles
+//   drops it where the second interface's reflection leaves on the wrong side
+//   and the exit direction lies in that reflection's refraction cone; here
+//   it is kept for every exit direction (an over-count of that cone's share
+//   of such paths); where the second interface's mesonormal faces away from
+//   the arriving light (tilted fibers only) Cycles still samples a normal,
+//   here the path ends without a residual. Only the residual: Cycles' eval()'s TT and TRT (its inner
+//   mesonormal cosine ratios, its TT without the exit-side test) are not
+//   variants here.
 // - Per-lobe scales R, TT, TRT (`lobe_scale`, Cycles' modulation factors;
 //   1 = the physical model); the residual is not scaled (as in Cycles).
 // - Left out (Cycles): the GGX glass albedo correction (energy_scale, a
@@ -113,6 +130,9 @@
 namespace fiberlab::analytic {
 
 enum class HuangMasking { Separable, Correlated, None };
+// p >= 3: Cycles' sampler's residual (from the TRT path's third interface)
+// or its eval()'s (from the second interface; see huang2022.cpp).
+enum class HuangResidual { Sampler, CyclesEval };
 
 struct Huang2022Params {
   double eta = 1.55;                       // > 1
@@ -127,6 +147,7 @@ struct Huang2022Params {
   // projected width's (every photon that meets the fiber scatters; Cycles'
   // sampler). They differ by up to tan(tilt) tan(theta_i) (see below).
   bool mesonormal_flux = true;
+  HuangResidual residual = HuangResidual::Sampler;
   int lobes = 4;                           // 1..4 (p >= 3 is one residual lobe)
   long quadrature_points = 1L << 22;       // in [1024, 2^30]
 };

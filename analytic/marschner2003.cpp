@@ -68,19 +68,6 @@ double at_p(const std::vector<T>& v, int p, const char* name) {
 
 }  // namespace
 
-// ---- M (section 5.1) ---------------------------------------------------------
-
-double g(double beta, double x) {
-  return std::exp(-0.5 * (x / beta) * (x / beta)) / (std::sqrt(kTwoPi) * beta);
-}
-
-double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bool two_theta_h) {
-  const double theta_h = 0.5 * (theta_i + theta_r);
-  // Marschner's alpha_p shifts theta_h, half of the theta_r shift (SPEC s7).
-  if (two_theta_h) return g(beta, 2.0 * theta_h - alpha_theta_r);  // Zinke & Weber
-  return g(beta, theta_h - 0.5 * alpha_theta_r);                     // as published
-}
-
 // ---- Appendix B ---------------------------------------------------------------
 
 double eta_prime(double eta, double theta) { return cylinder::eta_prime(eta, theta); }
@@ -383,8 +370,8 @@ namespace {
 // when a step is below 1e-13 rad: Newton's next step would be ~1e-26 /
 // |phi'| (quadratic convergence), while phi near 2 pi carries a rounding
 // error of ~1e-15, so a tighter stop only makes the iterate wander inside
-// the rounding (a stop at 1e-15 runs the 100-step cap at most crossings:
-// half of predict's time).
+// the rounding (a stop at 1e-15 would run into the 100-step cap at most
+// crossings).
 // `guess` is used where it lies inside (a, b); else linear interpolation.
 template <class PhiOf, class SlopeOf>
 double crossing(const PhiOf& phi_of, const SlopeOf& slope_of, double target, double a, double b, double fa,
@@ -442,44 +429,56 @@ void node_masses(const cylinder::Attenuation& att, int p, const std::vector<cyli
   }
 }
 
-}  // namespace
-
-void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
-              const CausticParams* cp, int n_phi, std::vector<double>& out) {
-  const std::size_t C = sigma_a.size();
-  out.assign(static_cast<std::size_t>(n_phi) * C, 0.0);
-  const double e = proj.eta_p, half_pi = 0.5 * kPi, delta = kTwoPi / n_phi;
-  // Eq. 10's coefficients once (Phi_cubic and dPhi_cubic_dgamma, same arithmetic).
-  const double c_cubic = c_of(e), b1 = 6.0 * p * c_cubic / kPi - 2.0,
-               b3 = 8.0 * p * c_cubic / kPi3, d3 = 24.0 * p * c_cubic / kPi3;
-  auto phi_of = [&](double x) {
-    return proj.exact_roots ? Phi(p, x, e) : b1 * x - b3 * x * x * x + p * kPi;
-  };
-  auto slope_of = [&](double x) { return proj.exact_roots ? dPhi_dgamma(p, x, e) : b1 - d3 * x * x; };
-  // Monotonic pieces: split at the fold (dphi/dgamma = 0), if any.
-  double fold = -1.0;
-  if (proj.exact_roots) {
-    fold = cylinder::fold_gamma(p, e);
-  } else if (p >= 1) {
-    if (b1 > 0.0 && std::sqrt(b1 / d3) < half_pi) fold = std::sqrt(b1 / d3);
+// Phi(p, gamma_i) of Eq. 3 (exact roots) or of Eq. 10's cubic, and its
+// slope; the cubic's coefficients once (the arithmetic of Phi_cubic and
+// dPhi_cubic_dgamma).
+class PhiOfGamma {
+ public:
+  PhiOfGamma(int p, const Projection& proj) : p_(p), e_(proj.eta_p), exact_(proj.exact_roots) {
+    const double c_cubic = c_of(e_);
+    b1_ = 6.0 * p * c_cubic / kPi - 2.0;
+    b3_ = 8.0 * p * c_cubic / kPi3;
+    d3_ = 24.0 * p * c_cubic / kPi3;
   }
-  std::vector<double> br = fold > 0.0 && fold < half_pi ? std::vector<double>{-half_pi, -fold, fold, half_pi}
-                                                         : std::vector<double>{-half_pi, half_pi};
-  const bool glints = p == 2 && cp && cp->w_c > 0.0;
-  const Glint gl = glints ? glint_of(proj, *cp) : Glint{};
-  // Quadrature nodes over gamma_i: each piece between consecutive crossings
-  // of a bin edge exits into one bin and carries a smooth integrand; long
-  // pieces in panels of at most pi/64, 5 points per panel (3 on panels
-  // shorter than 0.005 rad: one bin's worth of h).
-  struct Piece {
-    std::size_t end;  // one past its last node
-    int bin;          // the phi bin every node of it exits into
-  };
-  static thread_local std::vector<cylinder::PathNode> nodes;
-  static thread_local std::vector<Piece> pieces;
-  static thread_local std::vector<double> cuts, mass;
+  double operator()(double x) const { return exact_ ? Phi(p_, x, e_) : b1_ * x - b3_ * x * x * x + p_ * kPi; }
+  double slope(double x) const { return exact_ ? dPhi_dgamma(p_, x, e_) : b1_ - d3_ * x * x; }
+  // Its monotonic pieces on [-pi/2, pi/2]: split at the fold (dphi/dgamma = 0), if any.
+  std::vector<double> branches() const {
+    const double half_pi = 0.5 * kPi;
+    double fold = -1.0;
+    if (exact_) {
+      fold = cylinder::fold_gamma(p_, e_);
+    } else if (p_ >= 1) {
+      if (b1_ > 0.0 && std::sqrt(b1_ / d3_) < half_pi) fold = std::sqrt(b1_ / d3_);
+    }
+    return fold > 0.0 && fold < half_pi ? std::vector<double>{-half_pi, -fold, fold, half_pi}
+                                        : std::vector<double>{-half_pi, half_pi};
+  }
+
+ private:
+  int p_;
+  double e_;
+  bool exact_;
+  double b1_, b3_, d3_;
+};
+
+// Nodes over gamma_i whose exits fall into one phi bin each, grouped in
+// pieces: each piece between consecutive crossings of a bin edge exits into
+// one bin and carries a smooth integrand; long pieces in panels of at most
+// pi/64, 5 points per panel (3 on panels shorter than 0.005 rad: one bin's
+// worth of h). With want_phi each node's phi (unwrapped) is set.
+struct Piece {
+  std::size_t end;  // one past its last node
+  int bin;          // the phi bin every node of it exits into
+};
+void edge_pieces(const PhiOfGamma& phi_of, int n_phi, bool want_phi, std::vector<cylinder::PathNode>& nodes,
+                 std::vector<Piece>& pieces) {
+  const double delta = kTwoPi / n_phi;
+  auto slope_of = [&](double x) { return phi_of.slope(x); };
+  static thread_local std::vector<double> cuts;
   nodes.clear();
   pieces.clear();
+  const std::vector<double> br = phi_of.branches();
   for (std::size_t k = 0; k + 1 < br.size(); ++k) {
     const double a = br[k], b = br[k + 1];
     const double fa = phi_of(a), fb = phi_of(b);
@@ -509,11 +508,45 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
       if (nodes.size() == first) continue;
       // The piece's bin, from its middle.
       pieces.push_back({nodes.size(), cylinder::phi_bin(wrap_angle(phi_of(0.5 * (cuts[q] + cuts[q + 1]))), n_phi)});
-      // Section 5.2.2: the caustic's removal factor needs each node's phi.
-      if (glints)
+      if (want_phi)
         for (std::size_t n = first; n < nodes.size(); ++n) nodes[n].phi = phi_of(nodes[n].gamma);
     }
   }
+}
+
+// The glints of section 5.2.2: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their
+// bin masses in closed form (images 2 pi away included; N_TRT wraps
+// phi - phi_c), the same for every channel, added to out[j * C + c].
+void add_glints(const Glint& gl, const CausticParams& cp, const Projection& proj, const std::vector<double>& sigma_a,
+                int n_phi, std::vector<double>& out) {
+  const std::size_t C = sigma_a.size();
+  const double delta = kTwoPi / n_phi;
+  std::vector<double> edges(n_phi + 1), glint_mass(n_phi, 0.0);
+  for (int j = 0; j <= n_phi; ++j) edges[j] = -kPi + j * delta;
+  for (int img = -1; img <= 1; ++img) {
+    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp.w_c, glint_mass.data());
+    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp.w_c, glint_mass.data());
+  }
+  for (std::size_t ch = 0; ch < C; ++ch) {
+    const double a2 = A(2, gl.gamma_c, proj.eta_p, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
+    const double scale = gl.t * cp.k_g * a2 * gl.dh;
+    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * glint_mass[j];
+  }
+}
+
+}  // namespace
+
+void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
+              const CausticParams* cp, int n_phi, std::vector<double>& out) {
+  const std::size_t C = sigma_a.size();
+  out.assign(static_cast<std::size_t>(n_phi) * C, 0.0);
+  const bool glints = p == 2 && cp && cp->w_c > 0.0;
+  const Glint gl = glints ? glint_of(proj, *cp) : Glint{};
+  static thread_local std::vector<cylinder::PathNode> nodes;
+  static thread_local std::vector<Piece> pieces;
+  static thread_local std::vector<double> mass;
+  // Section 5.2.2: the caustic's removal factor needs each node's phi.
+  edge_pieces(PhiOfGamma(p, proj), n_phi, glints, nodes, pieces);
   const cylinder::Attenuation att(proj.eta, proj.theta, sigma_a, proj.absorption);
   node_masses(att, p, nodes, glints && gl.t != 0.0 ? &gl : nullptr, cp, mass);
   // Each piece's sum into its bin.
@@ -526,21 +559,7 @@ void N_p_bins(int p, const Projection& proj, const std::vector<double>& sigma_a,
       out[static_cast<std::size_t>(pc.bin) * C + c] += sum;
     }
   }
-  if (!glints || gl.t == 0.0) return;
-  // The glints: t k_G A(2, h_c) dh g(w_c; phi -+ phi_c), their bin masses in
-  // closed form (images 2 pi away included; N_TRT wraps phi - phi_c), the
-  // same for every channel.
-  std::vector<double> edges(n_phi + 1), glint_mass(n_phi, 0.0);
-  for (int j = 0; j <= n_phi; ++j) edges[j] = -kPi + j * delta;
-  for (int img = -1; img <= 1; ++img) {
-    add_gaussian_interval_masses(edges.data(), n_phi, gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
-    add_gaussian_interval_masses(edges.data(), n_phi, -gl.phi_c + kTwoPi * img, cp->w_c, glint_mass.data());
-  }
-  for (std::size_t ch = 0; ch < C; ++ch) {
-    const double a2 = A(2, gl.gamma_c, e, proj.eta_pp, sigma_a[ch] / proj.cos_theta_t, proj.absorption);
-    const double scale = gl.t * cp->k_g * a2 * gl.dh;
-    for (int j = 0; j < n_phi; ++j) out[static_cast<std::size_t>(j) * C + ch] += scale * glint_mass[j];
-  }
+  if (glints && gl.t != 0.0) add_glints(gl, *cp, proj, sigma_a, n_phi, out);
 }
 
 // ---- Section 5.2.3 ------------------------------------------------------------
@@ -633,20 +652,12 @@ class Marschner2003 final : public Model {
   }
 
   // The default per-bin 6 x 6 Gauss-Legendre rule cannot see a Gaussian M of
-  // beta = 0.1 deg inside a 2 deg bin, nor the 1/sqrt caustics of N_TRT. Here:
-  // theta_r is split at the bin edges and every beta/2 (in theta_r) over
-  // +-8 standard deviations around each lobe's centre -theta_i + alpha[p],
-  // 4 Gauss-Legendre points per piece; M_p and the geometry factor of Eq. 9
-  // once per theta_r node. N's phi-bin integrals, where N depends on theta_d
-  // only (a circular fiber; R and TT of any fiber): exact integrals over h
-  // (N_p_bins), for R and TT interpolated in theta_r between exact
-  // evaluations (add_interpolated), for TRT (caustics that cross bin edges
-  // make its bins kink in theta_r) at every node. Where N_TRT depends on phi
-  // itself (eccentricity, section 5.2.3): density() at points in phi, split at
-  // the bin edges and every min(2 deg, w_c/2); each piece gets a 4-point
-  // Gauss-Legendre rule in u after phi = a + (b-a)(1 - cos(pi u))/2, which
-  // makes a 1/sqrt singularity at a piece end smooth. With w_c == 0 the
-  // caustics move with phi_h and are not split at (integrable, less
+  // beta = 0.1 deg inside a 2 deg bin, nor the 1/sqrt caustics of N_TRT. Here
+  // theta_r is split at theta_breakpoints, 4 Gauss-Legendre points per piece,
+  // and each node goes to add_circular_node (N depends on theta_d only: a
+  // circular fiber, or R and TT of any fiber) or add_eccentric_node (N_TRT of
+  // an elliptical fiber, section 5.2.3). With w_c == 0 the caustics of an
+  // elliptical fiber move with phi_h and are not split at (integrable, less
   // accurate).
   std::vector<double> bin_probabilities(const BinGrid& grid, double theta_i,
                                         double phi_i) const override {
@@ -654,27 +665,10 @@ class Marschner2003 final : public Model {
     const std::size_t C = params_.sigma_a.size();
     std::vector<double> out(static_cast<std::size_t>(L) * nt * np * C, 0.0);
     const GaussLegendre& gl = gauss_legendre(4);
-    std::vector<double> value, nbins;
-    const double half_pi = 0.5 * kPi;
-    double phi_step = deg_to_rad(2.0);
-    if (params_.w_c > 0.0) phi_step = std::min(phi_step, 0.5 * params_.w_c);
-
     for (int lobe = 0; lobe < L; ++lobe) {
       const int p_lo = lobe, p_hi = std::min(2, lobe == L - 1 ? 2 : lobe);
       if (p_lo > 2) continue;
-      // theta_r breakpoints.
-      std::vector<double> tk(grid.theta_edges.begin(), grid.theta_edges.end());
-      for (int p = p_lo; p <= p_hi; ++p) {
-        const double beta = m3::at_p(params_.beta_long, p, "beta_long");
-        const double sd = params_.two_theta_h ? beta : 2.0 * beta;  // in theta_r
-        const double centre = -theta_i + m3::at_p(params_.alpha, p, "alpha");
-        for (int k = -16; k <= 16; ++k) {
-          const double t = centre + 0.5 * k * sd;
-          if (t > -half_pi && t < half_pi) tk.push_back(t);
-        }
-      }
-      std::sort(tk.begin(), tk.end());
-      tk.erase(std::unique(tk.begin(), tk.end()), tk.end());
+      const std::vector<double> tk = theta_breakpoints(grid, p_lo, p_hi, theta_i);
       // Eccentricity changes N_TRT only (section 5.2.3: eta* "to the code
       // that computes N_TRT"): a lobe without p = 2 takes the circular
       // fiber's phi-bin integrals over h whatever the eccentricity.
@@ -687,58 +681,11 @@ class Marschner2003 final : public Model {
         for (int a = 0; a < static_cast<int>(gl.x.size()); ++a) {
           const double tr = 0.5 * (t0 + t1) + 0.5 * (t1 - t0) * gl.x[a];
           const double wt = 0.5 * (t1 - t0) * gl.w[a];
-          // Hoisted per theta_r: M_p does not depend on phi. Where every
-          // order's M is below 1e-13 of its peak (beyond ~7.7 standard
-          // deviations) the node adds less than 1e-13 of the lobe's density
-          // per bin (N and the geometry factor are bounded): skip its 180
-          // phi bins.
-          bool negligible = true;
-          for (int p = p_lo; p <= p_hi && negligible; ++p) {
-            const double beta = m3::at_p(params_.beta_long, p, "beta_long");
-            const double M = m3::M_p(beta, m3::at_p(params_.alpha, p, "alpha"), theta_i, tr, params_.two_theta_h);
-            negligible = M < 1e-13 * m3::g(beta, 0.0);
-          }
-          if (negligible) continue;
-          if (by_h) {
-            // Circular fiber: N depends on theta_d only; M and the geometry
-            // factor once per theta_r node, N's phi-bin integrals either
-            // interpolated (below, after the nodes) or exact per node.
-            const double theta_d = 0.5 * (tr - theta_i);
-            const double cos_d = std::cos(theta_d), cos_r = std::cos(tr);
-            if (cos_d * cos_d < 1e-300) continue;
-            const double geometry = (cos_r * cos_r) / (cos_d * cos_d);
-            for (int p = p_lo; p <= p_hi; ++p) {
-              const double beta = m3::at_p(params_.beta_long, p, "beta_long");
-              const double M = m3::M_p(beta, m3::at_p(params_.alpha, p, "alpha"), theta_i, tr, params_.two_theta_h);
-              if (M == 0.0) continue;
-              const double f = wt * M * geometry;
-              if (interpolate_theta_ && p < 2) {
-                points[p].push_back({i, tr, f});
-                continue;
-              }
-              const m3::Projection proj = m3::project(params_.eta, theta_d, params_.exact_roots, params_.absorption);
-              m3::N_p_bins(p, proj, params_.sigma_a, p == 2 ? &caustic_ : nullptr, np, nbins);
-              double* row = &out[(static_cast<std::size_t>(lobe) * nt + i) * np * C];
-              for (std::size_t x = 0; x < nbins.size(); ++x) row[x] += f * nbins[x];
-            }
-            continue;
-          }
-          for (int j = 0; j < np; ++j) {
-            const double f0 = grid.phi_edges[j], f1 = grid.phi_edges[j + 1];
-            double* bin = &out[((static_cast<std::size_t>(lobe) * nt + i) * np + j) * C];
-            const int n_sub = std::max(1, static_cast<int>(std::ceil((f1 - f0) / phi_step)));
-            const double width = (f1 - f0) / n_sub;
-            for (int sub = 0; sub < n_sub; ++sub) {
-              const double lo = f0 + sub * width;
-              for (int b = 0; b < 4; ++b) {
-                const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
-                const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
-                const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
-                density(lobe, theta_i, phi_i, tr, ph, value);
-                for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
-              }
-            }
-          }
+          if (negligible(p_lo, p_hi, theta_i, tr)) continue;
+          if (by_h)
+            add_circular_node(lobe, p_lo, p_hi, i, tr, wt, theta_i, nt, np, points, out);
+          else
+            add_eccentric_node(grid, lobe, i, tr, wt, theta_i, phi_i, out);
         }
       }
       for (int p = p_lo; p <= p_hi; ++p) add_interpolated(lobe, p, theta_i, points[p], nt, np, out);
@@ -752,6 +699,97 @@ class Marschner2003 final : public Model {
     double theta;  // theta_r
     double w;      // quadrature weight times M_p and the geometry factor
   };
+
+  // theta_r breakpoints: the bin edges and every half standard deviation
+  // (in theta_r) within +-8 of each order's centre -theta_i + alpha[p].
+  std::vector<double> theta_breakpoints(const BinGrid& grid, int p_lo, int p_hi, double theta_i) const {
+    const double half_pi = 0.5 * kPi;
+    std::vector<double> tk(grid.theta_edges.begin(), grid.theta_edges.end());
+    for (int p = p_lo; p <= p_hi; ++p) {
+      const double beta = m3::at_p(params_.beta_long, p, "beta_long");
+      const double sd = params_.two_theta_h ? beta : 2.0 * beta;  // in theta_r
+      const double centre = -theta_i + m3::at_p(params_.alpha, p, "alpha");
+      for (int k = -16; k <= 16; ++k) {
+        const double t = centre + 0.5 * k * sd;
+        if (t > -half_pi && t < half_pi) tk.push_back(t);
+      }
+    }
+    std::sort(tk.begin(), tk.end());
+    tk.erase(std::unique(tk.begin(), tk.end()), tk.end());
+    return tk;
+  }
+
+  // Whether every order's M at theta_r is below 1e-13 of its peak (beyond
+  // ~7.7 standard deviations): there the node adds less than 1e-13 of the
+  // lobe's density per bin (N and the geometry factor are bounded).
+  bool negligible(int p_lo, int p_hi, double theta_i, double tr) const {
+    for (int p = p_lo; p <= p_hi; ++p) {
+      const double beta = m3::at_p(params_.beta_long, p, "beta_long");
+      const double M = m3::M_p(beta, m3::at_p(params_.alpha, p, "alpha"), theta_i, tr, params_.two_theta_h);
+      if (!(M < 1e-13 * m3::g(beta, 0.0))) return false;
+    }
+    return true;
+  }
+
+  // A theta_r node of a circular fiber (N depends on theta_d only): M and the
+  // geometry factor of Eq. 9 once, N's phi-bin integrals either interpolated
+  // later (R and TT: into points[p]) or exact here (TRT, whose caustics
+  // crossing bin edges make its bins kink in theta_r).
+  void add_circular_node(int lobe, int p_lo, int p_hi, int i, double tr, double wt, double theta_i, int nt, int np,
+                         std::vector<ThetaPoint>* points, std::vector<double>& out) const {
+    const std::size_t C = params_.sigma_a.size();
+    const double theta_d = 0.5 * (tr - theta_i);
+    const double cos_d = std::cos(theta_d), cos_r = std::cos(tr);
+    if (cos_d * cos_d < 1e-300) return;
+    const double geometry = (cos_r * cos_r) / (cos_d * cos_d);
+    static thread_local std::vector<double> nbins;
+    for (int p = p_lo; p <= p_hi; ++p) {
+      const double beta = m3::at_p(params_.beta_long, p, "beta_long");
+      const double M = m3::M_p(beta, m3::at_p(params_.alpha, p, "alpha"), theta_i, tr, params_.two_theta_h);
+      if (M == 0.0) continue;
+      const double f = wt * M * geometry;
+      if (interpolate_theta_ && p < 2) {
+        points[p].push_back({i, tr, f});
+        continue;
+      }
+      const m3::Projection proj = m3::project(params_.eta, theta_d, params_.exact_roots, params_.absorption);
+      m3::N_p_bins(p, proj, params_.sigma_a, p == 2 ? &caustic_ : nullptr, np, nbins);
+      double* row = &out[(static_cast<std::size_t>(lobe) * nt + i) * np * C];
+      for (std::size_t x = 0; x < nbins.size(); ++x) row[x] += f * nbins[x];
+    }
+  }
+
+  // A theta_r node of an elliptical fiber's TRT lobe (N_TRT depends on phi
+  // through eta*(phi_h), section 5.2.3): density() at points in phi, split
+  // at the bin edges and every phi_step (min(2 deg, w_c / 2)); each piece
+  // gets a 4-point Gauss-Legendre rule in u after
+  // phi = a + (b - a)(1 - cos(pi u)) / 2, which makes a 1/sqrt singularity
+  // at a piece end smooth.
+  void add_eccentric_node(const BinGrid& grid, int lobe, int i, double tr, double wt, double theta_i, double phi_i,
+                          std::vector<double>& out) const {
+    const int nt = grid.n_theta(), np = grid.n_phi();
+    const std::size_t C = params_.sigma_a.size();
+    const GaussLegendre& gl = gauss_legendre(4);
+    double phi_step = deg_to_rad(2.0);
+    if (params_.w_c > 0.0) phi_step = std::min(phi_step, 0.5 * params_.w_c);
+    std::vector<double> value;
+    for (int j = 0; j < np; ++j) {
+      const double f0 = grid.phi_edges[j], f1 = grid.phi_edges[j + 1];
+      double* bin = &out[((static_cast<std::size_t>(lobe) * nt + i) * np + j) * C];
+      const int n_sub = std::max(1, static_cast<int>(std::ceil((f1 - f0) / phi_step)));
+      const double width = (f1 - f0) / n_sub;
+      for (int sub = 0; sub < n_sub; ++sub) {
+        const double lo = f0 + sub * width;
+        for (int b = 0; b < 4; ++b) {
+          const double u = 0.5 * (1.0 + gl.x[b]);  // in [0, 1]
+          const double ph = lo + 0.5 * width * (1.0 - std::cos(kPi * u));
+          const double w = wt * 0.5 * gl.w[b] * 0.5 * width * kPi * std::sin(kPi * u);
+          density(lobe, theta_i, phi_i, tr, ph, value);
+          for (std::size_t c = 0; c < C; ++c) bin[c] += w * value[c];
+        }
+      }
+    }
+  }
 
   // Adds order p of a circular fiber to `lobe`: sum over the theta_r nodes
   // of w N_p's phi-bin integrals at theta_d = (theta_r - theta_i) / 2, with
@@ -879,10 +917,10 @@ ModelInfo marschner2003_info() {
   };
   m.make = make_marschner2003;
   m.approximations = marschner_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
     apply_fiber_basics(f, p);
     p.eccentricity = f.eccentricity;
-    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), kMinMarschnerBeta);
+    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), mapping, kMinMarschnerBeta);
   };
   return m;
 }

@@ -48,6 +48,7 @@
 #include <memory>
 #include <vector>
 
+#include "analytic/longitudinal_lobes.h"
 #include "analytic/model.h"
 
 namespace fiberlab::analytic {
@@ -65,13 +66,16 @@ namespace marschner2003 {
 
 // ---- Longitudinal scattering function M (section 5.1) ----------------------
 
-// g(beta; x): unit-integral zero-mean Gaussian with standard deviation beta.
-double g(double beta, double x);
+// g(beta; x): unit-integral zero-mean Gaussian with standard deviation beta
+// (longitudinal_lobes.h).
+inline double g(double beta, double x) { return longitudinal::gaussian(beta, x); }
 
 // M_p as published: g(beta; theta_h - alpha_theta_r / 2) (integrates to 2 over
 // theta_r for small beta), or with two_theta_h g(beta; 2 theta_h - alpha_theta_r)
-// (integrates to 1).
-double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bool two_theta_h);
+// (integrates to 1) (longitudinal_lobes.h).
+inline double M_p(double beta, double alpha_theta_r, double theta_i, double theta_r, bool two_theta_h) {
+  return longitudinal::gaussian_M_p(beta, alpha_theta_r, theta_i, theta_r, two_theta_h);
+}
 
 // ---- Bravais indices (Appendix B) ------------------------------------------
 

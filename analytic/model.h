@@ -65,6 +65,7 @@ struct ModelParams {
   double ggx_roughness = 0.3;
   std::vector<double> lobe_scale{1.0, 1.0, 1.0};
   int huang_masking = 0;
+  int huang_residual = 0;  // p >= 3: 0 Cycles' sampler's residual, 1 its eval()'s
   bool mesonormal_flux = true;
   double quadrature_points = 4194304.0;
 };

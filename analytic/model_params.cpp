@@ -2,10 +2,12 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
 
+#include "analytic/physical_defaults.h"
 #include "common/error.h"
 #include "common/physical_limits.h"
 #include "common/units.h"
@@ -37,6 +39,17 @@ bool parse_double(const std::string& text, double& out) {
 // Degrees on the command line, radians inside.
 double to_internal(const std::string& unit) { return unit == "deg" ? deg_to_rad(1.0) : 1.0; }
 
+ParamSpec blank_spec(std::string key, std::string meaning, std::string unit, std::string default_value,
+                     std::string allowed) {
+  ParamSpec s;
+  s.key = std::move(key);
+  s.meaning = std::move(meaning);
+  s.unit = std::move(unit);
+  s.default_value = std::move(default_value);
+  s.allowed = std::move(allowed);
+  return s;
+}
+
 std::string number_text(double x) { return fmt::format("{:g}", x); }
 
 std::string list_text(const std::vector<double>& v, double scale) {
@@ -54,7 +67,7 @@ ParamSpec number_param(std::string key, std::string meaning, std::string unit,
                        std::string default_value, std::string allowed, double ModelParams::*field,
                        std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
+  ParamSpec s = blank_spec(key, std::move(meaning), unit, std::move(default_value), allowed);
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || !ok(x)) fail(key, value, allowed);
@@ -82,7 +95,7 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
                      std::string default_value, std::string allowed,
                      std::vector<double> ModelParams::*field, std::function<bool(double)> ok) {
   const double scale = to_internal(unit);
-  ParamSpec s{key, std::move(meaning), unit, std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
+  ParamSpec s = blank_spec(key, std::move(meaning), unit, std::move(default_value), allowed);
   s.set = [key, allowed, field, ok, scale](ModelParams& p, const std::string& value) {
     std::vector<double> out;
     std::size_t start = 0;
@@ -106,13 +119,24 @@ ParamSpec list_param(std::string key, std::string meaning, std::string unit,
     return true;
   };
   s.attribute = [key, field](const ModelParams& p) { return ParamAttribute{key, false, "", p.*field}; };
+  s.get_entry = [field, scale](const ModelParams& p, int index) { return for_lobe(p.*field, std::max(0, index)) / scale; };
+  s.set_entry = [field, scale](ModelParams& p, int index, double x) {
+    std::vector<double>& list = p.*field;
+    if (index < 0) {  // one common value: one entry (the last entry applies to every larger index)
+      list = {x * scale};
+      return;
+    }
+    if (list.empty()) list.push_back(x * scale);
+    while (static_cast<int>(list.size()) <= index) list.push_back(list.back());
+    list[static_cast<std::size_t>(index)] = x * scale;
+  };
   return s;
 }
 
 ParamSpec integer_param(std::string key, std::string meaning, std::string default_value,
                         int ModelParams::*field, int min_value) {
   const std::string allowed = fmt::format("an integer >= {}", min_value);
-  ParamSpec s{key, std::move(meaning), "integer", std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
+  ParamSpec s = blank_spec(key, std::move(meaning), "integer", std::move(default_value), allowed);
   s.set = [key, allowed, field, min_value](ModelParams& p, const std::string& value) {
     double x;
     if (!parse_double(value, x) || x != std::floor(x) || x < min_value || x > 1e6)
@@ -132,7 +156,7 @@ ParamSpec choice_param(std::string key, std::string meaning, std::string default
                        std::function<int(const ModelParams&)> get) {
   std::string allowed;
   for (const auto& c : choices) allowed += (allowed.empty() ? "" : " | ") + c;
-  ParamSpec s{key, std::move(meaning), "choice", std::move(default_value), allowed, "", {}, {}, {}, {}, {}, {}};
+  ParamSpec s = blank_spec(key, std::move(meaning), "choice", std::move(default_value), allowed);
   s.set = [key, allowed, choices, set](ModelParams& p, const std::string& value) {
     const std::string v = trim(value);
     for (std::size_t i = 0; i < choices.size(); ++i)
@@ -170,6 +194,12 @@ ParamSpec sigma_a_param() {
                            [](double x) { return x >= 0.0; });
   s.from_fiber = "fiber.sigma_a (or melanin)";
   s.fit_min = 0.0;
+  // One common value for every channel keeps the number of channels.
+  const auto set_entry = s.set_entry;
+  s.set_entry = [set_entry](ModelParams& p, int index, double x) {
+    if (index >= 0) return set_entry(p, index, x);
+    std::fill(p.sigma_a.begin(), p.sigma_a.end(), x);
+  };
   return s;
 }
 
@@ -187,6 +217,7 @@ ParamSpec beta_long_param(std::string meaning) {
                            "a comma list of degrees in [0, 90], indexed by lobe p", &ModelParams::beta_long,
                            [](double x) { return x >= 0.0 && x <= 90.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
+  s.per_lobe = true;
   // A fit keeps widths >= 1 deg: the published models' azimuthal
   // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
   // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
@@ -201,6 +232,7 @@ ParamSpec beta_azim_param(std::string meaning) {
                            "a comma list of degrees in [0, 90], indexed by lobe p", &ModelParams::beta_azim,
                            [](double x) { return x >= 0.0 && x <= 90.0; });
   s.from_fiber = "roughness (calibrated rule, physical_defaults.h)";
+  s.per_lobe = true;
   // A fit keeps widths >= 1 deg: the published models' azimuthal
   // quadratures cost ~1/beta (d'Eon's Gaussian detector took ~5 s per
   // evaluation at 0.4 deg on a 2-direction, 18 x 36 grid), and no tally in
@@ -218,6 +250,18 @@ ParamSpec alpha_param(std::string meaning) {
                            "a comma list of degrees in [-180, 180], indexed by lobe p", &ModelParams::alpha,
                            [](double x) { return std::abs(x) <= 180.0; });
   s.from_fiber = "fiber.scale_tilt (SPEC s7: R -2a, TT +a, TRT +4a, p >= 3: 0)";
+  // As one value: the physical tilt a (TT's shift), every lobe by the rule.
+  s.whole_fit_key = "scale_tilt";
+  s.per_lobe = true;
+  const auto get_entry = s.get_entry;
+  const auto set_entry = s.set_entry;
+  s.get_entry = [get_entry](const ModelParams& p, int index) {
+    return index < 0 ? rad_to_deg(for_lobe(p.alpha, 1)) : get_entry(p, index);
+  };
+  s.set_entry = [set_entry](ModelParams& p, int index, double x) {
+    if (index >= 0) return set_entry(p, index, x);
+    p.alpha = tilt_shifts(deg_to_rad(x));
+  };
   // Free: a fit moves it through the physical tilt (fit key scale_tilt, the
   // shift rule), the range of the simulator's scale_tilt (SPEC s11).
   return fittable(s, -45.0 + 1e-6, 45.0 - 1e-6);

@@ -45,14 +45,26 @@ struct ParamSpec {
   std::function<bool(const ModelParams&)> in_range;
   // The current value for files (radians).
   std::function<ParamAttribute(const ModelParams&)> attribute;
-  // Fitting (compare/fit.h). Scalar parameters (number_param) only: the
-  // value as a number in command-line units (degrees), read and written
-  // without the text round trip.
+  // Fitting (compare/fit.h): the value as a number in command-line units
+  // (degrees), read and written without the text round trip. Scalars
+  // (number_param): get_number / set_number. Lists (list_param): entry
+  // `index` (the list extended by its last entry as needed), or with index
+  // -1 the list as one common value (get: entry 0; set: every entry).
   std::function<double(const ModelParams&)> get_number;
   std::function<void(ModelParams&, double)> set_number;
+  std::function<double(const ModelParams&, int index)> get_entry;
+  std::function<void(ModelParams&, int index, double)> set_entry;
+  // The fit key of a list as one value when it is not the list's own key
+  // (alpha: `scale_tilt`, the physical tilt through SPEC s7's shift rule;
+  // a bare `alpha` is refused). Empty: the key itself.
+  std::string whole_fit_key;
+  // A list indexed by the tally's lobe (beta_long, beta_azim, alpha): a
+  // per-lobe fit moves that lobe's entry (compare/fit.h per_lobe_keys()).
+  bool per_lobe = false;
   // The closed range a fit keeps the value in, in command-line units: the
   // table's allowed range, an open end moved inside by a small margin
-  // (eta > 1: 1 + 1e-6). For a list, the range of each entry.
+  // (eta > 1: 1 + 1e-6, the one floor of eta: a fit never asks for less,
+  // and no model needs more). For a list, the range of each entry.
   double fit_min = -std::numeric_limits<double>::infinity();
   double fit_max = std::numeric_limits<double>::infinity();
   // A free parameter: part of the model's shape that the fiber's physics

@@ -40,7 +40,8 @@ ModelParams default_params(const std::string& name) { return table_defaults(mode
 ModelParams params_for_fiber(const std::string& name, const PhysicalFiber& fiber) {
   const ModelInfo& m = model_info(name);
   ModelParams p = table_defaults(m.params);
-  m.from_fiber(fiber, p);
+  FiberMapping mapping;
+  m.from_fiber(fiber, p, mapping);
   return p;
 }
 

@@ -32,8 +32,11 @@ struct ModelInfo {
   std::function<std::vector<std::string>(const ModelParams&)> approximations;
   // The model's parameters for a simulated fiber: the table's defaults with
   // the fiber's eta, sigma_a, lobes, eccentricity (where the model has it),
-  // roughness and tilt mapped by the model's rule (physical_defaults.h).
-  std::function<void(const PhysicalFiber&, ModelParams&)> from_fiber;
+  // roughness and tilt mapped by the model's rule (physical_defaults.h). A
+  // fiber the model cannot represent: fiberlab::Error naming the field and
+  // what is allowed, unless mapping.user_sets() the key concerned; an
+  // approximate rule adds a line to mapping.notes.
+  std::function<void(const PhysicalFiber&, ModelParams&, FiberMapping&)> from_fiber;
 };
 
 // Every registered model, in listing order.

@@ -1,9 +1,34 @@
 #include "analytic/physical_defaults.h"
 
+#include <fmt/core.h>
+
 #include <algorithm>
 #include <cmath>
 
+#include "common/units.h"
+
 namespace fiberlab::analytic {
+
+std::string PhysicalFiber::roughness_text() const {
+  switch (roughness) {
+    case Roughness::Smooth: return "smooth";
+    case Roughness::Gaussian: {
+      const double bl = beta_long.empty() ? 0.0 : beta_long.front();
+      return fmt::format("gaussian beta = [{:g}, {:g}] deg", rad_to_deg(bl),
+                         rad_to_deg(beta_azim.empty() ? bl : beta_azim.front()));
+    }
+    case Roughness::ExitBlur: return "exit_blur";
+    case Roughness::Beckmann: return fmt::format("beckmann alpha = [{:g}, {:g}]", alpha_long, alpha_azim);
+    case Roughness::GGX: return fmt::format("ggx alpha = [{:g}, {:g}]", alpha_long, alpha_azim);
+  }
+  return "";
+}
+
+bool FiberMapping::user_sets(const std::string& key) const {
+  return std::find(user_keys.begin(), user_keys.end(), key) != user_keys.end();
+}
+
+double microfacet_as_gaussian(double alpha) { return std::atan(alpha / std::sqrt(2.0)); }
 
 std::vector<double> tilt_shifts(double a) { return {-2.0 * a, a, 4.0 * a, 0.0}; }
 
@@ -50,8 +75,18 @@ void apply_fiber_basics(const PhysicalFiber& f, ModelParams& p) {
   p.alpha = tilt_shifts(f.scale_tilt);
 }
 
-void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, const WidthCalibration& cal,
-                           double min_beta_long) {
+void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& p, const WidthCalibration& cal,
+                           FiberMapping& mapping, double min_beta_long) {
+  PhysicalFiber f = fiber;
+  if (f.microfacet()) {
+    f.roughness = PhysicalFiber::Roughness::Gaussian;
+    f.beta_long = {microfacet_as_gaussian(f.alpha_long)};
+    f.beta_azim = {microfacet_as_gaussian(f.alpha_azim)};
+    mapping.notes.push_back(fmt::format(
+        "roughness: the {} fiber read as the gaussian fiber of the same RMS facet slope per axis, beta = "
+        "atan(alpha / sqrt 2) = [{:g}, {:g}] deg, then the calibrated rule (nominal: fit or --set the widths)",
+        fiber.roughness_text(), rad_to_deg(f.beta_long.front()), rad_to_deg(f.beta_azim.front())));
+  }
   const std::vector<double>& azim = f.beta_azim.empty() ? f.beta_long : f.beta_azim;
   switch (f.roughness) {
     case PhysicalFiber::Roughness::ExitBlur:
@@ -74,6 +109,8 @@ void apply_fiber_roughness(const PhysicalFiber& f, ModelParams& p, const WidthCa
       p.beta_azim = w.beta_azim;
       break;
     }
+    case PhysicalFiber::Roughness::Beckmann:
+    case PhysicalFiber::Roughness::GGX: break;  // mapped to Gaussian above
   }
   for (double& b : p.beta_long) b = std::max(b, min_beta_long);
 }

@@ -16,14 +16,22 @@
 //     every event): a *calibrated* rule, gaussian_lobe_widths(): the theta_r
 //     spread of each lobe measured in simulations over a grid of roughness
 //     and theta_i (scripts/calibrate_widths.py regenerates the table below),
-//     expressed in each model's width convention.
+//     expressed in each model's width convention;
+//   * beckmann / ggx (microfacet alpha per axis): models with their own
+//     microfacet roughness (huang2022) take alpha itself; the Gaussian-width
+//     models take the gaussian fiber of the same RMS facet slope per axis
+//     (microfacet_as_gaussian(), a stated approximation).
+// A rule that is an approximation says so in FiberMapping::notes (printed by
+// `predict` and `compare`); a fiber a model cannot represent is refused
+// (fiberlab::Error naming the field and what the model allows) unless the
+// user sets the parameter concerned with --set.
 #include <string>
 #include <vector>
 
 namespace fiberlab::analytic {
 
 struct PhysicalFiber {
-  enum class Roughness { Smooth, Gaussian, ExitBlur };
+  enum class Roughness { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
   double eta = 1.55;
   double eccentricity = 1.0;
   double scale_tilt = 0.0;  // radians, towards the root
@@ -31,8 +39,30 @@ struct PhysicalFiber {
   Roughness roughness = Roughness::Smooth;
   std::vector<double> beta_long{0.0};  // radians; indexed by p for exit_blur
   std::vector<double> beta_azim;       // radians; empty: beta_long
+  // beckmann / ggx: the facets' roughness along the fiber axis and about it.
+  double alpha_long = 0.0, alpha_azim = 0.0;
   int lobes = 4;
+
+  bool microfacet() const { return roughness == Roughness::Beckmann || roughness == Roughness::GGX; }
+  // "ggx alpha = [0.3, 0.1]": the roughness as the config gives it, for notes and errors.
+  std::string roughness_text() const;
 };
+
+// What a model's rule (ModelInfo::from_fiber) knows and says besides the
+// parameters: the keys the user sets with --set (a fiber the model cannot
+// represent is refused only when the user does not set the key concerned),
+// and one line per approximate mapping applied, printed with the model.
+struct FiberMapping {
+  std::vector<std::string> user_keys;
+  std::vector<std::string> notes;
+  bool user_sets(const std::string& key) const;
+};
+
+// The gaussian fiber of the same RMS facet slope per axis: Beckmann's slopes
+// are Normal(0, alpha^2 / 2) per axis, so beta = atan(alpha / sqrt 2). A
+// nominal width for the Gaussian-width models (GGX's slopes have no finite
+// variance, and the calibrated widths are for gaussian facets).
+double microfacet_as_gaussian(double alpha);
 
 // SPEC s7's shifts of theta_r for tilt a: {-2a, a, 4a, 0}.
 std::vector<double> tilt_shifts(double scale_tilt);
@@ -92,7 +122,10 @@ namespace fiberlab::analytic {
 void apply_fiber_basics(const PhysicalFiber& fiber, ModelParams& params);
 // beta_long / beta_azim from the roughness (see the top of this file), in
 // the model's width variable; every beta_long at least min_beta_long.
+// A beckmann / ggx fiber goes through microfacet_as_gaussian() per axis, as
+// a gaussian fiber, and the mapping is noted in `mapping`.
 void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params,
-                           const WidthCalibration& calibration, double min_beta_long = 0.0);
+                           const WidthCalibration& calibration, FiberMapping& mapping,
+                           double min_beta_long = 0.0);
 
 }  // namespace fiberlab::analytic

@@ -72,68 +72,58 @@ SmoothCylinder::SmoothCylinder(ModelParams params) : params_(std::move(params)) 
   if (params_.sigma_a.empty()) throw Error("exact model: sigma_a needs at least one channel");
 }
 
+namespace {
+// N_p(phi) (SPEC s7): the sum over the roots gamma of Phi(p, gamma) = phi
+// (mod 2 pi) of A(p, h) / |2 dPhi/dh|, dh = cos(gamma) dgamma, added to
+// out[c]; the roots by bisection on the monotonic pieces of Phi.
+void add_N_p(const cylinder::Attenuation& att, int p, double phi, std::vector<double>& out) {
+  const int C = att.channels();
+  const double eta_p = att.eta_p();
+  std::vector<double> a(C);
+  const std::vector<double> br = [&] {
+    const double gc = cylinder::fold_gamma(p, eta_p);
+    if (gc > 0.0) return std::vector<double>{-kPi / 2, -gc, gc, kPi / 2};
+    return std::vector<double>{-kPi / 2, kPi / 2};
+  }();
+  for (std::size_t k = 0; k + 1 < br.size(); ++k) {
+    const double ga = br[k], gb = br[k + 1];
+    const double pa = cylinder::Phi(p, ga, eta_p), pb = cylinder::Phi(p, gb, eta_p);
+    const double lo = std::min(pa, pb), hi = std::max(pa, pb);
+    for (long m = static_cast<long>(std::ceil((lo - phi) / kTwoPi));
+         phi + m * kTwoPi <= hi; ++m) {
+      const double e = phi + m * kTwoPi;
+      if (e <= lo || e >= hi) continue;
+      // Bisection on the monotonic piece (density() is not performance critical).
+      double x0 = ga, x1 = gb;
+      const bool inc = pb > pa;
+      for (int it = 0; it < 200 && x1 - x0 > 1e-15; ++it) {
+        const double xm = 0.5 * (x0 + x1);
+        if ((cylinder::Phi(p, xm, eta_p) < e) == inc) x0 = xm; else x1 = xm;
+      }
+      const double g = 0.5 * (x0 + x1);
+      att.A(p, g, a.data());
+      const double jac = std::cos(g) / (2.0 * std::abs(cylinder::dPhi_dgamma(p, g, eta_p)));
+      for (int c = 0; c < C; ++c) out[c] += a[c] * jac;
+    }
+  }
+}
+}  // namespace
+
 void SmoothCylinder::density(int lobe, double theta_i, double, double theta_r, double phi,
                              std::vector<double>& out) const {
   const int C = static_cast<int>(params_.sigma_a.size());
   out.assign(C, 0.0);
   if (std::abs(theta_r + theta_i) > 1e-9) return;
   const cylinder::Attenuation att(params_.eta, theta_i, params_.sigma_a, params_.absorption);
-  const double eta_p = att.eta_p();
-  std::vector<double> a(C);
   const int L = params_.lobes;
   const int p_first = lobe, p_last_fixed = lobe < L - 1 ? lobe : -1;
   // Orders of the last lobe: up to the point where the remaining energy is
-  // negligible (64-point estimate), the remainder spread uniformly in phi.
-  int p_end = p_last_fixed;
-  double res_sum[16] = {0};
-  if (p_end < 0) {
-    const GaussLegendre& gl = gauss_legendre(64);
-    for (int P = lobe;; ++P) {
-      double worst = 0.0;
-      std::vector<double> acc(C, 0.0);
-      for (int q = 0; q < 64; ++q) {
-        const double g = 0.5 * kPi * gl.x[q];
-        att.A_beyond(P, g, a.data());
-        for (int c = 0; c < C; ++c) acc[c] += 0.25 * kPi * gl.w[q] * std::cos(g) * a[c];
-      }
-      for (int c = 0; c < C; ++c) worst = std::max(worst, acc[c]);
-      if (worst <= 1e-7 || P >= 100) {
-        p_end = P;
-        for (int c = 0; c < C && c < 16; ++c) res_sum[c] = acc[c];
-        break;
-      }
-    }
-  }
-  for (int p = p_first; p <= p_end; ++p) {
-    const std::vector<double> br = [&] {
-      const double gc = cylinder::fold_gamma(p, eta_p);
-      if (gc > 0.0) return std::vector<double>{-kPi / 2, -gc, gc, kPi / 2};
-      return std::vector<double>{-kPi / 2, kPi / 2};
-    }();
-    for (std::size_t k = 0; k + 1 < br.size(); ++k) {
-      const double ga = br[k], gb = br[k + 1];
-      const double pa = cylinder::Phi(p, ga, eta_p), pb = cylinder::Phi(p, gb, eta_p);
-      const double lo = std::min(pa, pb), hi = std::max(pa, pb);
-      for (long m = static_cast<long>(std::ceil((lo - phi) / kTwoPi));
-           phi + m * kTwoPi <= hi; ++m) {
-        const double e = phi + m * kTwoPi;
-        if (e <= lo || e >= hi) continue;
-        // Bisection on the monotonic piece (density() is not performance critical).
-        double x0 = ga, x1 = gb;
-        const bool inc = pb > pa;
-        for (int it = 0; it < 200 && x1 - x0 > 1e-15; ++it) {
-          const double xm = 0.5 * (x0 + x1);
-          if ((cylinder::Phi(p, xm, eta_p) < e) == inc) x0 = xm; else x1 = xm;
-        }
-        const double g = 0.5 * (x0 + x1);
-        att.A(p, g, a.data());
-        const double jac = std::cos(g) / (2.0 * std::abs(cylinder::dPhi_dgamma(p, g, eta_p)));
-        for (int c = 0; c < C; ++c) out[c] += a[c] * jac;
-      }
-    }
-  }
+  // negligible, the remainder spread uniformly in phi.
+  std::vector<double> res;
+  const int p_end = p_last_fixed >= 0 ? p_last_fixed : cylinder::last_order(att, lobe, 1e-7, 100, res);
+  for (int p = p_first; p <= p_end; ++p) add_N_p(att, p, phi, out);
   if (p_last_fixed < 0)
-    for (int c = 0; c < C && c < 16; ++c) out[c] += res_sum[c] / kTwoPi;
+    for (int c = 0; c < C; ++c) out[c] += res[c] / kTwoPi;
 }
 
 std::vector<double> SmoothCylinder::bin_probabilities(const BinGrid& grid, double theta_i,
@@ -182,7 +172,7 @@ ModelInfo exact_info() {
   m.params = {eta_param(), sigma_a_param(), absorption_param("chord"), lobes_param()};
   m.make = make_smooth_cylinder;
   m.approximations = exact_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p) {
+  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping&) {
     if (f.eccentricity != 1.0)
       throw Error(fmt::format("model exact: circular fibers only; this fiber has eccentricity {:g}",
                               f.eccentricity));

@@ -5,7 +5,11 @@
 //  (b) circle, gaussian beta 5 deg, tilt 3 deg, sigma_a (0.2, 0.4, 0.8), theta_i 30 deg;
 //  (c) ellipse e = 0.8, beta 7.5 deg, tilt 3 deg, the same sigma_a, theta_i 17, phi_i 11 deg;
 //  (d) steep tilt: circle, beta 5 deg, tilt 20 deg, sigma_a 0, theta_i 30 deg (light
-//      guided along the fiber runs to max_segments).
+//      guided along the fiber runs to max_segments);
+//  (g) case c with `ggx` alpha 0.19 (sqrt(2) tan 7.5 deg, the width
+//      compare/models.cpp maps to beta 7.5 deg) instead of gaussian;
+//  (k) the same with `beckmann` alpha 0.19;
+//  (m) case c's geometry, white, `ggx` alpha 0.3 with `masking: smith_g1`.
 // One thread, so the rate is per core. Counters: photons/s, interface events
 // and candidate normals per photon. `trace` is the batched SIMD tracer that
 // `fiberlab run` uses for unpolarised light (binning and tally included);
@@ -57,6 +61,17 @@ Settings bench_case(char which) {
     s.fiber.sigma_a = {0.0};
     s.fiber.scale_tilt = deg_to_rad(20.0);
   }
+  if (which == 'g' || which == 'k' || which == 'm') {
+    s.fiber.eccentricity = 0.8;
+    s.source.theta_i = {deg_to_rad(17.0)};
+    s.source.phi_i = {deg_to_rad(11.0)};
+    s.roughness.model = which == 'k' ? RoughnessModel::Beckmann : RoughnessModel::GGX;
+    s.roughness.alpha_long = s.roughness.alpha_azim = which == 'm' ? 0.3 : 0.19;
+    if (which == 'm') {
+      s.fiber.sigma_a = {0.0};
+      s.roughness.masking = Masking::SmithG1;
+    }
+  }
   return s;
 }
 
@@ -105,6 +120,9 @@ BENCHMARK_CAPTURE(trace, a_smooth_circle, 'a')->Unit(benchmark::kMillisecond)->M
 BENCHMARK_CAPTURE(trace, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, g_ggx_ellipse, 'g')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, k_beckmann_ellipse, 'k')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace, m_ggx_smith_g1_white, 'm')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_per_chunk, 'b', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_per_chunk, 'c', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
@@ -134,6 +152,8 @@ BENCHMARK_CAPTURE(trace_reference, a_smooth_circle, 'a')->Unit(benchmark::kMilli
 BENCHMARK_CAPTURE(trace_reference, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 BENCHMARK_CAPTURE(trace_reference, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_CAPTURE(trace_reference, g_ggx_ellipse, 'g')->Unit(benchmark::kMillisecond)->MinTime(1.0);
+BENCHMARK_CAPTURE(trace_reference, k_beckmann_ellipse, 'k')->Unit(benchmark::kMillisecond)->MinTime(1.0);
 
 }  // namespace
 

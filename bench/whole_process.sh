@@ -18,9 +18,8 @@
 # machine has, since rates on AVX2-only machines are about half.
 # Wall times come from bash's EPOCHREALTIME (microseconds, read without
 # starting a process) around each run: the run's own start-up (fork, exec,
-# about 3 ms on these VMs) counts, a timer's does not. (Until 2026-12-04 the
-# script read `date +%s%N`, two more processes per run: about 5 ms more on
-# every time here, 2.5% of a 0.2 s run.) The result files go to
+# about 3 ms on these VMs) counts, a timer's does not (no `date` process
+# per reading). The result files go to
 # a temporary directory, removed at the end. Use an otherwise idle machine:
 # the medians damp, not remove, other jobs' noise.
 set -euo pipefail

@@ -5,16 +5,23 @@
 // judgement: compare/atlas.h; the config: compare/atlas_config.h; the file:
 // compare/atlas_file.h; the report: compare/atlas_report.h; the checkpoint
 // saved after each fiber (OUT.checkpoint.h5, as `fiberlab run`'s):
-// compare/atlas_checkpoint.h.
+// compare/atlas_checkpoint.h. Under `mpirun -np N` the fibers are spread
+// over the ranks and rank 0 alone writes (run_fibers_on_ranks; docs/ATLAS.md
+// "Many processes").
 // Exit status 0 when written, 2 on bad input (nothing written), 128 + signal
 // when interrupted (the finished fibers kept in the checkpoint, no OUT).
 #include <fmt/core.h>
 
 #include <omp.h>
 
+#include <unistd.h>
+
+#include <cstring>
 #include <filesystem>
 #include <memory>
+#include <optional>
 
+#include "app/on_all_ranks.h"
 #include "cli/commands.h"
 #include "common/atomic_output.h"
 #include "common/error.h"
@@ -26,11 +33,16 @@
 #include "compare/atlas_report.h"
 #include "sim/store/checkpoint.h"
 #include "sim/run/memory_budget.h"
+#include "sim/run/process_group.h"
+#include "sim/run/rank_agreement.h"
 #include "sim/run/settings.h"
+#include "sim/store/exact_tally.h"
 
 namespace fiberlab::cli {
 
 namespace {
+
+using app::on_all_ranks;
 
 struct AtlasOptions {
   std::string config, output, report, threads, photons, resume;
@@ -65,7 +77,7 @@ struct AtlasJob {
   bool resumed = false;
 };
 
-AtlasJob new_job(const AtlasOptions& o, const std::string& command) {
+AtlasJob new_job(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group) {
   if (o.config.empty()) throw Error("atlas: give a CONFIG file, or --resume CHECKPOINT");
   if (o.output.empty()) throw Error("atlas: give the output file with -o OUT.h5");
   AtlasJob job;
@@ -75,7 +87,7 @@ AtlasJob new_job(const AtlasOptions& o, const std::string& command) {
   job.report = o.report.empty() ? default_report_dir(o.output) : o.report;
   job.checkpoint = sim::checkpoint_path(o.output);
   job.inputs = {o.config};
-  if (std::filesystem::exists(job.checkpoint))
+  if (group.is_root() && std::filesystem::exists(job.checkpoint))
     throw Error(fmt::format("{} exists (an interrupted atlas of this output): resume it with "
                             "`fiberlab atlas --resume {}`, or delete it", job.checkpoint, job.checkpoint));
   job.setup = {o.config, job.config.yaml, o.photons, std::filesystem::path(o.output).filename().string(),
@@ -104,25 +116,129 @@ AtlasJob resumed_job(const AtlasOptions& o) {
   return job;
 }
 
-void atlas_command(const AtlasOptions& o, const std::string& command) {
-  AtlasJob job = o.resume.empty() ? new_job(o, command) : resumed_job(o);
-  compare::AtlasControl control;
-  if (!o.threads.empty()) {
-    control.threads = static_cast<int>(sim::parse_integer_flag("--threads", o.threads, 1, sim::kMaxThreads));
-    omp_set_num_threads(control.threads);
+
+// Rank r's fiber bytes into rank 0: each rank's segment of a zeroed buffer,
+// summed exactly (the other ranks add zeros). Returns, on rank 0, every
+// rank's bytes (empty for a rank without a fiber this round).
+std::vector<std::vector<std::uint8_t>> gather_to_root(const sim::ProcessGroup& group,
+                                                      const std::vector<std::uint8_t>& mine) {
+  using Word = sim::ExactTally::Word;
+  const std::size_t ranks = static_cast<std::size_t>(group.size()), per_word = sizeof(Word);
+  std::vector<std::int64_t> sizes(ranks, 0);
+  sizes[group.rank()] = static_cast<std::int64_t>(mine.size());
+  group.max(sizes);
+  std::vector<std::size_t> first(ranks + 1, 0);
+  for (std::size_t r = 0; r < ranks; ++r) first[r + 1] = first[r] + (static_cast<std::size_t>(sizes[r]) + per_word - 1) / per_word;
+  std::vector<Word> words(first[ranks], 0);
+  std::memcpy(words.data() + first[group.rank()], mine.data(), mine.size());
+  group.sum_to_root(words);
+  std::vector<std::vector<std::uint8_t>> out(ranks);
+  if (!group.is_root()) return out;
+  for (std::size_t r = 0; r < ranks; ++r) {
+    out[r].resize(static_cast<std::size_t>(sizes[r]));
+    std::memcpy(out[r].data(), words.data() + first[r], out[r].size());
   }
-  check_output_target(job.output, job.inputs);
-  // The checkpoint is rewritten in place when resuming; never over CONFIG.
-  check_output_target(job.checkpoint, o.config.empty() ? std::vector<std::string>{} : std::vector{o.config});
-  remove_stale_temporaries(job.checkpoint);  // of an atlas killed while writing it
-  check_report_dir(job.report);
-  if (!o.quiet) control.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
+  return out;
+}
+
+// Under an MPI launcher: fiber i of each round of N runs on rank i mod N;
+// rank 0 gathers the round, saves the checkpoint and, at the end, writes
+// OUT and the report. Returns false when a signal stopped the atlas (the
+// finished rounds kept in the checkpoint).
+bool run_fibers_on_ranks(const sim::ProcessGroup& group, AtlasJob& job, const compare::AtlasControl& control) {
+  const std::size_t n = job.config.fibers.size(), ranks = static_cast<std::size_t>(group.size());
+  const std::string scratch =
+      (std::filesystem::temp_directory_path() / fmt::format("fiberlab_atlas_{}_{}.h5", ::getpid(), group.rank()))
+          .string();
+  while (job.fibers.size() < n) {
+    const std::size_t mine = job.fibers.size() + static_cast<std::size_t>(group.rank());
+    std::vector<std::uint8_t> bytes;
+    std::vector<std::int64_t> stopped{0};
+    on_all_ranks(group, [&] {
+      try {
+        if (mine < n) bytes = compare::pack_atlas_fiber(job.config, mine, compare::run_atlas_fiber(job.config, mine, control),
+                                                        scratch);
+      } catch (const compare::AtlasInterrupted& s) {
+        stopped[0] = s.signal;
+      }
+    });
+    group.max(stopped);
+    if (stopped[0] != 0) {
+      if (group.is_root()) {
+        if (job.fibers.empty())
+          fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first fibers were finished; nothing "
+                     "written\n", signal_name(static_cast<int>(stopped[0])));
+        else
+          fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
+                     "fiberlab atlas --resume {}\n", signal_name(static_cast<int>(stopped[0])), job.fibers.size(), n,
+                     job.checkpoint, job.checkpoint);
+      }
+      exit_code = 128 + static_cast<int>(stopped[0]);
+      return false;
+    }
+    const auto received = gather_to_root(group, bytes);
+    on_all_ranks(group, [&] {
+      const std::size_t round = job.fibers.size();
+      for (std::size_t r = 0; r < ranks && round + r < n; ++r) {
+        if (group.is_root())
+          job.fibers.push_back(compare::unpack_atlas_fiber(job.config, round + r, received[r], scratch));
+        else
+          job.fibers.emplace_back();  // rank 0 keeps the results; the others only count them
+      }
+      if (group.is_root()) compare::write_atlas_checkpoint(job.checkpoint, job.setup, job.config, job.fibers);
+    });
+  }
+  return true;
+}
+
+void atlas_on_ranks(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group);
+
+void atlas_command(const AtlasOptions& o, const std::string& command) {
+  sim::ProcessGroup group;
+  try {
+    atlas_on_ranks(o, command, group);
+  } catch (const sim::FailedElsewhere&) {
+    exit_code = 2;  // rank 0 reports
+  }
+}
+
+// One process: the fibers in order, the checkpoint after each. Under an MPI
+// launcher (several ranks): every rank reads CONFIG (or the checkpoint),
+// the ranks check they agree, the fibers are spread over them, and only
+// rank 0 writes (run_fibers_on_ranks).
+void atlas_on_ranks(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group) {
+  AtlasJob job;
+  compare::AtlasControl control;
+  on_all_ranks(group, [&] {
+    job = o.resume.empty() ? new_job(o, command, group) : resumed_job(o);
+    if (!o.threads.empty()) {
+      control.threads = static_cast<int>(sim::parse_integer_flag("--threads", o.threads, 1, sim::kMaxThreads));
+      omp_set_num_threads(control.threads);
+    }
+    if (group.is_root()) {
+      check_output_target(job.output, job.inputs);
+      // The checkpoint is rewritten in place when resuming; never over CONFIG.
+      check_output_target(job.checkpoint, o.config.empty() ? std::vector<std::string>{} : std::vector{o.config});
+      remove_stale_temporaries(job.checkpoint);  // of an atlas killed while writing it
+      check_report_dir(job.report);
+    }
+  });
+  if (group.size() > 1)
+    on_all_ranks(group, [&] {
+      const std::string text = fmt::format("{}fibers done: {}\n", compare::atlas_config_identity(job.config),
+                                           job.fibers.size());
+      if (const auto disagreement = sim::ranks_disagree(group, text)) throw Error(*disagreement);
+    });
+  if (!o.quiet && group.is_root())
+    control.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
 
   install_interrupt_handlers();
   const std::size_t n = job.config.fibers.size();
   if (job.resumed && control.progress)
     control.progress(fmt::format("resuming: {} of {} fibers from {}", job.fibers.size(), n, job.checkpoint));
-  try {
+  if (group.size() > 1) {
+    if (!run_fibers_on_ranks(group, job, control) || !group.is_root()) return;
+  } else try {
     while (job.fibers.size() < n) {
       job.fibers.push_back(compare::run_atlas_fiber(job.config, job.fibers.size(), control));
       compare::write_atlas_checkpoint(job.checkpoint, job.setup, job.config, job.fibers);

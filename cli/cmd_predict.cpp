@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analytic/model_registry.h"
+#include "app/predict.h"
 #include "cli/commands.h"
 #include "common/atomic_output.h"
 #include "compare/models.h"
@@ -27,25 +28,10 @@ struct PredictOptions {
 
 void predict(const PredictOptions& o) {
   const sim::Settings s = sim::load_settings_or_result(o.input);
-  const compare::ModelSpec spec = compare::parse_model_spec(o.model);
-  const analytic::ModelParams params = compare::params_for(s, spec, o.settings);
-  const std::unique_ptr<analytic::Model> model = analytic::make_model(spec.name, params);
-  fmt::print("{}", compare::model_header(spec, params));
-
-  compare::PredictionFile pred;
-  pred.model = spec.name;
-  pred.grid = BinGrid::make(s.tally.n_theta, s.tally.n_phi, s.tally.theta_bins);
-  pred.lobes = params.lobes;
-  pred.channels = static_cast<int>(params.sigma_a.size());
+  const app::ChosenModel chosen = app::choose_model(s, compare::parse_model_spec(o.model), o.settings);
+  fmt::print("{}", compare::model_header(chosen.spec, chosen.params, chosen.fiber_notes));
   check_output_target(o.output, {o.input});  // before the work
-  for (const sim::Settings::Incidence& inc : s.incidences()) {
-    pred.theta_i.push_back(inc.theta_i);
-    pred.phi_i.push_back(inc.phi_i);
-    const std::vector<double> p = compare::predict_bins(*model, pred.grid, inc.theta_i, inc.phi_i, pred.lobes,
-                                                        pred.channels, s.fiber.eccentricity != 1.0);
-    pred.probability.insert(pred.probability.end(), p.begin(), p.end());
-  }
-  compare::write_prediction(o.output, pred, s, params, {o.input});
+  compare::write_prediction(o.output, app::predict(s, chosen), s, chosen.params, {o.input});
 }
 
 }  // namespace

@@ -10,9 +10,11 @@ std::string lobe_name(int lobe, int lobes) {
   return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
 }
 
-std::vector<std::string> lobe_names(int lobes) {
+std::vector<std::string> lobe_names(int lobes, bool scattered) {
+  const int by_p = scattered ? lobes - 1 : lobes;
   std::vector<std::string> out;
-  for (int l = 0; l < lobes; ++l) out.push_back(lobe_name(l, lobes));
+  for (int l = 0; l < by_p; ++l) out.push_back(lobe_name(l, by_p));
+  if (scattered) out.push_back("scattered");
   return out;
 }
 
@@ -36,8 +38,8 @@ void describe(h5::File& f, const std::string& path, const std::string& dimension
   f.set_attr(path, "description", description);
 }
 
-void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin) {
-  f.set_attr("/", "lobe_names", join_names(lobe_names(lobes)));
+void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin, bool scattered) {
+  f.set_attr("/", "lobe_names", join_names(lobe_names(lobes, scattered)));
   f.set_attr("/", "channel_names", join_names(channel_names(channels, from_melanin)));
 }
 

@@ -13,7 +13,9 @@ namespace fiberlab {
 // Tally lobe names (SPEC s6): lobes 0..L-2 by their paths (R, TT, TRT, TRRT,
 // ...), the last one collecting every larger p ("p>=3" for L = 4).
 std::string lobe_name(int lobe, int lobes);
-std::vector<std::string> lobe_names(int lobes);
+// With `scattered` (a fiber with a medulla, docs/FUR.md) the last of the
+// `lobes` is "scattered" and the others are named as for lobes - 1.
+std::vector<std::string> lobe_names(int lobes, bool scattered = false);
 
 // Channel names: "R", "G", "B" for a fiber whose sigma_a came from melanin
 // (three channels, d'Eon et al. 2011 s6.1), else "c0", "c1", ...
@@ -42,7 +44,8 @@ void write_described(h5::File& f, const std::string& path, const h5::Dims& dims,
 }
 
 // Root attributes `lobe_names` and `channel_names` (comma-separated).
-void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin);
+void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin,
+                      bool scattered = false);
 
 // Where the bin edges, solid angles and incident directions are: in a
 // result or prediction file /bins/... and /source/... (common/result_layout.h

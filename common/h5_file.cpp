@@ -128,10 +128,9 @@ Handle dataset_creation(const Dims& dims, bool slab_rows, const std::string& pat
       H5Zfilter_avail(H5Z_FILTER_DEFLATE) > 0) {
     const Dims chunk = chunk_shape(dims, slab_rows);
     H5Pset_chunk(dcpl.id(), static_cast<int>(chunk.size()), chunk.data());
-    // Level 2: libdeflate (the row plans' compressor) runs 2.4x faster there
-    // than at level 1 on zeros and sparse bins (870 against 360 MB/s), 1.15x
-    // on a 4 M-photon case c direction, for files no larger; level 4 is 30%
-    // slower than level 1 (all on 90 x 180 x 8-lobe, 3-channel results).
+    // Level 2: libdeflate (the row plans' compressor) deflates zeros and
+    // sparse bins faster at level 2 than at level 1, into files no larger;
+    // higher levels are slower.
     H5Pset_deflate(dcpl.id(), 2);
   }
   return dcpl;

@@ -65,7 +65,8 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
                                 const std::string& name, const AtlasControl& control) {
   const auto t0 = Clock::now();
   AtlasModelResult m;
-  m.model = name;
+  m.model = name;  // the entry's name; `model` is the registered model it runs
+  const std::string& model = registered_model(config, name);
   analytic::ModelParams p;
   try {
     p = atlas_start_params(config, fiber, name);
@@ -75,9 +76,9 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
     return m;
   }
   m.applicable = true;
-  m.params_before = analytic::describe_params(name, p);
-  m.before = judge_model(r, name, p);
-  const std::vector<std::string> keys = free_fit_keys(name);
+  m.params_before = analytic::describe_params(model, p);
+  m.before = judge_model(r, model, p);
+  const std::vector<std::string> keys = free_fit_keys(model);
   if (keys.empty()) {
     m.status = "not fitted: its parameter table marks no parameter free";
   } else if (config.max_iterations == 0) {
@@ -87,14 +88,14 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
     try {
       Options fit_options;
       fit_options.lobes = config.fit_lobes;
-      m.fit = fit_model(r, name, p, keys, fit_options, config.max_iterations, [&](const std::string& line) {
+      m.fit = fit_model(r, model, p, keys, fit_options, config.max_iterations, [&](const std::string& line) {
         check_interrupt();
         say(control, "  " + name + " " + line);
       });
       m.fitted = true;
       m.status = fit_status(m.fit);
-      m.params_after = analytic::describe_params(name, m.fit.params);
-      m.after = judge_model(r, name, m.fit.params);
+      m.params_after = analytic::describe_params(model, m.fit.params);
+      m.after = judge_model(r, model, m.fit.params);
     } catch (const Error& e) {
       m.status = std::string("fit failed: ") + e.what();
     }
@@ -107,11 +108,12 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
 }  // namespace
 
 analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
-                                         const std::string& model) {
-  const auto fixed = config.model_parameters.find(model);
+                                         const std::string& entry) {
+  const std::string& model = registered_model(config, entry);
+  const auto fixed = config.model_parameters.find(entry);
   const analytic::ModelParams p = params_for(
       fiber.settings,
-      ModelSpec{model, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second, model},
+      ModelSpec{model, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second, entry},
       {});
   compare::make_model(model, p);  // the model's own checks
   return p;

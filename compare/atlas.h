@@ -26,7 +26,7 @@
 namespace fiberlab::compare {
 
 struct AtlasModelResult {
-  std::string model;
+  std::string model;   // the entry's name (a registered model or a variant)
   std::string status;  // "fitted", "not fitted: ...", "not applicable: ..."
   bool applicable = false, fitted = false;
   std::string params_before, params_after;  // "key=value ..." (command-line units)
@@ -61,12 +61,13 @@ struct AtlasControl {
 // (install_interrupt_handlers() must have been called by the command).
 AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t fiber, const AtlasControl& control);
 
-// The parameters model `model` starts from for `fiber`: its physical
-// defaults for the fiber (ModelInfo::from_fiber) with the config's
-// model_parameters on top, checked by the model. Throws fiberlab::Error when
+// The parameters the entry `entry` of config.models (a registered model or
+// a variant) starts from for `fiber`: its model's physical defaults for the
+// fiber (ModelInfo::from_fiber) with the entry's fixed settings on top,
+// checked by the model. Throws fiberlab::Error when
 // the model refuses the fiber (then "not applicable").
 analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
-                                         const std::string& model);
+                                         const std::string& entry);
 
 // Summary per fiber, model and lobe, over every theta_i and channel.
 struct AtlasLobeSummary {

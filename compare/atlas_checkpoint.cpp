@@ -6,6 +6,8 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -317,8 +319,9 @@ struct FitArrays {
 };
 
 FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const AtlasConfig& config,
-                   const AtlasFiber& fiber, const std::string& model, const std::string& where) {
+                   const AtlasFiber& fiber, const std::string& entry, const std::string& where) {
   if (at.fit >= fits.keys.size()) r.fail("fit_keys has fewer lines than fitted models");
+  const std::string& model = registered_model(config, entry);
   FitResult fit;
   fit.keys = free_fit_keys(model);
   if (fits.keys[at.fit] != joined(fit.keys, ","))
@@ -350,7 +353,7 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
   // The parameters at the minimum, as fit_model made them: the start
   // parameters with each key set to its fitted value.
   try {
-    fit.params = atlas_start_params(config, fiber, model);
+    fit.params = atlas_start_params(config, fiber, entry);
     for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
   } catch (const Error& e) {
     r.fail(fmt::format("{}: the fitted parameters are refused by {}: {}", where, model, e.what()));
@@ -394,7 +397,7 @@ Stored read_stored(const Reader& r, std::size_t F, const AtlasConfig& config) {
       if (st[0] > 1 || st[1] > 1 || st[2] > K * L * C || st[3] > K * L * C)
         r.fail(fmt::format("model_state of fiber {}, model {} is out of range", i + 1, config.models[m]));
       rows += st[2] + st[3];
-      const std::size_t P = free_fit_keys(config.models[m]).size();
+      const std::size_t P = free_fit_keys(registered_model(config, config.models[m])).size();
       if (st[1] == 1 && P > 0) {
         ++fitted;
         fitted_keys += P;
@@ -429,9 +432,10 @@ AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const 
   out.before = read_comparisons(r, s.comparisons, st[2], at, fiber, where + ", before");
   out.after = read_comparisons(r, s.comparisons, st[3], at, fiber, where + ", after");
   if (out.fitted && !out.applicable) r.fail(where + ": fitted but not applicable");
-  if (out.fitted && !free_fit_keys(out.model).empty()) {
+  const std::string& model = registered_model(config, out.model);
+  if (out.fitted && !free_fit_keys(model).empty()) {
     out.fit = read_fit(r, s.fits, at, config, fiber.fiber, out.model, where);
-    if (analytic::describe_params(out.model, out.fit.params) != out.params_after)
+    if (analytic::describe_params(model, out.fit.params) != out.params_after)
       r.fail(where + ": the fitted values do not give params_after");
   }
   return out;
@@ -472,6 +476,7 @@ std::string first_difference(const std::string& a, const std::string& b) {
 std::string atlas_config_identity(const AtlasConfig& config) {
   std::string s = fmt::format("fiberlab atlas config identity {}\nmodels: {}\n", kAtlasCheckpointVersion,
                               joined(config.models, ","));
+  for (const auto& [variant, model] : config.variant_of) s += fmt::format("variant {}: model {}\n", variant, model);
   for (const auto& [model, settings] : config.model_parameters)
     s += fmt::format("model_parameters.{}: {}\n", model, joined(settings, " "));
   s += fmt::format("fit.max_iterations: {}\ntheta_i (rad):", config.max_iterations);
@@ -570,6 +575,59 @@ AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
                          "/dataset_digests differs: datasets swapped, edited or damaged)",
                          names[d]));
   return c;
+}
+
+namespace {
+
+AtlasConfig one_fiber_config(const AtlasConfig& config, std::size_t index) {
+  AtlasConfig one = config;
+  one.fibers = {config.fibers.at(index)};
+  return one;
+}
+
+// Removes the scratch file however the caller leaves.
+struct ScratchFile {
+  std::string path;
+  ~ScratchFile() {
+    std::error_code ec;
+    std::filesystem::remove(path, ec);
+  }
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> pack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                           const AtlasFiberResult& result, const std::string& scratch) {
+  const AtlasConfig one = one_fiber_config(config, index);
+  const ScratchFile file{scratch};
+  {
+    h5::File f = h5::File::create(scratch);
+    write_flat(f, flatten({result}), 1, one.theta_i.size(), one.models.size());
+    f.close();
+  }
+  std::ifstream in(scratch, std::ios::binary);
+  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (!in.good() && !in.eof()) throw Error(fmt::format("{}: cannot read back the packed fiber", scratch));
+  return bytes;
+}
+
+AtlasFiberResult unpack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                    const std::vector<std::uint8_t>& bytes, const std::string& scratch) {
+  const AtlasConfig one = one_fiber_config(config, index);
+  const ScratchFile file{scratch};
+  {
+    std::ofstream out(scratch, std::ios::binary | std::ios::trunc);
+    out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+    if (!out) throw Error(fmt::format("{}: cannot write the received fiber", scratch));
+  }
+  const h5::File f = h5::File::open_read(scratch);
+  const std::string origin = fmt::format("fiber {} received from another rank", index + 1);
+  const Reader r{f, origin};
+  const Stored stored = read_stored(r, 1, one);
+  Cursor at;
+  AtlasFiberResult result = read_fiber(r, stored, at, one, 0);
+  result.fiber = config.fibers.at(index);
+  return result;
 }
 
 std::string describe_atlas_checkpoint(const std::string& path) {

@@ -80,4 +80,14 @@ std::string describe_atlas_checkpoint(const std::string& path);
 void check_same_atlas_config(const AtlasCheckpoint& checkpoint, const AtlasConfig& given,
                              const std::string& checkpoint_file);
 
+// One finished fiber as bytes, for `mpirun ... fiberlab atlas` (the rank
+// that ran it sends them to rank 0): the checkpoint's datasets for this
+// fiber alone, as an HDF5 file written to and read from `scratch` (a path
+// of the calling process's own; removed afterwards). Exact: every number
+// is stored as computed, so the unpacked result equals the packed one.
+std::vector<std::uint8_t> pack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                           const AtlasFiberResult& result, const std::string& scratch);
+AtlasFiberResult unpack_atlas_fiber(const AtlasConfig& config, std::size_t index,
+                                    const std::vector<std::uint8_t>& bytes, const std::string& scratch);
+
 }  // namespace fiberlab::compare

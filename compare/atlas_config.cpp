@@ -4,9 +4,12 @@
 #include <fmt/ranges.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <memory>
 #include <set>
 
 #include "analytic/model_registry.h"
@@ -124,7 +127,8 @@ std::string absorption_label(const Reader& r, const YAML::Node& entry, const std
 // The simulator config of one fiber, parsed by the simulator's own parser.
 sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML::Node& roughness,
                              const YAML::Node& absorption, double tilt, double eccentricity,
-                             const YAML::Node& theta_i, const std::string& where) {
+                             const YAML::Node& medulla, const YAML::Node& theta_i,
+                             const std::string& where) {
   YAML::Node c;
   c["photons"] = top["photons"];
   c["seed"] = top["seed"] ? top["seed"] : YAML::Node(1);
@@ -134,6 +138,7 @@ sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML:
   fiber["eccentricity"] = eccentricity;
   fiber["scale_tilt"] = tilt;
   for (const auto& kv : absorption) fiber[kv.first.Scalar()] = kv.second;
+  if (!(medulla.IsScalar() && medulla.Scalar() == "none")) fiber["medulla"] = medulla;
   c["fiber"] = fiber;
   c["roughness"] = roughness;
   YAML::Node source;
@@ -150,79 +155,176 @@ sim::Settings fiber_settings(const Reader& r, const YAML::Node& top, const YAML:
   }
 }
 
-std::vector<std::string> read_models(const Reader& r, const YAML::Node& n) {
+// One entry of `models`: a registered model, or a variant (its own name,
+// a registered model, fixed parameters).
+struct ModelEntry {
+  std::string name, model;
+  // Null for a registered model's own entry. A pointer: assigning a
+  // YAML::Node (as sorting does) rewrites the node it refers to.
+  std::shared_ptr<const YAML::Node> parameters;
+  std::string path;       // "models[1]", for errors
+  std::size_t rank = 0;   // registry index of model
+  std::size_t order = 0;  // 0 for a registered model, 1 + config position for a variant
+};
+
+bool is_variant_name(const std::string& name) {
+  if (name.empty() || name.size() > 64) return false;
+  for (char c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '_' && c != '-') return false;
+  return true;
+}
+
+std::size_t registry_index(const std::vector<std::string>& all, const std::string& name) {
+  return static_cast<std::size_t>(std::find(all.begin(), all.end(), name) - all.begin());
+}
+
+std::string allowed_models(const std::vector<std::string>& all) {
+  std::string allowed = "all";
+  for (const auto& m : all) allowed += " | " + m;
+  return allowed + " | {name: NAME, model: MODEL, parameters: {KEY: VALUE}}";
+}
+
+ModelEntry read_variant(const Reader& r, const YAML::Node& n, const std::string& path,
+                        const std::vector<std::string>& all, std::size_t i) {
+  only_keys(r, n, path, {"name", "model", "parameters"});
+  ModelEntry e;
+  e.path = path;
+  e.order = 1 + i;
+  if (!n["name"] || !n["name"].IsScalar() || !is_variant_name(n["name"].Scalar()))
+    r.fail(fmt::format("{}.name = {} must be the variant's name (1 to 64 letters, digits, _ or -)", path,
+                       show(n["name"])));
+  e.name = n["name"].Scalar();
+  if (registry_index(all, e.name) < all.size())
+    r.fail(fmt::format("{}.name = {} is a registered model's name (give the variant a name of its own)", path, e.name));
+  if (!n["model"] || !n["model"].IsScalar() || registry_index(all, n["model"].Scalar()) == all.size()) {
+    std::string allowed;
+    for (const auto& m : all) allowed += (allowed.empty() ? "" : " | ") + m;
+    r.fail(fmt::format("{}.model = {} is not a registered model (allowed: {})", path, show(n["model"]), allowed));
+  }
+  e.model = n["model"].Scalar();
+  e.rank = registry_index(all, e.model);
+  if (n["parameters"]) {
+    if (!n["parameters"].IsMap())
+      r.fail(fmt::format("{}.parameters = {} must be a mapping {{KEY: VALUE}} of {}'s fixed parameters", path,
+                         show(n["parameters"]), e.model));
+    e.parameters = std::make_shared<const YAML::Node>(n["parameters"]);
+  }
+  return e;
+}
+
+// models: `all` (default) or a list of registered names and variants, in
+// the registry's order of their models (a model's variants after it).
+std::vector<ModelEntry> read_models(const Reader& r, const YAML::Node& n) {
   const std::vector<std::string> all = analytic::model_names();
-  if (!n || (n.IsScalar() && n.Scalar() == "all")) return all;
-  std::set<std::string> wanted;
+  std::vector<ModelEntry> out;
+  if (!n || (n.IsScalar() && n.Scalar() == "all")) {
+    for (std::size_t j = 0; j < all.size(); ++j) out.push_back({all[j], all[j], {}, "models", j, 0});
+    return out;
+  }
+  std::set<std::string> names;
   const auto list = items(r, n, "models");
   for (std::size_t i = 0; i < list.size(); ++i) {
-    const std::string name = list[i].IsScalar() ? list[i].Scalar() : show(list[i]);
-    bool known = false;
-    for (const auto& m : all) known = known || m == name;
-    if (!known) {
-      std::string allowed = "all";
-      for (const auto& m : all) allowed += " | " + m;
-      r.fail(fmt::format("models[{}] = {} is not a registered model (allowed: {})", i, name, allowed));
+    const std::string path = fmt::format("models[{}]", i);
+    if (list[i].IsMap()) {
+      ModelEntry e = read_variant(r, list[i], path, all, i);
+      if (!names.insert(e.name).second)
+        r.fail(fmt::format("{}.name = {} is already an entry of models (each variant needs its own name)", path, e.name));
+      out.push_back(std::move(e));
+      continue;
     }
-    wanted.insert(name);
+    const std::string name = list[i].IsScalar() ? list[i].Scalar() : show(list[i]);
+    const std::size_t j = registry_index(all, name);
+    if (j == all.size())
+      r.fail(fmt::format("{} = {} is not a registered model (allowed: {})", path, name, allowed_models(all)));
+    if (names.insert(name).second) out.push_back({name, name, {}, path, j, 0});
   }
-  std::vector<std::string> out;
-  for (const auto& m : all)
-    if (wanted.count(m)) out.push_back(m);
+  std::stable_sort(out.begin(), out.end(), [](const ModelEntry& a, const ModelEntry& b) {
+    return a.rank != b.rank ? a.rank < b.rank : a.order < b.order;
+  });
   return out;
 }
 
-// model_parameters: {MODEL: {KEY: VALUE, ...}, ...}, each KEY a fixed
-// (not free) parameter of MODEL's table, each VALUE accepted by the table's
-// own parser (applied to the model's defaults here, to each fiber's
-// physical defaults by the atlas).
+// {KEY: VALUE, ...} at `path`: fixed (not free) parameters of `model`'s
+// table, each VALUE accepted by the table's own parser (applied to the
+// model's defaults here, to each fiber's physical defaults by the atlas).
+// Returns "KEY=VALUE" settings.
+std::vector<std::string> read_fixed_settings(const Reader& r, const YAML::Node& settings, const std::string& path,
+                                             const std::string& model) {
+  std::vector<std::string> out;
+  const analytic::ParamTable& table = analytic::model_info(model).params;
+  std::set<std::string> fixed;
+  for (const analytic::ParamSpec& s : table)
+    if (!s.free) fixed.insert(s.key);
+  if (settings.IsMap())
+    for (const auto& setting : settings)
+      if (const analytic::ParamSpec* spec = analytic::find_param(table, setting.first.Scalar()); spec && spec->free)
+        r.fail(fmt::format("{}.{} is a free parameter: the atlas fits it, starting from the fiber's physical "
+                           "value (fixed keys of {}: {})",
+                           path, spec->key, model, fmt::join(fixed, ", ")));
+  only_keys(r, settings, path, fixed);
+  analytic::ModelParams p = analytic::default_params(model);
+  for (const auto& setting : settings) {
+    const std::string key = setting.first.Scalar();
+    const analytic::ParamSpec* spec = analytic::find_param(table, key);
+    // eta, sigma_a, lobes, eccentricity: each fiber's own (the atlas's eta,
+    // its absorption and eccentricity sweeps, its tally); a model told
+    // otherwise would predict another fiber or another tally shape, and
+    // fail only once the fibers are simulated.
+    if (spec->from_fiber.rfind("fiber.", 0) == 0 || spec->from_fiber.rfind("tally.", 0) == 0)
+      r.fail(fmt::format("{}.{} is each fiber's own ({}): the atlas sets it from its eta, tally and "
+                         "sweep, not per model", path, key, spec->from_fiber));
+    std::string value;
+    if (setting.second.IsScalar()) {
+      value = setting.second.Scalar();
+    } else if (setting.second.IsSequence()) {  // a per-lobe or per-channel list
+      for (const auto& x : setting.second)
+        value += (value.empty() ? "" : ",") + (x.IsScalar() ? x.Scalar() : show(x));
+    }
+    try {
+      if (value.empty()) throw Error("empty");
+      spec->set(p, value);
+    } catch (const Error&) {
+      r.fail(fmt::format("{}.{} = {} is not allowed (allowed: {})", path, key, show(setting.second), spec->allowed));
+    }
+    out.push_back(key + "=" + value);
+  }
+  return out;
+}
+
+// model_parameters: {MODEL: {KEY: VALUE, ...}, ...} for the models of the
+// entries; then each variant's: its model's settings with its own on top
+// (a key it gives replaces its model's).
 std::map<std::string, std::vector<std::string>> read_model_parameters(const Reader& r, const YAML::Node& n,
-                                                                      const std::vector<std::string>& models) {
+                                                                      const std::vector<ModelEntry>& entries) {
   std::map<std::string, std::vector<std::string>> out;
-  if (!n) return out;
-  std::set<std::string> chosen(models.begin(), models.end());
-  only_keys(r, n, "model_parameters", chosen);
-  for (const auto& kv : n) {
-    const std::string model = kv.first.Scalar();
-    const std::string path = "model_parameters." + model;
-    const analytic::ParamTable& table = analytic::model_info(model).params;
-    std::set<std::string> fixed;
-    for (const analytic::ParamSpec& s : table)
-      if (!s.free) fixed.insert(s.key);
-    if (kv.second.IsMap())
-      for (const auto& setting : kv.second)
-        if (const analytic::ParamSpec* spec = analytic::find_param(table, setting.first.Scalar()); spec && spec->free)
-          r.fail(fmt::format("{}.{} is a free parameter: the atlas fits it, starting from the fiber's physical "
-                             "value (fixed keys of {}: {})",
-                             path, spec->key, model, fmt::join(fixed, ", ")));
-    only_keys(r, kv.second, path, fixed);
-    analytic::ModelParams p = analytic::default_params(model);
-    for (const auto& setting : kv.second) {
-      const std::string key = setting.first.Scalar();
-      const analytic::ParamSpec* spec = analytic::find_param(table, key);
-      // eta, sigma_a, lobes, eccentricity: each fiber's own (the atlas's eta,
-      // its absorption and eccentricity sweeps, its tally); a model told
-      // otherwise would predict another fiber or another tally shape, and
-      // fail only once the fibers are simulated.
-      if (spec->from_fiber.rfind("fiber.", 0) == 0 || spec->from_fiber.rfind("tally.", 0) == 0)
-        r.fail(fmt::format("{}.{} is each fiber's own ({}): the atlas sets it from its eta, tally and "
-                           "sweep, not per model", path, key, spec->from_fiber));
-      std::string value;
-      if (setting.second.IsScalar()) {
-        value = setting.second.Scalar();
-      } else if (setting.second.IsSequence()) {  // a per-lobe or per-channel list
-        for (const auto& x : setting.second)
-          value += (value.empty() ? "" : ",") + (x.IsScalar() ? x.Scalar() : show(x));
-      }
-      try {
-        if (value.empty()) throw Error("empty");
-        spec->set(p, value);
-      } catch (const Error&) {
-        r.fail(fmt::format("{}.{} = {} is not allowed (allowed: {})", path, key, show(setting.second), spec->allowed));
-      }
-      out[model].push_back(key + "=" + value);
+  std::set<std::string> chosen;
+  for (const ModelEntry& e : entries) chosen.insert(e.model);
+  if (n) {
+    only_keys(r, n, "model_parameters", chosen);
+    for (const auto& kv : n) {
+      const std::string model = kv.first.Scalar();
+      out[model] = read_fixed_settings(r, kv.second, "model_parameters." + model, model);
     }
   }
+  std::map<std::string, std::vector<std::string>> variants;
+  for (const ModelEntry& e : entries) {
+    if (e.name == e.model) continue;
+    std::vector<std::string> settings;
+    if (const auto base = out.find(e.model); base != out.end()) settings = base->second;
+    if (e.parameters)
+      for (const std::string& own : read_fixed_settings(r, *e.parameters, e.path + ".parameters", e.model)) {
+        const std::string key = own.substr(0, own.find('=') + 1);
+        std::erase_if(settings, [&](const std::string& x) { return x.rfind(key, 0) == 0; });
+        settings.push_back(own);
+      }
+    if (!settings.empty()) variants[e.name] = settings;
+  }
+  // Settings of a model listed only through its variants are not an entry's.
+  for (auto it = out.begin(); it != out.end();)
+    it = std::any_of(entries.begin(), entries.end(), [&](const ModelEntry& e) { return e.name == it->first; })
+             ? std::next(it)
+             : out.erase(it);
+  out.merge(variants);
   return out;
 }
 
@@ -244,13 +346,17 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   integer(r, top["photons"], "photons", 1, 1e12);
   if (!top["sweep"]) r.fail("sweep is missing (roughness, absorption, scale_tilt, eccentricity, theta_i lists)");
   const YAML::Node sweep = top["sweep"];
-  only_keys(r, sweep, "sweep", {"roughness", "absorption", "scale_tilt", "eccentricity", "theta_i"});
+  only_keys(r, sweep, "sweep", {"roughness", "absorption", "scale_tilt", "eccentricity", "medulla", "theta_i"});
 
   AtlasConfig c;
   c.path = origin;
   c.yaml = yaml_text;
-  c.models = read_models(r, top["models"]);
-  c.model_parameters = read_model_parameters(r, top["model_parameters"], c.models);
+  const std::vector<ModelEntry> entries = read_models(r, top["models"]);
+  for (const ModelEntry& e : entries) {
+    c.models.push_back(e.name);
+    if (e.name != e.model) c.variant_of[e.name] = e.model;
+  }
+  c.model_parameters = read_model_parameters(r, top["model_parameters"], entries);
   if (const YAML::Node fit = top["fit"]) {
     only_keys(r, fit, "fit", {"max_iterations", "lobes"});
     if (fit["max_iterations"])
@@ -262,6 +368,13 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   const auto tilts = sweep["scale_tilt"] ? numbers(r, sweep["scale_tilt"], "sweep.scale_tilt") : std::vector<double>{0.0};
   const auto eccs =
       sweep["eccentricity"] ? numbers(r, sweep["eccentricity"], "sweep.eccentricity") : std::vector<double>{1.0};
+  // sweep.medulla: `none` or a simulator fiber.medulla block each (docs/FUR.md).
+  const auto medullas = sweep["medulla"] ? items(r, sweep["medulla"], "sweep.medulla")
+                                         : std::vector<YAML::Node>{YAML::Node("none")};
+  for (std::size_t m = 0; m < medullas.size(); ++m)
+    if (!medullas[m].IsMap() && !(medullas[m].IsScalar() && medullas[m].Scalar() == "none"))
+      r.fail(fmt::format("sweep.medulla[{}] = {} must be none or a medulla block such as "
+                         "{{radius: 0.5, sigma_s: 8}}", m, show(medullas[m])));
   const YAML::Node theta_node = sweep["theta_i"];
   const auto theta = numbers(r, theta_node, "sweep.theta_i");
   for (double t : theta) c.theta_i.push_back(deg_to_rad(t));
@@ -271,18 +384,22 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   for (std::size_t g = 0; g < roughness.size(); ++g)
     if (!roughness[g].IsMap()) r.fail(fmt::format("sweep.roughness[{}] = {} must be a roughness block such as "
                                                   "{{model: gaussian, beta_long: 5}}", g, show(roughness[g])));
-  if (roughness.size() * absorption.size() * tilts.size() * eccs.size() > kMaxFibers)
+  if (roughness.size() * absorption.size() * tilts.size() * eccs.size() * medullas.size() > kMaxFibers)
     r.fail(fmt::format("the sweep has more than {} fibers (shorten its lists)", kMaxFibers));
 
   for (std::size_t g = 0; g < roughness.size(); ++g)
     for (std::size_t a = 0; a < absorption.size(); ++a)
       for (std::size_t t = 0; t < tilts.size(); ++t)
-        for (std::size_t e = 0; e < eccs.size(); ++e) {
+        for (std::size_t e = 0; e < eccs.size(); ++e)
+        for (std::size_t m = 0; m < medullas.size(); ++m) {
           AtlasFiber f;
           roughness_size(roughness[g], f);
           const std::string where =
-              fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e);
-          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], theta_node, where);
+              fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e) +
+              (sweep["medulla"] ? fmt::format(" x medulla[{}]", m) : "");
+          f.settings = fiber_settings(r, top, roughness[g], absorption[a], tilts[t], eccs[e], medullas[m],
+                                      theta_node, where);
+          f.medulla_index = static_cast<int>(m);
           f.roughness_index = static_cast<int>(g);
           f.absorption_index = static_cast<int>(a);
           f.tilt_index = static_cast<int>(t);
@@ -293,6 +410,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
                                                                : fmt::format(" alpha {:g}", f.roughness);
           f.label = fmt::format("{}{}, {}, tilt {:g}, e {:g}", f.roughness_model, size, f.absorption_label,
                                 tilts[t], eccs[e]);
+          if (const auto& md = f.settings.fiber.medulla)
+            f.label += fmt::format(", medulla k {:g} sigma_s {:g}", md->radius, md->sigma_s);
           c.fibers.push_back(std::move(f));
         }
   // fit.lobes: names of the tally's lobes (every fiber shares the tally).
@@ -323,6 +442,11 @@ AtlasConfig load_atlas_config(const std::string& path) {
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxConfigBytes) throw Error(path + ": atlas config is larger than 1 MiB");
   return parse_atlas_config(text, path);
+}
+
+const std::string& registered_model(const AtlasConfig& config, const std::string& entry) {
+  const auto it = config.variant_of.find(entry);
+  return it == config.variant_of.end() ? entry : it->second;
 }
 
 void override_photons(AtlasConfig& config, const std::string& flag_text) {

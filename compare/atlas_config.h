@@ -15,11 +15,21 @@
 //       - {sigma_a: 0.0}
 //     scale_tilt: [0, 3]  # degrees
 //     eccentricity: [1.0]
+//     medulla: [none, {radius: 0.5, sigma_s: 8}]  # optional: fur (docs/FUR.md); none: no medulla
 //     theta_i: [0, 30, 60]  # degrees: the incident directions of every fiber
-//   models: all           # or a list of registered model names
+//   models: all           # or a list of registered model names and variants:
+//   #  [deon2011, {name: chiang2016_pbrt, model: chiang2016, parameters: {mp: pbrt_v4}}]
 //   model_parameters:     # optional: fixed (not fitted) parameters per model
 //     huang2022: {quadrature_points: 262144}
 //   fit: {max_iterations: 20, lobes: [R, TT, TRT]}   # lobes: optional, default every lobe
+//
+// A variant is a registered model under its own name (letters, digits, _
+// and -; unique among the entries) with its own fixed parameters (the rules
+// of model_parameters below, applied after the model's model_parameters if
+// any): the same model can appear several times side by side. Entries are
+// ordered by the registry's order of their models; a model's variants follow
+// it, in the config's order. The name is what the tables, file and report
+// show.
 //
 // model_parameters: for a model of `models`, keys of its own parameter table
 // (`fiberlab models`) that the fit does not move (a free key is refused: the
@@ -51,20 +61,28 @@ struct AtlasFiber {
   double roughness = 0.0;       // its size: beta_long (deg) or alpha; 0 for smooth
   std::string roughness_unit;   // "deg" (beta) or "" (alpha)
   int roughness_index = 0, absorption_index = 0, tilt_index = 0, eccentricity_index = 0;
+  int medulla_index = 0;        // sweep.medulla's entry (0 without the list)
   std::string absorption_label; // "sigma_a=0.2" or "melanin 0.8/0.1"
 };
 
 struct AtlasConfig {
   std::string path, yaml;       // the file and its text (stored in the output)
   std::vector<AtlasFiber> fibers;
-  std::vector<std::string> models;  // registered names, in registry order
-  // model name -> its fixed settings "KEY=VALUE" (model_parameters), checked.
+  // Entry names: registered models and variants, in registry order.
+  std::vector<std::string> models;
+  // Variant name -> the registered model it runs (registered names absent).
+  std::map<std::string, std::string> variant_of;
+  // Entry name -> its fixed settings "KEY=VALUE" (model_parameters; for a
+  // variant, its model's then its own), checked.
   std::map<std::string, std::vector<std::string>> model_parameters;
   int max_iterations = 20;
   // fit.lobes: the tally lobes the fit judges and fits (empty: every lobe).
   std::vector<int> fit_lobes;
   std::vector<double> theta_i;  // radians
 };
+
+// The registered model an entry of config.models runs (itself unless a variant).
+const std::string& registered_model(const AtlasConfig& config, const std::string& entry);
 
 // Parses and checks the atlas config text; `origin` names it in errors.
 AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin);

@@ -203,7 +203,18 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
     put(f, "theta_i", {s.K}, config.theta_i, "incidence", "radians", "incident inclinations, the same for every fiber");
     write_fibers(f, s, fibers);
     f.create_group("models");
-    for (std::size_t m = 0; m < config.models.size(); ++m) write_model(f, s, config.models[m], fibers, m);
+    for (std::size_t m = 0; m < config.models.size(); ++m) {
+      write_model(f, s, config.models[m], fibers, m);
+      // A variant's group says which registered model it runs, with what.
+      if (const auto v = config.variant_of.find(config.models[m]); v != config.variant_of.end()) {
+        const auto fixed = config.model_parameters.find(v->first);
+        f.set_attr("/models/" + v->first, "model", v->second);
+        std::string settings;
+        if (fixed != config.model_parameters.end())
+          for (const std::string& kv : fixed->second) settings += (settings.empty() ? "" : " ") + kv;
+        f.set_attr("/models/" + v->first, "fixed_parameters", settings);
+      }
+    }
     f.close();
   }
   out.commit();
@@ -230,7 +241,10 @@ std::string describe_atlas_file(const std::string& path) {
   for (std::size_t start = 0; start < models.size();) {
     const std::size_t comma = std::min(models.find(',', start), models.size());
     const std::string m = models.substr(start, comma - start), g = "/models/" + m + "/";
-    s += fmt::format("model {}: applicable to {}, fitted to {}, converged on {} of {} fibers\n", m,
+    const std::string variant = f.has_attr(g, "model") ? fmt::format(" ({} {})", f.attr_string(g, "model"),
+                                                                       f.attr_string(g, "fixed_parameters"))
+                                                       : "";
+    s += fmt::format("model {}{}: applicable to {}, fitted to {}, converged on {} of {} fibers\n", m, variant,
                      count(g + "applicable"), count(g + "fitted"), count(g + "converged"), F[0]);
     start = comma + 1;
   }

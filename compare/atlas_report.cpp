@@ -45,8 +45,13 @@ int lobe_count(const std::vector<AtlasFiberResult>& fibers) { return fibers.empt
 std::string fixed_parameters(const AtlasConfig& config) {
   std::string s;
   for (const auto& [model, settings] : config.model_parameters) {
-    s += fmt::format("{}{}:", s.empty() ? " Fixed model parameters (not fitted; the config's model_parameters): "
-                                        : "; ", model);
+    const auto variant = config.variant_of.find(model);
+    s += fmt::format("{}{}{}:", s.empty() ? config.variant_of.empty()
+                                              ? " Fixed model parameters (not fitted; the config's model_parameters): "
+                                              : " Fixed model parameters (not fitted; the config's model_parameters "
+                                                "and variants): "
+                                          : "; ",
+                     model, variant == config.variant_of.end() ? "" : " (" + variant->second + ")");
     for (const std::string& kv : settings) s += " " + kv;
   }
   return s.empty() ? s : s + ".";

@@ -25,6 +25,20 @@ double EnergyCurve::three_lobe(std::size_t k, int c) const {
   return s;
 }
 
+void add_scattered_lobe(EnergyCurve& e) {
+  const std::size_t K = e.theta_i.size(), L = static_cast<std::size_t>(e.lobes), C = static_cast<std::size_t>(e.channels);
+  std::vector<double> lobe(K * (L + 1) * C, 0.0), error(K * (L + 1) * C, 0.0);
+  for (std::size_t k = 0; k < K; ++k)
+    for (std::size_t l = 0; l < L; ++l)
+      for (std::size_t c = 0; c < C; ++c) {
+        lobe[(k * (L + 1) + l) * C + c] = e.lobe[(k * L + l) * C + c];
+        error[(k * (L + 1) + l) * C + c] = e.lobe_error[(k * L + l) * C + c];
+      }
+  e.lobe = std::move(lobe);
+  e.lobe_error = std::move(error);
+  ++e.lobes;
+}
+
 EnergyCurve simulation_energy(const sim::ResultFile& r) {
   EnergyCurve e;
   e.label = "simulation";

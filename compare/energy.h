@@ -35,6 +35,11 @@ struct EnergyCurve {
 // ledger sum (exited + absorbed + truncated + lost) / N, which is 1 to rounding.
 EnergyCurve simulation_energy(const sim::ResultFile& result);
 
+// A model's curve against a fiber with a medulla (docs/FUR.md): the models
+// have none, so they predict nothing in its last lobe, `scattered`; the
+// curve gains that lobe with energy 0.
+void add_scattered_lobe(EnergyCurve& model_curve);
+
 // One model over theta_i (phi_i = 0), integrated on an n_theta x n_phi grid.
 EnergyCurve model_energy(const analytic::Model& model, const std::string& label,
                          const std::vector<double>& theta_i, int n_theta, int n_phi);

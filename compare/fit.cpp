@@ -46,169 +46,89 @@ Key parse_key(const std::string& key) {
   return k;
 }
 
-std::vector<double>* list_of(analytic::ModelParams& p, const std::string& name, double& scale) {
-  scale = kPi / 180.0;
-  if (name == "beta_long") return &p.beta_long;
-  if (name == "beta_azim") return &p.beta_azim;
-  if (name == "alpha") return &p.alpha;
-  scale = 1.0;
-  if (name == "sigma_a") return &p.sigma_a;
-  return nullptr;
-}
-
-[[noreturn]] void unknown(const std::string& key) {
-  throw Error(fmt::format(
-      "--fit key '{}' is not fittable (allowed: eta, sigma_a, beta_long, beta_azim, alpha[p], "
-      "scale_tilt, k_g, w_c, delta_eta, delta_h_m, eccentricity, or NAME[INDEX] for the lists)",
-      key));
-}
-
-// Scalar keys of ModelParams that a fit may move (the model's table decides
-// which of them a model has).
-double* scalar_of(analytic::ModelParams& p, const std::string& name, double& scale) {
-  scale = 1.0;
-  if (name == "eta") return &p.eta;
-  if (name == "k_g") return &p.k_g;
-  if (name == "delta_eta") return &p.delta_eta;
-  if (name == "delta_h_m") return &p.delta_h_m;
-  if (name == "eccentricity") return &p.eccentricity;
-  scale = kPi / 180.0;
-  if (name == "w_c") return &p.w_c;
-  return nullptr;
-}
-
-}  // namespace
-
-double get_parameter(const analytic::ModelParams& p0, const std::string& key) {
-  analytic::ModelParams p = p0;
-  const Key k = parse_key(key);
-  if (k.name == "scale_tilt" && k.index < 0) return rad_to_deg(analytic::for_lobe(p.alpha, 1));
-  double scale = 1.0;
-  if (double* x = scalar_of(p, k.name, scale); x && k.index < 0) return *x / scale;
-  std::vector<double>* list = list_of(p, k.name, scale);
-  if (!list) unknown(key);
-  return analytic::for_lobe(*list, std::max(0, k.index)) / scale;
-}
-
-void set_parameter(analytic::ModelParams& p, const std::string& key, double value) {
-  const Key k = parse_key(key);
-  if (k.name == "scale_tilt" && k.index < 0) {
-    p.alpha = analytic::tilt_shifts(deg_to_rad(value));  // SPEC s7's shift rule
-    return;
-  }
-  double scale = 1.0;
-  if (double* x = scalar_of(p, k.name, scale); x && k.index < 0) {
-    double v = value * scale;
-    if (k.name == "eta") v = std::max(v, 1.0 + 1e-9);
-    else if (k.name == "eccentricity") v = std::clamp(v, 1e-3, 1.0);
-    else v = std::max(v, 0.0);
-    *x = v;
-    return;
-  }
-  std::vector<double>* list = list_of(p, k.name, scale);
-  if (!list) unknown(key);
-  double v = value * scale;
-  // Widths and absorption are non-negative; a width of exactly 0 switches
-  // d'Eon's model to its delta limits, so keep a positive floor.
-  if (k.name == "beta_long" || k.name == "beta_azim") v = std::max(v, deg_to_rad(0.05));
-  if (k.name == "sigma_a") v = std::max(v, 0.0);
-  if (k.index < 0) {
-    if (k.name == "sigma_a") std::fill(list->begin(), list->end(), v);
-    else *list = {v};
-    return;
-  }
-  if (list->empty()) list->push_back(v);
-  while (static_cast<int>(list->size()) <= k.index) list->push_back(list->back());
-  (*list)[k.index] = v;
-}
-
-namespace {
-
-// The table entry of a key's name, and whether it is a scalar the table
-// reads and writes itself (number_param: ParamSpec::get_number).
+// The table entry a fit key moves: the spec named `k.name`, or the list
+// whose whole value has that fit key (alpha's `scale_tilt`); nullptr if none.
 const analytic::ParamSpec* spec_of(const std::string& model_name, const Key& k) {
-  return analytic::find_param(analytic::model_info(model_name).params, k.name);
+  const analytic::ParamTable& table = analytic::model_info(model_name).params;
+  if (k.index < 0)
+    for (const analytic::ParamSpec& s : table)
+      if (!s.whole_fit_key.empty() && s.whole_fit_key == k.name) return &s;
+  return analytic::find_param(table, k.name);
 }
-bool table_scalar(const analytic::ParamSpec* spec) { return spec && spec->get_number && spec->set_number; }
-// A per-lobe list whose entry 0 (alpha) is a tilt shift: fitted per lobe or
-// through the physical scale_tilt (a model with a list `alpha`).
-bool has_alpha_list(const std::string& model_name) {
-  const analytic::ParamSpec* a = analytic::find_param(analytic::model_info(model_name).params, "alpha");
-  return a && !table_scalar(a);
+// A fit moves real numbers: integers (lobes, quadrature_points) and choices stay as set.
+bool is_real(const analytic::ParamSpec& spec) { return spec.unit != "integer" && spec.unit != "choice"; }
+bool is_list(const analytic::ParamSpec& spec) { return spec.get_entry && spec.set_entry && is_real(spec); }
+bool is_scalar(const analytic::ParamSpec& spec) { return spec.get_number && spec.set_number && is_real(spec); }
+// The key a fit gives the spec's whole value.
+const std::string& whole_key(const analytic::ParamSpec& spec) {
+  return spec.whole_fit_key.empty() ? spec.key : spec.whole_fit_key;
+}
+// The spec `key` moves, in its table, as a fit may move it (a number: a
+// scalar, a list entry NAME[p], or a list's whole value by its fit key);
+// fiberlab::Error naming the model's fittable keys otherwise.
+const analytic::ParamSpec& fit_spec(const std::string& model_name, const std::string& key) {
+  const Key k = parse_key(key);
+  const analytic::ParamSpec* spec = spec_of(model_name, k);
+  const bool ok = spec && (k.index < 0 ? (is_scalar(*spec) || (is_list(*spec) && whole_key(*spec) == k.name))
+                                       : is_list(*spec) && k.name == spec->key);
+  if (ok) return *spec;
+  // The numeric keys in table order (a list also per entry, NAME[p]), then
+  // the lists' whole fit keys.
+  std::string fittable, whole;
+  for (const analytic::ParamSpec& s : analytic::model_info(model_name).params) {
+    if (is_scalar(s) || is_list(s)) fittable += (fittable.empty() ? "" : ", ") + s.key;
+    if (is_list(s) && !s.whole_fit_key.empty()) whole += ", " + s.whole_fit_key;
+  }
+  fittable += whole;
+  if (spec && is_list(*spec) && k.index < 0 && k.name == spec->key)
+    throw Error(fmt::format("--fit {}: one common shift for every lobe moves R the wrong way; fit "
+                            "{}[p] per lobe (e.g. {}[0],{}[1]) or the physical {}",
+                            key, k.name, k.name, k.name, spec->whole_fit_key));
+  throw Error(fmt::format("--fit {}: model {} cannot fit '{}'; fittable keys: {} (lists per lobe as NAME[p])",
+                          key, model_name, key, fittable));
 }
 
 }  // namespace
 
 double get_parameter(const std::string& model_name, const analytic::ModelParams& p, const std::string& key) {
+  const analytic::ParamSpec& spec = fit_spec(model_name, key);
   const Key k = parse_key(key);
-  if (const analytic::ParamSpec* spec = spec_of(model_name, k); table_scalar(spec) && k.index < 0)
-    return spec->get_number(p);
-  return get_parameter(p, key);
+  return is_list(spec) ? spec.get_entry(p, k.index) : spec.get_number(p);
 }
 
 void set_parameter(const std::string& model_name, analytic::ModelParams& p, const std::string& key,
                    double value) {
+  const analytic::ParamSpec& spec = fit_spec(model_name, key);
   const Key k = parse_key(key);
-  if (const analytic::ParamSpec* spec = spec_of(model_name, k); table_scalar(spec) && k.index < 0)
-    return spec->set_number(p, value);
-  set_parameter(p, key, value);
+  if (is_list(spec)) spec.set_entry(p, k.index, value);
+  else spec.set_number(p, value);
 }
 
 std::pair<double, double> fit_range(const std::string& model_name, const std::string& key) {
-  const Key k = parse_key(key);
-  if (k.name == "scale_tilt" && has_alpha_list(model_name)) {
-    const analytic::ParamSpec* a = analytic::find_param(analytic::model_info(model_name).params, "alpha");
-    return {a->fit_min, a->fit_max};
-  }
-  const analytic::ParamSpec* spec = spec_of(model_name, k);
-  if (!spec) throw Error(fmt::format("--fit {}: model {} has no such parameter", key, model_name));
-  double lo = spec->fit_min;
-  // set_parameter's floor for widths (d'Eon's delta limits at exactly 0).
-  if (k.name == "beta_long" || k.name == "beta_azim") lo = std::max(lo, 0.05);
-  return {lo, spec->fit_max};
+  const analytic::ParamSpec& spec = fit_spec(model_name, key);
+  return {spec.fit_min, spec.fit_max};
 }
 
 std::vector<std::string> free_fit_keys(const std::string& model_name) {
   std::vector<std::string> keys;
-  for (const analytic::ParamSpec& s : analytic::model_info(model_name).params) {
-    if (!s.free) continue;
-    // A per-lobe list of tilt shifts moves through the physical tilt (one
-    // number, SPEC s7's rule); any other list as one common value.
-    keys.push_back(s.key == "alpha" && !table_scalar(&s) ? "scale_tilt" : s.key);
-  }
+  // A list as one number: its whole fit key (alpha's physical scale_tilt,
+  // SPEC s7's rule), any other list as one common value.
+  for (const analytic::ParamSpec& s : analytic::model_info(model_name).params)
+    if (s.free) keys.push_back(whole_key(s));
   return keys;
 }
 
-void check_fit_key(const std::string& model_name, const std::string& key) {
-  const Key k = parse_key(key);
-  const analytic::ParamTable& table = analytic::model_info(model_name).params;
-  std::string fittable;
-  for (const analytic::ParamSpec& s : table)
-    if (s.unit != "choice" && s.unit != "integer") fittable += (fittable.empty() ? "" : ", ") + s.key;
-  if (has_alpha_list(model_name)) fittable += ", scale_tilt";
-  const analytic::ParamSpec* spec = analytic::find_param(table, k.name);
-  const bool is_list = spec && !table_scalar(spec);
-  const bool known = k.name == "scale_tilt" ? has_alpha_list(model_name) && k.index < 0
-                                            : spec && spec->unit != "choice" && spec->unit != "integer" &&
-                                                  (k.index < 0 || is_list);
-  if (!known)
-    throw Error(fmt::format("--fit {}: model {} cannot fit '{}'; fittable keys: {} (lists per lobe as NAME[p])",
-                            key, model_name, key, fittable));
-  if (k.name == "alpha" && k.index < 0 && is_list)
-    throw Error(fmt::format("--fit alpha: one common shift for every lobe moves R the wrong way; fit "
-                            "alpha[p] per lobe (e.g. alpha[0],alpha[1]) or the physical scale_tilt"));
-}
+void check_fit_key(const std::string& model_name, const std::string& key) { fit_spec(model_name, key); }
 
 void check_fit_keys(const std::string& model_name, const std::vector<std::string>& keys) {
   for (std::size_t i = 0; i < keys.size(); ++i) {
-    check_fit_key(model_name, keys[i]);
+    const analytic::ParamSpec* sb = &fit_spec(model_name, keys[i]);
     const Key b = parse_key(keys[i]);
     for (std::size_t j = 0; j < i; ++j) {
       const Key a = parse_key(keys[j]);
-      const bool same = a.name == b.name && (a.index == b.index || a.index < 0 || b.index < 0);
-      const bool both_alpha = (a.name == "scale_tilt" && b.name == "alpha") ||
-                              (a.name == "alpha" && b.name == "scale_tilt");
-      if (same || both_alpha)
+      // The same table entry, the same entry of it or the whole of it
+      // (scale_tilt and alpha[p] both move alpha).
+      if (&fit_spec(model_name, keys[j]) == sb && (a.index == b.index || a.index < 0 || b.index < 0))
         throw Error(fmt::format("--fit {}: {} fits the same parameter as {} (give each parameter once)",
                                 fmt::join(keys, ","), keys[i], keys[j]));
     }
@@ -239,10 +159,8 @@ std::vector<std::string> per_lobe_keys(const std::string& model_name, const std:
   for (const std::string& key : keys) {
     const Key k = parse_key(key);
     const analytic::ParamSpec* spec = spec_of(model_name, k);
-    if (k.index < 0 && k.name == "scale_tilt" && has_alpha_list(model_name))
-      out.push_back(fmt::format("alpha[{}]", lobe));
-    else if (k.index < 0 && spec && !table_scalar(spec) && (k.name == "beta_long" || k.name == "beta_azim"))
-      out.push_back(fmt::format("{}[{}]", k.name, lobe));
+    if (k.index < 0 && spec && spec->per_lobe && is_list(*spec))
+      out.push_back(fmt::format("{}[{}]", spec->key, lobe));
     else
       out.push_back(key);
   }

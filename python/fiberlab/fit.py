@@ -5,7 +5,7 @@ import dataclasses
 
 from . import _fiberlab
 from ._checks import count_argument, instance_argument
-from .comparison import Comparison, _options
+from .comparison import DEFAULTS, Comparison, _options
 from .prediction import settings_overrides
 
 
@@ -62,8 +62,9 @@ class Fit:
             self.outcome)
 
 
-def fit(result, model, keys, max_chi2=None, min_effective=30.0, model_error=1e-4, min_energy=1e-4,
-        max_iterations=40, lobes=None, progress=None, **fixed):
+def fit(result, model, keys, max_chi2=None, min_effective=DEFAULTS["min_effective"],
+        model_error=DEFAULTS["model_error"], min_energy=DEFAULTS["min_energy"],
+        max_iterations=DEFAULTS["max_iterations"], lobes=None, progress=None, **fixed):
     """Fits `keys` of analytic model `model` to a Result, as `fiberlab compare
     RESULT --model MODEL --fit KEYS --set KEY=VALUE...` does. keys: a list
     (or a comma-separated string) of the model's numeric keys: eta,

@@ -110,7 +110,7 @@ class Result:
 
     @functools.cached_property
     def lobe_names(self):
-        return list(_fiberlab.lobe_names(self._file.lobes))
+        return list(_fiberlab.lobe_names(self._file.lobes, self._file.settings.medulla))
 
     @functools.cached_property
     def channel_names(self):
@@ -195,7 +195,7 @@ class Result:
                                       ", ".join(str(int(n)) for n in np.unique(self.photons))))
 
 
-MAX_THREADS = 1024  # sim/run/memory_budget.h kMaxThreads, the cap of `fiberlab run --threads`
+MAX_THREADS = _fiberlab.max_threads  # sim/run/memory_budget.h kMaxThreads, the cap of `fiberlab run --threads`
 
 
 def run(config, photons=None, seed=None, threads=None, progress=True):

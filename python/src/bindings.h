@@ -1,7 +1,8 @@
 #pragma once
 // The compiled part of the Python module `fiberlab` (`fiberlab._fiberlab`):
 // thin bindings of the C++ libraries, one file per concept. Physics and
-// statistics stay in the C++ (sim/, analytic/, compare/); these files only
+// statistics stay in the C++ (sim/, analytic/, compare/, and the workflows
+// the command line shares in app/); these files only
 // convert between C++ containers and NumPy arrays (SPEC s9 index order,
 // (K, L, n_theta, n_phi, C), C-contiguous copies) and release the GIL for
 // long work.
@@ -43,6 +44,6 @@ void bind_result(py::module_& m);      // result_binding.cpp: ResultFile, Settin
 void bind_run(py::module_& m);         // run_binding.cpp: the simulation
 void bind_prediction(py::module_& m);  // prediction_binding.cpp: analytic models' bin probabilities
 void bind_comparison(py::module_& m);  // comparison_binding.cpp: compare/'s statistics and verdict
-void bind_fit(py::module_& m);         // fit_binding.cpp: compare/fit.h, the fit of `fiberlab compare --fit`
+void bind_fit(py::module_& m);         // fit_binding.cpp: app/fit.h, the fit of `fiberlab compare --fit`
 
 }  // namespace fiberlab::python

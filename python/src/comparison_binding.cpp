@@ -7,6 +7,7 @@
 #include <optional>
 
 #include "analytic/model_registry.h"
+#include "app/fit.h"
 #include "bindings.h"
 #include "common/error.h"
 #include "common/units.h"
@@ -125,10 +126,19 @@ py::dict verdict_dict(const compare::Verdict& v, int lobes) {
 
 void bind_comparison(py::module_& m) {
   m.def("compare", &compare_bins, py::arg("result"), py::arg("probability"), py::arg("alpha"),
-        py::arg("max_chi2") = py::none(), py::arg("min_effective") = 30.0, py::arg("model_error") = 1e-4,
-        py::arg("min_energy") = 1e-4,
+        py::arg("max_chi2") = py::none(), py::arg("min_effective") = compare::Options{}.min_effective,
+        py::arg("model_error") = compare::Options{}.model_rel_error, py::arg("min_energy") = compare::Options{}.min_lobe_energy,
         "compare::compare's statistics per (k, lobe, channel) and compare::judge's verdict");
   m.def("model_names", &analytic::model_names);
+  // The defaults of `fiberlab compare`'s judging flags and of its fit, which
+  // fiberlab.compare and fiberlab.fit take as their own.
+  const compare::Options defaults;
+  py::dict d;
+  d["min_effective"] = defaults.min_effective;
+  d["model_error"] = defaults.model_rel_error;
+  d["min_energy"] = defaults.min_lobe_energy;
+  d["max_iterations"] = app::kFitIterations;
+  m.attr("comparison_defaults") = d;
   m.attr("probability_rounding") = compare::kProbabilityRounding;  // compare/prediction_file.h
 }
 

@@ -1,13 +1,14 @@
 // fiberlab.predict from Python: an analytic model's bin probabilities for the
 // histogram of a configuration, exactly as `fiberlab predict` makes them
-// (parameters from compare::params_for: the config's defaults, then
-// KEY=VALUE overrides in the --set syntax; bins from compare::predict_bins).
+// (app::choose_model and app::predict: the config's defaults, then KEY=VALUE
+// overrides in the --set syntax).
 #include <pybind11/stl.h>
 
 #include <string>
 #include <vector>
 
 #include "analytic/model_registry.h"
+#include "app/predict.h"
 #include "bindings.h"
 #include "common/units.h"
 #include "compare/models.h"
@@ -45,30 +46,21 @@ py::dict params_dict(const std::string& model_name, const analytic::ModelParams&
 namespace {
 
 py::dict predict(const sim::Settings& s, const std::string& model_name, const std::vector<std::string>& sets) {
-  const compare::ModelSpec spec{model_name, {}, model_name};
-  const analytic::ModelParams params = compare::params_for(s, spec, sets);
-  const BinGrid grid = BinGrid::make(s.tally.n_theta, s.tally.n_phi, s.tally.theta_bins);
-  const std::vector<sim::Settings::Incidence> inc = s.incidences();
-  const int L = params.lobes, C = static_cast<int>(params.sigma_a.size());
-  std::vector<double> probability, theta_i, phi_i;
+  app::ChosenModel chosen;
+  compare::PredictionFile pred;
   {
     py::gil_scoped_release release;
-    const auto model = compare::make_model(spec.name, params);
-    for (const sim::Settings::Incidence& x : inc) {
-      const std::vector<double> p = compare::predict_bins(*model, grid, x.theta_i, x.phi_i, L, C,
-                                                          s.fiber.eccentricity != 1.0);
-      probability.insert(probability.end(), p.begin(), p.end());
-      theta_i.push_back(x.theta_i);
-      phi_i.push_back(x.phi_i);
-    }
+    chosen = app::choose_model(s, compare::ModelSpec{model_name, {}, model_name}, sets);
+    pred = app::predict(s, chosen);
   }
-  const py::ssize_t K = static_cast<py::ssize_t>(inc.size());
+  const BinGrid& grid = pred.grid;
+  const py::ssize_t K = static_cast<py::ssize_t>(pred.configs());
   py::dict d;
-  d["probability"] = to_array(probability, {K, L, grid.n_theta(), grid.n_phi(), C});
-  d["params"] = params_dict(spec.name, params);
-  d["alpha"] = params.alpha;  // radians, for compare::compare
-  d["theta_i"] = to_array(theta_i, {K});
-  d["phi_i"] = to_array(phi_i, {K});
+  d["probability"] = to_array(pred.probability, {K, pred.lobes, grid.n_theta(), grid.n_phi(), pred.channels});
+  d["params"] = params_dict(model_name, chosen.params);
+  d["alpha"] = chosen.params.alpha;  // radians, for compare::compare
+  d["theta_i"] = to_array(pred.theta_i, {K});
+  d["phi_i"] = to_array(pred.phi_i, {K});
   d["theta_edges"] = to_array(grid.theta_edges, {grid.n_theta() + 1});
   d["phi_edges"] = to_array(grid.phi_edges, {grid.n_phi() + 1});
   return d;

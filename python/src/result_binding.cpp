@@ -1,12 +1,13 @@
 // A simulation's result (sim/store/result_file.h) as seen from Python: the raw
-// sums, the estimators of SPEC section 6 (computed by sim::bin_estimate and
-// sim::lobe_energy, not here), the energy ledger, and file I/O.
+// sums, the estimators of SPEC section 6 (computed by app/estimates.h and
+// compare::simulation_energy, not here), the energy ledger, and file I/O.
 #include <pybind11/stl.h>
 #include <yaml-cpp/yaml.h>
 
 #include <memory>
 #include <string>
 
+#include "app/estimates.h"
 #include "bindings.h"
 #include "common/error.h"
 #include "common/file_schema.h"
@@ -63,53 +64,20 @@ std::string checked_path(const std::string& path) {
 }
 
 // P = S1/N, its standard error, and P / Omega with its standard error, for
-// every bin (SPEC s6, sim::bin_estimate).
+// every bin (app::bin_estimates).
 py::tuple estimators(const Result& r) {
-  const std::size_t n = r.weight_sum.size();
-  std::vector<double> mean(n), err(n), density(n), density_err(n);
-  const int nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t k = i / r.bin_cells();
-    const sim::Estimate e = sim::bin_estimate(r.weight_sum[i], r.weight_sq_sum[i], r.photons[k]);
-    const std::size_t b = i / C;  // (k, lobe, theta, phi)
-    const double omega = r.grid.solid_angle(static_cast<int>(b / np % nt), static_cast<int>(b % np));
-    mean[i] = e.mean;
-    err[i] = e.std_error;
-    density[i] = e.mean / omega;
-    density_err[i] = e.std_error / omega;
-  }
+  const app::BinEstimates e = app::bin_estimates(r);
   const Shape s = bins_shape(r);
-  return py::make_tuple(to_array(mean, s), to_array(err, s), to_array(density, s), to_array(density_err, s));
+  return py::make_tuple(to_array(e.mean, s), to_array(e.std_err, s), to_array(e.density, s),
+                        to_array(e.density_std_err, s));
 }
 
-// Marginal probabilities over theta_r (summed over phi) or over phi (summed
-// over theta_r), with their standard errors: a photon lands in one bin, so a
-// marginal bin's S1 and S2 are its bins' sums (then sim::bin_estimate).
+// Marginal probabilities over theta_r or over phi, with their standard
+// errors (app::marginal).
 py::tuple marginal(const Result& r, const std::string& axis) {
-  if (axis != "theta" && axis != "phi") throw Error("marginal axis '" + axis + "': must be theta or phi");
-  const bool theta = axis == "theta";
-  const std::size_t K = r.configs();
-  const int L = r.lobes, nt = r.grid.n_theta(), np = r.grid.n_phi(), C = r.channels;
-  const int n = theta ? nt : np;
-  std::vector<double> s1(K * L * n * C, 0.0), s2(s1.size(), 0.0);
-  for (std::size_t k = 0; k < K; ++k)
-    for (int l = 0; l < L; ++l)
-      for (int i = 0; i < nt; ++i)
-        for (int j = 0; j < np; ++j)
-          for (int c = 0; c < C; ++c) {
-            const std::size_t from = r.cell(k, l, i, j, c);
-            const std::size_t to = ((k * L + l) * n + (theta ? i : j)) * C + c;
-            s1[to] += r.weight_sum[from];
-            s2[to] += r.weight_sq_sum[from];
-          }
-  std::vector<double> mean(s1.size()), err(s1.size());
-  for (std::size_t x = 0; x < s1.size(); ++x) {
-    const sim::Estimate e = sim::bin_estimate(s1[x], s2[x], r.photons[x / (static_cast<std::size_t>(L) * n * C)]);
-    mean[x] = e.mean;
-    err[x] = e.std_error;
-  }
-  const Shape s{static_cast<py::ssize_t>(K), L, n, C};
-  return py::make_tuple(to_array(mean, s), to_array(err, s));
+  const app::Marginal m = app::marginal(r, axis);
+  const Shape s{static_cast<py::ssize_t>(r.configs()), r.lobes, m.n, r.channels};
+  return py::make_tuple(to_array(m.mean, s), to_array(m.std_err, s));
 }
 
 // The energy ledger (compare::simulation_energy): lobe energies with their
@@ -132,7 +100,8 @@ void bind_result(py::module_& m) {
   py::class_<sim::Settings>(m, "Settings", "A resolved simulation configuration (sim/run/settings.h)")
       .def_property_readonly("yaml", [](const sim::Settings& s) { return sim::to_yaml(s); })
       .def_property_readonly("config", [](const sim::Settings& s) { return yaml_to_python(YAML::Load(sim::to_yaml(s))); })
-      .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally.lobes; })
+      .def_property_readonly("lobes", [](const sim::Settings& s) { return s.tally_lobes(); })
+      .def_property_readonly("medulla", [](const sim::Settings& s) { return s.fiber.medulla.has_value(); })
       .def_property_readonly("channels", [](const sim::Settings& s) { return s.fiber.sigma_a.size(); })
       .def_property_readonly("melanin", [](const sim::Settings& s) { return s.fiber.eumelanin.has_value(); });
   m.def("parse_settings", &sim::parse_settings_yaml, py::arg("yaml_text"), py::arg("origin"),
@@ -192,7 +161,9 @@ void bind_result(py::module_& m) {
     py::gil_scoped_release release;
     return std::make_shared<Result>(sim::read_result(source));
   }, py::arg("path"));
-  m.def("lobe_names", &lobe_names, py::arg("lobes"), "R, TT, TRT, ..., p>=L-1 (common/file_schema.h)");
+  m.def("lobe_names", [](int lobes, bool scattered) { return lobe_names(lobes, scattered); }, py::arg("lobes"),
+        py::arg("scattered") = false,
+        "R, TT, TRT, ..., p>=L-1, and `scattered` last for a fiber with a medulla (common/file_schema.h)");
   m.def("channel_names", [](const sim::Settings& s) {
     return channel_names(static_cast<int>(s.fiber.sigma_a.size()), s.fiber.eumelanin.has_value());
   }, py::arg("settings"), "R, G, B for a melanin fiber, else c0, c1, ... (common/file_schema.h)");

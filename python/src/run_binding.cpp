@@ -1,4 +1,4 @@
-// fiberlab.run from Python: sim::Simulation on resolved Settings, with the
+// fiberlab.run from Python: app::simulate on resolved Settings, with the
 // GIL released while photons are traced and an optional Python progress
 // callable (called about twice a second, sim/run/simulation.h).
 //
@@ -11,19 +11,17 @@
 #include <pybind11/functional.h>
 #include <pybind11/stl.h>
 
-#include <omp.h>
-
-#include <algorithm>
 #include <csignal>
 #include <memory>
 #include <optional>
 
+#include "app/run.h"
+#include "app/threads.h"
 #include "bindings.h"
 #include "common/error.h"
 #include "common/interrupt.h"
 #include "sim/run/memory_budget.h"
 #include "sim/store/result_file.h"
-#include "sim/run/simulation.h"
 
 namespace fiberlab::python {
 
@@ -78,11 +76,8 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
                                      std::optional<std::uint64_t> seed, int threads, py::object progress) {
   if (photons) settings.photons = *photons;
   if (seed) settings.seed = *seed;
-  // The CLI's rule (cli/cmd_run.cpp, sim/run/memory_budget.h): 1 to kMaxThreads, every core by default.
-  if (threads > sim::kMaxThreads)
-    throw Error("threads = " + std::to_string(threads) + ": must be an integer from 1 to " +
-                std::to_string(sim::kMaxThreads) + " (as fiberlab run --threads)");
-  if (threads <= 0) threads = std::min(omp_get_max_threads(), sim::kMaxThreads);
+  app::check_total_photons(settings, "photons");
+  threads = app::run_threads(threads);
   ProgressRelay relay(std::move(progress));
   std::shared_ptr<sim::ResultFile> result;
   bool interrupted = false;
@@ -93,16 +88,9 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
     // handler that cannot run before the call returns.
     py::gil_scoped_release release;
     ScopedInterruptPolling polling;
-    const sim::Simulation simulation(settings);
-    sim::check_memory_budget(simulation.settings(), threads);
-    sim::RunProgress state = simulation.start();
-    sim::RunControl control;
-    control.threads = threads;
-    control.progress = relay.callback();
-    interrupted = simulation.run(state, control) == sim::RunOutcome::Interrupted;
-    if (!interrupted)
-      result = std::make_shared<sim::ResultFile>(
-          sim::make_result(simulation.settings(), simulation.grid(), state.tallies));
+    std::optional<sim::ResultFile> done = app::simulate(settings, threads, relay.callback());
+    interrupted = !done;
+    if (done) result = std::make_shared<sim::ResultFile>(std::move(*done));
     received = polling.received_signal();
   }
   if (interrupted) raise_interrupted(received);
@@ -117,6 +105,7 @@ std::shared_ptr<sim::ResultFile> run(sim::Settings settings, std::optional<std::
 }  // namespace
 
 void bind_run(py::module_& m) {
+  m.attr("max_threads") = sim::kMaxThreads;  // fiberlab.run's threads: 1 to this, as `fiberlab run --threads`
   m.def("run", &run, py::arg("settings"), py::arg("photons") = py::none(), py::arg("seed") = py::none(),
         py::arg("threads") = 0, py::arg("progress") = py::none(),
         "Simulates `settings` (threads <= 0: every core); progress(done, total) is called now and then");

@@ -64,6 +64,7 @@ def test_counts_accept_integral_floats_as_configs_do():
     ({"photons": float("nan")}, ["photons", "not an integer"]),
     ({"photons": 1e300}, ["photons", "out of range"]),
     ({"photons": True}, ["photons", "not a number"]),
+    ({"photons": 2 ** 63}, ["photons = 9223372036854775808 x 2 incident configurations", "2^64 - 1"]),
     ({"photons": "1000"}, ["photons", "not a number"]),
     ({"threads": 100000}, ["threads = 100000", "1 to 1024"]),
     ({"threads": 0}, ["threads = 0"]),

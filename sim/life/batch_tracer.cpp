@@ -31,7 +31,7 @@ constexpr int kRoundsPerStep = 8;
 struct Pool {
   enum Column {
     kPx, kPy, kDx, kDy, kDz, kInside, kPath, kSegments, kEventsHere, kTries, kWeight, kCode,
-    kPhiI, kScalarColumns,
+    kPhiI, kMedullaPath, kScatters, kLossList, kScalarColumns,
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
   // kSlot: the photon's slot, for the scorer (sim/life/finished_photons.h;
@@ -43,6 +43,13 @@ struct Pool {
   static constexpr int kLanes = kPoolLanes + W;
   alignas(64) double col[kColumns][kLanes];
   alignas(64) std::uint64_t bits[kBitColumns][kLanes];
+  // kLossList: the list of weight removed from a lane's photon (a model with
+  // an event weight, life::LossRecord), an index of the lists below; a
+  // photon in flight holds one, and gives it back when it is handed over.
+  std::vector<WeightLoss> loss_lists[kLanes];
+  int free_lists[kLanes];
+  int n_free = 0;
+  void give_list(int lane) { col[kLossList][lane] = free_lists[--n_free]; }
 
   template <class T, class Light>
   life::PhotonState<T, Light> load_state(int o) const {
@@ -57,6 +64,8 @@ struct Pool {
     s.tries = load<T>(col[kTries] + o);
     s.weight = load<T>(col[kWeight] + o);
     s.code = load<T>(col[kCode] + o);
+    s.medulla_path = load<T>(col[kMedullaPath] + o);
+    s.scatters = load<T>(col[kScatters] + o);
     s.rng = {load_bits<T>(bits[kS0] + o), load_bits<T>(bits[kS1] + o),
              load_bits<T>(bits[kS2] + o), load_bits<T>(bits[kS3] + o)};
     if constexpr (Light::kPolarized) {
@@ -84,6 +93,8 @@ struct Pool {
     put(s.tries, col[kTries]);
     put(s.weight, col[kWeight]);
     put(s.code, col[kCode]);
+    put(s.medulla_path, col[kMedullaPath]);
+    put(s.scatters, col[kScatters]);
     for (int k = 0; k < 4; ++k) put(s.rng.word(k), bits[kS0 + k]);
     if constexpr (Light::kPolarized) {
       put(s.light.q, col[kQ]);
@@ -129,13 +140,16 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
                const life::BitsOf<Lanes>& photon, const life::BitsOf<Lanes>& slot,
                std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
-  if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
+  if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
   const int n = f.n, k = std::popcount(lanes);
   pack_store(s.d.x, lanes, f.dx + n);
   pack_store(s.d.y, lanes, f.dy + n);
   pack_store(s.d.z, lanes, f.dz + n);
   pack_store(s.path, lanes, f.path + n);
   pack_store(s.weight, lanes, f.weight + n);
+  pack_store(s.medulla_path, lanes, f.medulla_path + n);
+  const std::uint64_t scattered =
+      life::pack_bits(life::lane_bits(s.scatters > Lanes(0.0)), lanes);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
   alignas(64) std::uint64_t slots[W];
@@ -154,6 +168,7 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     f.lost[n + j] = (lost >> j) & 1;
     f.last[n + j] = true;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
+    f.scattered[n + j] = (scattered >> j) & 1;
   }
   // No exit direction for a photon that did not exit.
   for (std::uint64_t rest = ~exited & ((std::uint64_t{1} << k) - 1); rest != 0; rest &= rest - 1) {
@@ -186,13 +201,16 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
                       const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
                       const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
-  if (f.n == 0) f.losses.clear();  // a new block (the batched models remove no weight)
+  if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
   const int n = f.n, k = std::popcount(lanes);
   pack_store(s.scored.d.x, lanes, f.dx + n);
   pack_store(s.scored.d.y, lanes, f.dy + n);
   pack_store(s.scored.d.z, lanes, f.dz + n);
   pack_store(s.scored.path, lanes, f.path + n);
   pack_store(s.scored.weight, lanes, f.weight + n);
+  pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
+  const std::uint64_t scattered =
+      life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
   alignas(64) std::uint64_t slots[W];
@@ -204,6 +222,7 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
     f.exited[n + j] = true;
     f.lost[n + j] = false;
     f.last[n + j] = false;
+    f.scattered[n + j] = (scattered >> j) & 1;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
   }
   if constexpr (HasExitHook<Model>) {
@@ -221,6 +240,22 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
   f.n = n + k;
 }
 
+// The losses of the photons of a vector whose lanes `lanes` finished this
+// step, now in slots [n, ...) of the block f, handed over in their order,
+// and their lists given back to the pool.
+void hand_over_losses(const Lanes& list, std::uint64_t lanes, int n, Pool& pool,
+                      FinishedPhotons& f) {
+  alignas(64) double index[W];
+  life::pack_store(list, lanes, index);
+  const int k = std::popcount(lanes);
+  for (int j = 0; j < k; ++j) {
+    const int i = static_cast<int>(index[j]);
+    for (const WeightLoss& l : pool.loss_lists[i]) f.losses.push_back({n + j, l});
+    pool.loss_lists[i].clear();
+    pool.free_lists[pool.n_free++] = i;
+  }
+}
+
 }  // namespace
 
 BatchTracer::BatchTracer(const Settings& s)
@@ -231,7 +266,7 @@ void BatchTracer::trace(double theta_i, double phi_i, const PhotonFeed& feed, co
   std::visit(
       [&](const auto& model) {
         using Model = std::decay_t<decltype(model)>;
-        if constexpr (requires { Model::kScalarOnly; }) {
+        if constexpr (!life::RunsBatched<Model>) {
           throw Error("internal error: this roughness model runs on the reference tracer only");
         } else if (settings_.polarization == Polarization::Stokes)
           trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
@@ -248,6 +283,10 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   using OneLight = typename Light::template Rebind<double>;  // the same light, one photon
   auto pool_owner = std::make_unique<Pool>();
   Pool& pool = *pool_owner;
+  // Weight removed by the model's event weights, a list per photon.
+  constexpr bool kLosses = life::HasEventWeight<Model, Lanes>;
+  if constexpr (kLosses)
+    for (int i = 0; i < Pool::kLanes; ++i) pool.free_lists[pool.n_free++] = i;
   auto done = std::make_unique<FinishedPhotons>();
   const Source source(settings_, theta_i, phi_i);
   const EllipseCrossSection& ellipse = config_.ellipse;
@@ -289,6 +328,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
                    [i](const auto& x, auto* column) { column[i] = x; });
     pool.col[Pool::kPhiI][i] = p.phi_i;
     pool.bits[Pool::kPhoton][i] = photon;
+    if constexpr (kLosses) pool.give_list(i);
   };
   auto flush = [&] {
     done->clear_tail();
@@ -324,6 +364,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
             std::min(W, kPoolLanes - n_active), end - next));
         if (expected_value)
           for (int j = 0; j < n; ++j) take_slot(n_active + j);
+        if constexpr (kLosses)
+          for (int i = n_active; i < n_active + n; ++i) pool.give_list(i);
         n_active += n;
         next += n;
       }
@@ -344,6 +386,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     for (int o = 0; o < n_active; o += W) {
       const MaskOf<Lanes> live = (iota + Lanes(o)) < Lanes(n_active);
       auto s = pool.load_state<Lanes, Light>(o);
+      if constexpr (kLosses) s.losses = {load<Lanes>(pool.col[Pool::kLossList] + o), pool.loss_lists};
       // A fixed incident direction keeps phi_i out of the pool.
       const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
       const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
@@ -363,7 +406,13 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
             free_slots.push_back(static_cast<std::uint32_t>(freed[j]));
         }
       }
-      if (finished != 0) hand_over(model, s, phi_lanes, photon, slot, finished, *done);
+      if (finished != 0) {
+        const int n_before = done->n;
+        hand_over(model, s, phi_lanes, photon, slot, finished, *done);
+        if constexpr (kLosses) hand_over_losses(s.losses.slot, finished, n_before, pool, *done);
+      }
+      if constexpr (kLosses)
+        life::pack_store(s.losses.slot, in_flight, pool.col[Pool::kLossList] + kept);
       pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
       if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
       life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);

@@ -88,8 +88,9 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
 }  // namespace
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
-                       bool expected_value)
+                       std::vector<double> medulla_sigma_a, bool expected_value)
     : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
+      medulla_sigma_a_(std::move(medulla_sigma_a)),
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()), expected_value_(expected_value),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
@@ -127,16 +128,27 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   for (int c = 0; c < channels; ++c) {
     const Batch minus_sigma(-sigma_a_[c]);
     double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
-    for (int i = 0; i < f.n; i += W)
-      (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
-          .store_unaligned(w + i);
+    if (medulla_sigma_a_.empty()) {
+      for (int i = 0; i < f.n; i += W)
+        (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
+            .store_unaligned(w + i);
+    } else {
+      // Beer-Lambert in the cortex and in the medulla, each with its own sigma_a.
+      const Batch minus_medulla(-medulla_sigma_a_[c]);
+      for (int i = 0; i < f.n; i += W)
+        (Batch::load_aligned(f.weight + i) *
+         xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i) +
+                    minus_medulla * Batch::load_aligned(f.medulla_path + i)))
+            .store_unaligned(w + i);
+    }
   }
   alignas(64) std::int64_t theta_bin[kCap], phi_bin[kCap];
   block_bins(f, theta_bin, phi_bin);
   std::size_t bin[kCap];
   for (int i = 0; i < f.n; ++i) {
     if (!f.exited[i]) continue;
-    bin[i] = tally.bin_index(std::min(f.segments[i], last_lobe_), static_cast<int>(theta_bin[i]),
+    const int lobe = f.scattered[i] ? last_lobe_ + 1 : std::min(f.segments[i], last_lobe_);
+    bin[i] = tally.bin_index(lobe, static_cast<int>(theta_bin[i]),
                              static_cast<int>(phi_bin[i]));
     tally.prefetch(bin[i]);
   }

@@ -18,7 +18,12 @@ namespace fiberlab::sim {
 
 class ExitScorer {
  public:
-  ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes, bool expected_value = false);
+  // lobes: tally.lobes, by p. medulla_sigma_a: the medulla's sigma_a (empty
+  // without a medulla); with one, photons that scattered in it go to lobe
+  // `lobes` (`scattered`, docs/FUR.md) and every photon's weight carries
+  // exp(-medulla_sigma_a[c] medulla_path). expected_value: Settings::estimator.
+  ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
+             std::vector<double> medulla_sigma_a = {}, bool expected_value = false);
   // Weights are computed for a whole block at once (vectorised), the tally
   // cells of the exits are located and prefetched, then added.
   void score(const FinishedPhotons& f, Tally& tally);
@@ -30,6 +35,7 @@ class ExitScorer {
   const BinGrid& grid_;
   std::vector<double> sigma_a_;
   int last_lobe_;
+  std::vector<double> medulla_sigma_a_;
   std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight

@@ -26,6 +26,8 @@ struct FinishedPhotons {
   alignas(64) double weight[kCapacity] = {};  // throughput before absorption (PhotonOutcome::weight)
   alignas(64) double theta[kCapacity], phi[kCapacity], phi_i[kCapacity];
   alignas(64) double dx[kCapacity] = {}, dy[kCapacity] = {}, dz[kCapacity] = {};  // exit direction
+  alignas(64) double medulla_path[kCapacity] = {};  // 3D length inside the medulla (0 without one)
+  bool scattered[kCapacity] = {};  // scattered in the medulla: the lobe `scattered`
   std::uint64_t photon[kCapacity];
   int segments[kCapacity];
   bool exited[kCapacity];
@@ -47,7 +49,7 @@ struct FinishedPhotons {
   // value that would overflow a conversion to an integer).
   void clear_tail() {
     const int end = (n + kBatchWidth - 1) / kBatchWidth * kBatchWidth;
-    for (double* column : {path, weight, phi_i, dx, dy, dz})
+    for (double* column : {path, weight, phi_i, dx, dy, dz, medulla_path})
       std::fill(column + n, column + end, 0.0);
   }
   // An exit that photon `index` scored by expected value (one photon at a
@@ -61,6 +63,8 @@ struct FinishedPhotons {
     photon[n] = index;
     phi_i[n] = incident_phi;
     path[n] = e.path_length;
+    medulla_path[n] = e.medulla_path;
+    scattered[n] = e.scattered;
     segments[n] = e.segments;
     exited[n] = true;
     theta[n] = inclination(e.direction);
@@ -81,6 +85,8 @@ struct FinishedPhotons {
     photon[n] = index;
     phi_i[n] = incident_phi;
     path[n] = o.path_length;
+    medulla_path[n] = o.medulla_path;
+    scattered[n] = o.scattered;
     segments[n] = o.segments;
     exited[n] = o.fate == PhotonFate::Exited;
     theta[n] = o.theta;
@@ -99,6 +105,8 @@ struct FinishedPhotons {
     o.direction = Vec3(dx[i], dy[i], dz[i]);
     o.segments = segments[i];
     o.path_length = path[i];
+    o.medulla_path = medulla_path[i];
+    o.scattered = scattered[i];
     o.theta = theta[i];
     o.phi = phi[i];
     return o;

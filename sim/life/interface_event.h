@@ -46,6 +46,13 @@ struct ExitScoring {
   Vec3Of<T> n0;
 };
 
+// Analog choices (the medulla's interface events, sim/life/medulla.h: none
+// of their branches leaves the fiber).
+template <class T>
+ExitScoring<T> analog_choices() {
+  return {false, MaskOf<T>(false), MaskOf<T>(false), {}};
+}
+
 // The branch that leaves the fiber at once, if it does: reflection for a
 // photon outside, refraction (none under total internal reflection) for one
 // inside, kept only where its direction leaves on the outside of n0
@@ -78,7 +85,8 @@ struct ScalarLight {
   using Rebind = ScalarLight<U>;
   explicit ScalarLight(const Vec3Of<T>& /*d*/ = {}) {}
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
-                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+                          const MaskOf<T>& act, LaneRandom<T>& rng,
+                          const ExitScoring<T>& e = analog_choices<T>()) {
     // F uses the true 3D angle between d and m (SPEC section 3).
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     const FresnelReflectanceOf<T> f = fresnel_reflectance(cos_i, n.eta_rel, n.ratio);
@@ -121,7 +129,8 @@ struct StokesLight {
   }
 
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
-                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+                          const MaskOf<T>& act, LaneRandom<T>& rng,
+                          const ExitScoring<T>& e = analog_choices<T>()) {
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     // Turn the reference axis about d to the event's s-axis s = d x m / |d x m|;
     // (Q, U) rotate by 2 psi, cos psi = e1.s, sin psi = (d x e1).s. At

@@ -22,6 +22,7 @@
 
 #include "sim/life/ellipse_cross_section.h"
 #include "sim/life/interface_event.h"
+#include "sim/life/medulla.h"
 #include "sim/roughness/roughness_model.h"
 #include "sim/run/settings.h"
 
@@ -45,12 +46,20 @@ struct LifeConfig {
   explicit LifeConfig(const Settings& s)
       : ellipse(s.fiber.eccentricity), eta(s.fiber.eta), cos_tilt(std::cos(s.fiber.scale_tilt)),
         sin_tilt(std::sin(s.fiber.scale_tilt)), max_segments(s.max_segments),
-        max_events(s.max_events_per_point),
+        max_events(s.max_events_per_point), medulla(medulla_config(s)),
         expected_value(s.estimator == Estimator::ExpectedValue) {}
   EllipseCrossSection ellipse;
   double eta;
   double cos_tilt, sin_tilt;  // cuticle tilt towards the root (SPEC section 2)
   int max_segments, max_events;
+  MedullaConfig medulla;  // not present: a plain fiber (sim/life/medulla.h)
+
+  static MedullaConfig medulla_config(const Settings& s) {
+    if (!s.fiber.medulla) return {};
+    const MedullaSettings& m = *s.fiber.medulla;
+    const EllipseCrossSection e(s.fiber.eccentricity);
+    return {e.r_v(), e.r_w(), m.radius, m.sigma_s, m.g, s.fiber.eta, m.eta, s.max_segments};
+  }
   bool expected_value;  // expected-value scoring of exits (kExpectedValueMinWeight)
 };
 
@@ -64,6 +73,8 @@ struct ScoredExit {
   Vec3Of<T> d;    // the leaving direction
   T path;         // internal path length so far
   T segments;     // the lobe index p
+  T medulla_path;  // 3D path length inside the medulla so far
+  T scatters;      // scattering events in the medulla so far
 };
 
 template <class T, class Light>
@@ -80,6 +91,8 @@ struct PhotonState {
   LaneRandom<T> rng;
   Light light;
   LossRecord<T> losses;  // weight removed by the model's event weights
+  T medulla_path;        // 3D path length inside the medulla (sim/life/medulla.h)
+  T scatters;            // scattering events in the medulla
   ScoredExit<T> scored;  // expected-value scoring: this step's exit (set only then)
 };
 
@@ -89,7 +102,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          {zero, d, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -119,7 +132,7 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
     s.losses.add(r.scored & (w.factor < T(1.0)), exit_weight * (T(1.0) - w.factor), s.path);
     exit_weight = select(r.scored, select(w.lost, T(0.0), exit_weight * w.factor), T(0.0));
   }
-  s.scored = {exit_weight, r.leave_direction, s.path, s.segments};
+  s.scored = {exit_weight, r.leave_direction, s.path, s.segments, s.medulla_path, s.scatters};
   s.weight = select(r.scored, s.weight * (T(1.0) - r.p_leave), s.weight);
 }
 
@@ -178,8 +191,8 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
 // One internal segment for the photons about to cross the fiber (SPEC
 // sections 2 and 4). A photon that did not leave at the boundary ending its
 // last allowed segment is truncated (SPEC section 5), and so is one running
-// exactly along the axis (guided for ever). Always inline: GCC left it out
-// of line, passing the state through memory (bench_sim b +10%, c +6% inline).
+// exactly along the axis (guided for ever). Always inline: out of line, GCC
+// passes the state through memory (bench/bench_sim.cpp shows the cost).
 template <class T, class Light>
 [[gnu::always_inline]] inline void travel(const LifeConfig& c, PhotonState<T, Light>& s,
                                           const MaskOf<T>& live) {
@@ -193,12 +206,16 @@ template <class T, class Light>
   const MaskOf<T> moved = go & !along_axis;
   T pv = s.px, pw = s.py;
   c.ellipse.advance(pv, pw, s.d.y, s.d.z, t);
+  T cortex = t;
+  const MaskOf<T> stuck = c.medulla.present ? cross_medulla(c.medulla, s, moved, cortex, pv, pw)
+                                            : MaskOf<T>(false);
   s.px = select(moved, pv, s.px);
   s.py = select(moved, pw, s.py);
-  s.path = s.path + t;
+  s.path = s.path + cortex;
   s.segments = s.segments + ones<T>(moved);
   s.events_here = select(moved, T(0.0), s.events_here);
   s.code = select(moved, T(kAtBoundary), select(go & along_axis, T(kTruncated), s.code));
+  s.code = select(stuck, T(kTruncated), s.code);
 }
 
 // One step of the life for the photons in `live`, all at a boundary point:

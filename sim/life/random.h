@@ -8,10 +8,9 @@
 // number generators", ACM TOMS 2021), seeded through SplitMix64. The authors
 // recommend it for floating-point numbers: its output is the sum s0 + s3 of
 // two state words, whose lowest bits have low linear complexity, and a
-// uniform double keeps only the top 52 bits. It replaced xoshiro256** (the
-// same state and steps, a scrambler of seven integer operations instead of
-// one), which cost 4-6% of a whole run on an AVX2 machine
-// (docs/PERFORMANCE.md).
+// uniform double keeps only the top 52 bits. It is preferred to
+// xoshiro256** (the same state and steps, a scrambler of seven integer
+// operations instead of one) for its cheaper draw (docs/PERFORMANCE.md).
 //
 // LaneRandom<T> is the generator written once for a number type (sim/simd/lanes.h):
 // one stream (T = double) or W streams side by side (T = Batch), each
@@ -38,8 +37,8 @@ struct RandomState {
 namespace life {
 
 // z c modulo 2^64 for a word or a vector of words. AVX2 has no 64-bit
-// multiply, and xsimd then multiplies lane by lane through memory (4-5% of a
-// case c run's time in splitmix below); the 32 x 32 -> 64-bit products
+// multiply, and xsimd then multiplies lane by lane through memory (splitmix
+// below runs for every photon's stream); the 32 x 32 -> 64-bit products
 // give the same bits: z c = lo(z) lo(c) + 2^32 (hi(z) lo(c) + lo(z) hi(c))
 // mod 2^64.
 inline std::uint64_t times(std::uint64_t z, std::uint64_t c) { return z * c; }

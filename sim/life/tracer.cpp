@@ -29,7 +29,7 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
       PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
       const int p = static_cast<int>(s.scored.segments);
       scored.push_back({exit_direction_of(model, s.scored.d.to_vec3(), p, blur), p, s.scored.path,
-                        s.scored.weight});
+                        s.scored.weight, s.scored.medulla_path, s.scored.scatters > 0.0});
     }
   }
   rng.core() = s.rng;
@@ -38,6 +38,8 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
                                        static_cast<int>(s.segments), s.path, s.weight, rng);
   out.losses = std::move(s.losses.list);
   out.scored = std::move(scored);
+  out.medulla_path = s.medulla_path;
+  out.scattered = s.scatters > 0.0;
   if (out.fate == PhotonFate::Exited) {
     out.theta = inclination(out.direction);
     out.phi = azimuth(out.direction);

@@ -23,6 +23,8 @@ struct ScoredExitOutcome {
   Vec3 direction;
   int segments;
   double path_length, weight;
+  double medulla_path = 0.0;  // with a medulla: the length inside it so far
+  bool scattered = false;     // scattered in the medulla so far (lobe `scattered`)
 };
 
 struct PhotonOutcome {
@@ -38,6 +40,11 @@ struct PhotonOutcome {
   // Exits scored by expected value along the way, in order (empty with the
   // analog estimator); `fate` and `weight` are then what is left at the end.
   std::vector<ScoredExitOutcome> scored;
+  // With a medulla (sim/life/medulla.h): the 3D length inside it (absorbed
+  // with the medulla's sigma_a; path_length is the cortex's), and whether the
+  // photon scattered there (then it is tallied in the lobe `scattered`).
+  double medulla_path = 0.0;
+  bool scattered = false;
 };
 
 // Work counters, for benchmarks and notes.

@@ -34,20 +34,23 @@
 //   (x < cot theta): y is Normal(0, 1/2) given x, and x inverts the closed-form
 //   marginal C(x) = cos theta (1 + erf x) / 2 + sin theta exp(-x^2) / (2 sqrt pi)
 //   by safeguarded Newton iteration to rounding (exact, not a fit).
+// Lambda, G1 and the samplers are sim/roughness/microfacet_lanes.h's, which
+// the tracers run for one photon or a vector of photons; this class is their
+// one-photon form in Eigen vectors, and adds D.
 #include <optional>
 
 #include "common/fiber_frame.h"
+#include "sim/roughness/microfacet_lanes.h"
 
 namespace fiberlab::sim {
 
-enum class MicrofacetModel { Beckmann, GGX };
-
-// Orthonormal frame about a mean normal n: t along the fiber axis projected
-// onto n's tangent plane (longitudinal), b = n x t (azimuthal).
+// Orthonormal frame about a mean normal n: t along the fiber axis u = x
+// projected onto n's tangent plane (longitudinal), b = n x t (azimuthal);
+// life::MicrofacetFrameOf<double> in Eigen vectors.
 struct MicrofacetFrame {
   Vec3 t, b, n;
-  // n unit; `axis` the fiber tangent u (any vector not parallel to n).
-  static MicrofacetFrame about(const Vec3& n, const Vec3& axis);
+  // n unit.
+  static MicrofacetFrame about(const Vec3& n);
   Vec3 to_local(const Vec3& v) const { return Vec3(v.dot(t), v.dot(b), v.dot(n)); }
   Vec3 to_world(const Vec3& v) const { return v.x() * t + v.y() * b + v.z() * n; }
 };
@@ -57,6 +60,8 @@ class MicrofacetDistribution {
   // alpha_long, alpha_azim > 0 (throws fiberlab::Error otherwise).
   MicrofacetDistribution(MicrofacetModel model, double alpha_long, double alpha_azim);
   MicrofacetModel model() const { return model_; }
+  double alpha_long() const { return ax_; }
+  double alpha_azim() const { return ay_; }
 
   // Everything below in the local frame (z = the mean normal), unit vectors.
   // D(m) per steradian of m; 0 for m_z <= 0.
@@ -76,9 +81,6 @@ class MicrofacetDistribution {
                                      double u2) const;
 
  private:
-  Vec3 sample_ggx_stretched(const Vec3& w, double u1, double u2) const;
-  // Slopes (x, y) of the alpha = 1 Beckmann VNDF for incidence theta in the x-z plane.
-  void sample_beckmann_slopes(double cos_theta, double u1, double u2, double& x, double& y) const;
   MicrofacetModel model_;
   double ax_, ay_;
 };

@@ -1,8 +1,8 @@
 #pragma once
-// The macro normals of a boundary point as one photon sees them (scalar), for
-// the microfacet roughness models (sim/roughness/microfacet_roughness.h). The gaussian
-// and smooth models, written for both number types, are in
-// sim/roughness/roughness_gaussian.h and sim/roughness/roughness_smooth.h.
+// The macro normals of a boundary point as one photon sees them, in Eigen
+// vectors: the one-photon convenience forms of the microfacet roughness
+// models (sim/roughness/microfacet_roughness.h) take them. The tracers use
+// life::BoundaryFrame (sim/roughness/roughness_model.h).
 #include "common/fiber_frame.h"
 
 namespace fiberlab::sim {

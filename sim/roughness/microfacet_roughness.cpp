@@ -6,6 +6,8 @@ namespace fiberlab::sim {
 
 namespace {
 
+using V = life::Vec3Of<double>;
+
 MicrofacetModel distribution_model(RoughnessModel m) {
   if (m == RoughnessModel::Beckmann) return MicrofacetModel::Beckmann;
   if (m == RoughnessModel::GGX) return MicrofacetModel::GGX;
@@ -17,22 +19,22 @@ MicrofacetModel distribution_model(RoughnessModel m) {
 MicrofacetRoughness::MicrofacetRoughness(const RoughnessSettings& r)
     : distribution_(distribution_model(r.model), r.alpha_long, r.alpha_azim), masking_(r.masking) {}
 
+Vec3 MicrofacetRoughness::mean_normal(const Vec3& d, const BoundaryNormals& n) {
+  return mean_normal(V(d), V(n.facing), V(n.untilted_facing)).to_vec3();
+}
+
 std::optional<Vec3> MicrofacetRoughness::sample_normal(const Vec3& d, const Vec3& mean,
                                                        PhotonRandom& rng) const {
   const double u1 = rng.uniform(), u2 = rng.uniform();
-  const std::optional<Vec3> m = distribution_.sample_visible(frame(mean), d, u1, u2);
-  // The VNDF has d.m <= 0; d.m = 0 (a facet seen exactly edge-on, probability
-  // zero up to rounding) has no event.
-  if (!m || !(d.dot(*m) < 0.0)) return std::nullopt;
-  return m;
+  bool ok = false;
+  const V m = sample_normal(V(d), V(mean), u1, u2, true, ok);
+  if (!ok) return std::nullopt;
+  return m.to_vec3();
 }
 
 double MicrofacetRoughness::masking_factor(const Vec3& mean, const Vec3& d_out,
                                            bool refracted) const {
-  // A refracted direction is judged from the other side of the mean surface,
-  // as -d_out (Lambda depends on w_x, w_y only through their squares).
-  const Vec3 w = frame(mean).to_local(refracted ? Vec3(-d_out) : d_out);
-  return distribution_.G1(w);  // 0 for w_z <= 0: the wrong side
+  return masking_factor(V(mean), V(d_out), refracted);
 }
 
 }  // namespace fiberlab::sim

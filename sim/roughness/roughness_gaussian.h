@@ -29,8 +29,8 @@ class GaussianRoughness {
   explicit GaussianRoughness(const Settings& s)
       : GaussianRoughness(s.roughness.beta_long.front(), s.roughness.beta_azim.front()) {}
 
-  // Always inline: GCC 12 left it out of line (the photon state, the frame
-  // and the stream passed through memory); inline, bench_sim case c +2%.
+  // Always inline: GCC 12 leaves it out of line, passing the photon state,
+  // the frame and the stream through memory.
   template <class T>
   [[gnu::always_inline]] FacetDraw<T> draw_normal(const Vec3Of<T>& d,
                                                   const BoundaryFrame<T>& frame,

@@ -38,14 +38,37 @@
 // - count candidates in counts.normal_draws and failures in
 //   counts.sampler_caps.
 //
-// To add a model: write it in one header (sim/roughness_<name>.h; see
-// sim/roughness/roughness_gaussian.h for a rejection sampler, sim/roughness/roughness_smooth.h
-// for the simplest), add its settings (sim/run/settings.*), and register it in
-// sim/roughness/roughness_models.h (the variant and make_roughness). Both tracers, the
-// batched one's lane management, Fresnel, Stokes light, tilt, the
-// consistency rule and truncation then apply to it unchanged.
+// Whether a model runs on the batched tracer is decided by its type alone:
+// RunsBatched below (a draw_normal for a vector of photons, and an
+// event_weight for one if it has one for a photon). Simulation and
+// BatchTracer ask it (runs_batched in sim/roughness/roughness_models.h); a
+// model written for T = double only runs on the reference tracer.
+//
+// To add a model, the files it touches (counted for beckmann / ggx, which
+// touch 23; a model of one header and one test file touches 12):
+// 1. its sampler, one header sim/roughness/roughness_<name>.h (see
+//    roughness_gaussian.h for a rejection sampler, roughness_smooth.h for the
+//    simplest, roughness_microfacet.h for one with an event weight), more
+//    files if it has parts of its own (the microfacet models: seven);
+// 2. its registration and settings (six): sim/roughness/roughness_models.h
+//    (the variant and make_roughness), sim/run/settings.h and settings.cpp
+//    (its name, parameters, reading and validation),
+//    sim/store/result_file.cpp (its parameters as file attributes),
+//    cli/cmd_info.cpp (their description), compare/models.cpp (the analytic
+//    models' stand-in for its fibers);
+// 3. its tests: its own file(s) in tests/sim/ (an oracle for its normals;
+//    the microfacet models: six), listed in tests/CMakeLists.txt, and a case
+//    in tests/sim/test_batch_tracer.cpp (photon by photon against the
+//    reference tracer);
+// 4. docs/PHYSICS.md (the model) and docs/FILE_FORMAT.md (its attributes).
+// Both tracers, the batched one's lane management, Fresnel, Stokes light,
+// tilt, the consistency rule, truncation and masking's losses then apply to
+// it unchanged.
+#include <concepts>
+#include <cstdint>
 #include <vector>
 
+#include "sim/simd/lane_packing.h"
 #include "sim/simd/lane_pair.h"
 #include "sim/simd/lanes.h"
 #include "sim/life/random.h"
@@ -115,11 +138,26 @@ struct EventWeight {
   MaskOf<T> lost;  // the path ends here (fate Lost, its weight booked as lost)
 };
 
-// The losses a photon records (one photon: a list; a vector of lanes: none,
-// the batched life runs no model with event weights yet).
+// The losses a photon records: one photon, a list; a vector of lanes, each
+// lane's photon a list of its own, lists[slot] (the batched tracer gives
+// each photon in flight a list and hands it over with the photon). A
+// photon's losses are recorded in the same order either way.
 template <class T>
 struct LossRecord {
-  void add(const MaskOf<T>&, const T&, const T&) {}
+  T slot;                                  // per lane: its photon's list
+  std::vector<WeightLoss>* lists = nullptr;  // none: the model removes no weight
+  void add(const MaskOf<T>& m, const T& weight, const T& path) {
+    if (!any(m)) return;
+    constexpr int kWidth = NumberTraits<T>::kWidth;
+    alignas(64) double w[kWidth], p[kWidth], k[kWidth];
+    store(weight, w);
+    store(path, p);
+    store(slot, k);
+    for (std::uint64_t lanes = lane_bits(m); lanes != 0; lanes &= lanes - 1) {
+      const int j = std::countr_zero(lanes);
+      lists[static_cast<int>(k[j])].push_back({w[j], p[j]});
+    }
+  }
 };
 template <>
 struct LossRecord<double> {
@@ -134,5 +172,21 @@ template <class T>
 struct LifeCounts {
   T events = T(0.0), normal_draws = T(0.0), sampler_caps = T(0.0);
 };
+
+// A model the batched tracer runs: written for its number type (Batch2,
+// sim/simd/lane_pair.h), event weight included if it has one for a photon.
+template <class Model>
+concept RunsBatched =
+    requires(const Model& m, const Vec3Of<Batch2>& d, const BoundaryFrame<Batch2>& f,
+             const MaskOf<Batch2>& live, LaneRandom<Batch2>& rng, Batch2& tries,
+             LifeCounts<Batch2>& counts, int rounds) {
+      { m.draw_normal(d, f, live, rng, tries, counts, rounds) } -> std::same_as<FacetDraw<Batch2>>;
+    } &&
+    (!requires(const Model& m, const EventGeometry<double>& e, bool a, LaneRandom<double>& r) {
+      m.event_weight(e, a, r);
+    } || requires(const Model& m, const EventGeometry<Batch2>& e, const MaskOf<Batch2>& a,
+                  LaneRandom<Batch2>& r) {
+      { m.event_weight(e, a, r) } -> std::same_as<EventWeight<Batch2>>;
+    });
 
 }  // namespace fiberlab::sim::life

@@ -1,8 +1,7 @@
 #pragma once
 // The registry of roughness models (sim/roughness/roughness_model.h says what a model
-// is and how to add one): every model the tracers can run, and which one a
-// configuration selects. A new model is one header plus a line in each of
-// the two lists below.
+// is and how to add one): every model the tracers can run, which one a
+// configuration selects, and whether the batched tracer runs it.
 #include <variant>
 
 #include "sim/life/exit_blur.h"
@@ -33,6 +32,13 @@ inline AnyRoughness make_roughness(const Settings& s) {
       return ExitBlurRoughness(s);
   }
   return life::SmoothRoughness(s);
+}
+
+// Whether the batched tracer runs the model of `r`: its type says
+// (life::RunsBatched, sim/roughness/roughness_model.h); otherwise the
+// reference tracer runs it.
+inline bool runs_batched(const AnyRoughness& r) {
+  return std::visit([](const auto& m) { return life::RunsBatched<std::decay_t<decltype(m)>>; }, r);
 }
 
 }  // namespace fiberlab::sim

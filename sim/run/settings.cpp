@@ -344,10 +344,12 @@ std::vector<double> to_radians(std::vector<double> degrees) {
 
 // ---------------------------------------------------------------- sections
 
+void read_medulla(const Reader& r, const YAML::Node& parent, FiberSettings& f);
+
 void read_fiber(const Reader& r, const YAML::Node& parent, FiberSettings& f) {
   const std::string path = "fiber";
   const YAML::Node n = r.section(parent["fiber"], path,
-                                 {"eta", "eccentricity", "scale_tilt", "sigma_a", "melanin"});
+                                 {"eta", "eccentricity", "scale_tilt", "sigma_a", "melanin", "medulla"});
   if (n["eta"]) f.eta = r.number(n["eta"], "fiber.eta", kEta);
   if (n["eccentricity"])
     f.eccentricity = r.number(n["eccentricity"], "fiber.eccentricity", kEccentricity);
@@ -375,6 +377,42 @@ void read_fiber(const Reader& r, const YAML::Node& parent, FiberSettings& f) {
     f.pheomelanin = cp;
     f.sigma_a = sigma_a_from_melanin(ce, cp);
   }
+  read_medulla(r, n, f);
+}
+
+const Rule kMedullaRadius{"must be in (0, 1): a fraction of the fiber's semi-axes",
+                          [](double x) { return x > 0.0 && x < 1.0; }};
+const Rule kAnisotropy{"must be in (-1, 1)", [](double x) { return x > -1.0 && x < 1.0; }};
+const Rule kMedullaEta{"must be in [1, 1e9]", [](double x) { return x >= 1.0 && x <= kMaxEta; }};
+
+// fiber.medulla (docs/FUR.md), after the fiber's own keys: its sigma_a has
+// the fiber's channels, and its eta defaults to the fiber's.
+void read_medulla(const Reader& r, const YAML::Node& parent, FiberSettings& f) {
+  const YAML::Node n = parent["medulla"];
+  if (!n) return;
+  const std::string path = "fiber.medulla";
+  const YAML::Node m = r.section(n, path, {"radius", "sigma_s", "sigma_a", "g", "eta"});
+  for (const char* key : {"radius", "sigma_s"})
+    if (!m[key])
+      r.fail(fmt::format("{}.{} is missing (a medulla needs radius in (0, 1) and sigma_s >= 0)",
+                         path, key));
+  MedullaSettings md;
+  md.radius = r.number(m["radius"], path + ".radius", kMedullaRadius);
+  md.sigma_s = r.number(m["sigma_s"], path + ".sigma_s", kNonNegative);
+  md.sigma_a.assign(f.sigma_a.size(), 0.0);
+  if (m["sigma_a"]) {
+    const Rule rule{fmt::format("must be a finite number >= 0, or a list of {} such numbers (the "
+                                "fiber's channels)", f.sigma_a.size()),
+                    kSigmaA.ok};
+    md.sigma_a = r.numbers(m["sigma_a"], path + ".sigma_a", rule, true);
+    if (md.sigma_a.size() == 1) md.sigma_a.assign(f.sigma_a.size(), md.sigma_a.front());
+    if (md.sigma_a.size() != f.sigma_a.size())
+      r.bad(path + ".sigma_a", m["sigma_a"], fmt::format("has {} channels", md.sigma_a.size()),
+            fmt::format("must have the fiber's {} channels, or be one number", f.sigma_a.size()));
+  }
+  if (m["g"]) md.g = r.number(m["g"], path + ".g", kAnisotropy);
+  md.eta = m["eta"] ? r.number(m["eta"], path + ".eta", kMedullaEta) : f.eta;
+  f.medulla = md;
 }
 
 // alpha of a microfacet model: a number (isotropic) or [longitudinal, azimuthal].
@@ -506,7 +544,7 @@ void read_top_level(const Reader& r, const YAML::Node& n, Settings& s) {
 void check_tally_size(const Reader& r, const Settings& s) {
   const double incidences = static_cast<double>(s.source.theta_i.size()) *
                             (s.source.phi_i_uniform ? 1.0 : static_cast<double>(s.source.phi_i.size()));
-  const double bytes = incidences * s.tally.lobes * static_cast<double>(s.tally.n_theta) *
+  const double bytes = incidences * s.tally_lobes() * static_cast<double>(s.tally.n_theta) *
                        s.tally.n_phi * static_cast<double>(s.fiber.sigma_a.size()) * 2.0 * 8.0;
   if (bytes > kMaxTallyBytes)
     r.fail(fmt::format(
@@ -514,7 +552,7 @@ void check_tally_size(const Reader& r, const Settings& s) {
         "{} incident configuration(s) x {} lobes x {} channel(s) (must be at most 8 GiB; lower "
         "tally.n_theta/n_phi, tally.lobes, the channels or the incident angles)",
         s.tally.n_theta, s.tally.n_phi, bytes / (1024.0 * 1024 * 1024),
-        static_cast<std::uint64_t>(incidences), s.tally.lobes,
+        static_cast<std::uint64_t>(incidences), s.tally_lobes(),
         s.fiber.sigma_a.size()));
 }
 
@@ -549,6 +587,14 @@ std::string roughness_parameters_text(const RoughnessSettings& g) {
                      betas_text(g.beta_azim));
 }
 
+// The fiber block's medulla line (empty without one).
+std::string medulla_text(const std::optional<MedullaSettings>& m) {
+  if (!m) return "";
+  return fmt::format("  medulla: {{radius: {}, sigma_s: {}, sigma_a: {}, g: {}, eta: {}}}\n",
+                     number_text(m->radius), number_text(m->sigma_s),
+                     list_text(m->sigma_a, number_text), number_text(m->g), number_text(m->eta));
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------- public API
@@ -570,6 +616,11 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   read_top_level(r, root, s);
   read_fiber(r, root, s.fiber);
   read_roughness(r, root, s.roughness);
+  // Masking's removed weight is absorbed along the cortex path only
+  // (sim/life/exit_scoring.cpp), so the two are not combined.
+  if (s.fiber.medulla && s.roughness.masking != Masking::None)
+    r.fail("fiber.medulla is not allowed with roughness.masking = smith_g1 (allowed with "
+           "masking: none)");
   read_source(r, root, s.source);
   read_tally(r, root, s.tally);
   check_tally_size(r, s);
@@ -634,6 +685,7 @@ std::string to_yaml(const Settings& s) {
       "  eccentricity: {}\n"
       "  scale_tilt: {}\n"
       "  {}\n"
+      "{}"
       "roughness:\n"
       "  model: {}\n"
       "{}"
@@ -651,7 +703,7 @@ std::string to_yaml(const Settings& s) {
       "polarization: {}\n"
       "estimator: {}\n",
       s.photons, s.seed, quoted(s.output), number_text(f.eta), number_text(f.eccentricity),
-      degrees_text(f.scale_tilt), absorption, to_string(s.roughness.model),
+      degrees_text(f.scale_tilt), absorption, medulla_text(f.medulla), to_string(s.roughness.model),
       roughness_parameters_text(s.roughness),
       list_text(s.source.theta_i, degrees_text), phi_i, kHSampling[s.source.h_stratified ? 0 : 1],
       s.tally.n_theta, s.tally.n_phi,

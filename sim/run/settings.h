@@ -29,6 +29,21 @@ enum class Polarization { Scalar, Stokes };
 // (analog once the weight is below life::kExpectedValueMinWeight).
 enum class Estimator { Analog, ExpectedValue };
 
+// `fiber.medulla` (docs/FUR.md): a scattering core, the cross-section scaled
+// by `radius` about the fiber's axis, filled with a medium of scattering
+// coefficient sigma_s and absorption sigma_a (1/R, as the fiber's), a
+// Henyey-Greenstein phase function of anisotropy g, and index eta (the
+// fiber's when not given: then its boundary is no interface).
+struct MedullaSettings {
+  double radius = 0.5;               // k in (0, 1), of the fiber's semi-axes
+  double sigma_s = 0.0;              // 1/R, finite, >= 0
+  std::vector<double> sigma_a;       // 1/R per channel (the fiber's channels)
+  double g = 0.0;                    // in (-1, 1)
+  double eta = 1.55;                 // relative to the outer medium, >= 1
+
+  friend bool operator==(const MedullaSettings&, const MedullaSettings&) = default;
+};
+
 struct FiberSettings {
   double eta = 1.55;           // relative index, > 1
   double eccentricity = 1.0;   // minor/major, (0, 1]
@@ -36,6 +51,7 @@ struct FiberSettings {
   std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
   // Set when the config gave melanin instead of sigma_a (sigma_a is then derived).
   std::optional<double> eumelanin, pheomelanin;
+  std::optional<MedullaSettings> medulla;  // none: a plain fiber
 
   friend bool operator==(const FiberSettings&, const FiberSettings&) = default;
 };
@@ -103,6 +119,10 @@ struct Settings {
     double theta_i, phi_i;
   };
   std::vector<Incidence> incidences() const;
+
+  // Lobes in the tally and in result files: tally.lobes by p, and with a
+  // medulla one more, `scattered`, after them (docs/FUR.md).
+  int tally_lobes() const { return tally.lobes + (fiber.medulla ? 1 : 0); }
 
   // Field-by-field equality (exact doubles): to_yaml -> parse_settings_yaml
   // gives back an equal Settings.

@@ -173,14 +173,14 @@ std::uint64_t Simulation::Runner::trace_round(std::size_t k, std::uint64_t first
 // Adds every rank's unflushed sums of direction k into rank 0's state. Into
 // a state that holds nothing yet, a thread's tally is swapped instead (exact:
 // the sum of it and zero): the state's pages were never touched, and
-// touching fresh memory costs about 1 ms per 2 MiB here, whereas the zero
-// tally the thread gets back costs nothing until that thread writes to it.
+// touching fresh memory costs time per page, whereas the zero tally the
+// thread gets back costs nothing until that thread writes to it.
 // A lone process adds the other threads' tallies on every thread and frees
 // them rather than clearing them on this one: a flush is rare (the last
 // round, checkpoints, target-error judgements), and a thread that traces
-// again faults its fresh tally in itself, in parallel with the others (the
-// last flush of a run, before the file is written, was 1.2-1.5 ms serial
-// of a 0.18 s case c run).
+// again faults its fresh tally in itself, in parallel with the others,
+// rather than this thread clearing every tally serially before the file is
+// written.
 void Simulation::Runner::flush(std::size_t k) {
   if (group_.size() == 1) {
     for (std::unique_ptr<Tally>& t : thread_tallies_)
@@ -329,12 +329,12 @@ Simulation::Simulation(Settings settings)
                           settings_.tally.theta_bins)),
       tracer_(settings_),
       batch_tracer_(settings_),
-      // The microfacet models run on the reference tracer (sim/roughness/roughness_microfacet.h).
-      use_batch_tracer_(!settings_.roughness.microfacet()),  // scalar and Stokes light
+      // The model's type decides (sim/roughness/roughness_model.h, RunsBatched).
+      use_batch_tracer_(runs_batched(make_roughness(settings_))),
       incidences_(settings_.incidences()) {}
 
 TallyShape Simulation::tally_shape() const {
-  return {settings_.tally.lobes, settings_.tally.n_theta, settings_.tally.n_phi,
+  return {settings_.tally_lobes(), settings_.tally.n_theta, settings_.tally.n_phi,
           static_cast<int>(settings_.fiber.sigma_a.size())};
 }
 
@@ -342,14 +342,14 @@ void Simulation::trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tal
                                TracerCounters& counters, std::atomic<std::uint64_t>* traced,
                                std::uint64_t per_photon) const {
   const Settings::Incidence inc = incidences_[k];
-  ExitScorer scorer(grid_, settings_.fiber.sigma_a, tally.lobes(),
+  ExitScorer scorer(grid_, settings_.fiber.sigma_a, settings_.tally.lobes,
+                    settings_.fiber.medulla ? settings_.fiber.medulla->sigma_a : std::vector<double>{},
                     settings_.estimator == Estimator::ExpectedValue);
   auto score = [&](const FinishedPhotons& f) { scorer.score(f, tally); };
   // Every run handed out is launched and traced in full, so it counts as
   // launched here, and as progress: a counter the threads share, touched a
-  // run (up to Simulation::kMaxRunChunks chunks) at a time. (Touched per
-  // block of about 300 finished photons, it cost a 16 M-photon case c run
-  // on two threads 2-3% of its time: the line moves between the cores.)
+  // run (up to Simulation::kMaxRunChunks chunks) at a time, because each
+  // touch moves its cache line between the cores.
   auto counted_feed = [&] {
     const PhotonRun run = feed();
     tally.add_launched(run.n);

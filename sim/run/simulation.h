@@ -91,8 +91,8 @@ class Simulation {
 
   // Traces the photons of every run the feed hands out (sim/life/photon_feed.h)
   // of incident configuration k into `tally` (with the batched tracer where
-  // it runs the roughness model, the reference tracer for the microfacet
-  // models). `traced`, when given, grows by `per_photon` for each photon of
+  // it runs the roughness model, runs_batched in
+  // sim/roughness/roughness_models.h; otherwise the reference tracer). `traced`, when given, grows by `per_photon` for each photon of
   // a run as the run is taken (progress: every run taken is traced in full).
   void trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tally,
                      TracerCounters& counters, std::atomic<std::uint64_t>* traced = nullptr,
@@ -114,8 +114,8 @@ class Simulation {
 
   Settings settings_;
   BinGrid grid_;
-  Tracer tracer_;            // the reference tracer; serves polarization: stokes
-  BatchTracer batch_tracer_; // the vectorised tracer for unpolarised light
+  Tracer tracer_;            // the reference tracer: a model the batched one does not run
+  BatchTracer batch_tracer_; // the vectorised tracer
   bool use_batch_tracer_;
   std::vector<Settings::Incidence> incidences_;
 };

@@ -7,8 +7,8 @@
 // division): the core runs one while the other waits, where a single vector
 // leaves its units idle. The halves are computed exactly as a Batch each, so
 // a photon's numbers do not depend on the type (tests/sim/test_batch_tracer.cpp).
-// (A Pair of Pairs, 4 chains, compiles too, but measured 0.6 of the Pair's
-// speed: with 32 registers, its values no longer fit and are spilled.)
+// (A Pair of Pairs, 4 chains, compiles too, but its values do not fit in 32
+// registers and are spilled.)
 #include <bit>
 #include <cstdint>
 #include <type_traits>

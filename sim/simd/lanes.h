@@ -74,9 +74,9 @@ inline Batch fma(const Batch& a, const Batch& b, const Batch& c) {
 }
 
 // Not m, always inline. xsimd 8.1's ! of a mask compares it with a false
-// mask, which GCC 12 left out of line on AVX-512 (28 calls in the photon
-// life, each passing the mask through memory); with it inline, bench_sim
-// ran cases b and c about 8% faster (docs/PERFORMANCE.md).
+// mask, which GCC 12 leaves out of line on AVX-512 (28 calls in the photon
+// life, each passing the mask through memory; bench/bench_sim.cpp shows the
+// cost, docs/PERFORMANCE.md).
 [[gnu::always_inline]] inline bool mask_not(bool m) { return !m; }
 [[gnu::always_inline]] inline MaskOf<Batch> mask_not(const MaskOf<Batch>& m) {
 #if defined(__AVX512F__)

@@ -50,8 +50,8 @@ template <class T>
 [[gnu::always_inline]] inline std::pair<T, T> kernel(const T& x) {
   const T z = x * x;
   // The Horner chains are written out: a generic helper over a coefficient
-  // array gave the same bits but measured 5% slower in the batched tracer
-  // (GCC then spilled more of the sampler's registers).
+  // array gives the same bits, but GCC then spills more of the sampler's
+  // registers in the batched tracer.
   // sin x = x + x z S(z)
   T s(-0x1.ab17d404de5b3p-41);
   s = fma(s, z, T(0x1.61217f0b800d5p-33));

@@ -28,6 +28,14 @@ void write_parameters(h5::File& f, const Settings& s) {
   f.set_attr("/fiber", "eccentricity", s.fiber.eccentricity);
   f.set_attr("/fiber", "scale_tilt", s.fiber.scale_tilt);
   f.set_attr("/fiber", "sigma_a", s.fiber.sigma_a);
+  if (const auto& m = s.fiber.medulla) {  // docs/FUR.md
+    f.create_group("/fiber/medulla");
+    f.set_attr("/fiber/medulla", "radius", m->radius);
+    f.set_attr("/fiber/medulla", "sigma_s", m->sigma_s);
+    f.set_attr("/fiber/medulla", "sigma_a", m->sigma_a);
+    f.set_attr("/fiber/medulla", "g", m->g);
+    f.set_attr("/fiber/medulla", "eta", m->eta);
+  }
   f.create_group("/roughness");
   f.set_attr("/roughness", "model", to_string(s.roughness.model));
   f.set_attr("/roughness", "beta_long", s.roughness.beta_long);
@@ -57,7 +65,7 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
     r.theta_i.push_back(inc.theta_i);
     r.phi_i.push_back(inc.phi_i);
   }
-  r.lobes = settings.tally.lobes;
+  r.lobes = settings.tally_lobes();
   r.channels = static_cast<int>(settings.fiber.sigma_a.size());
   for (const Tally& t : tallies) {
     r.photons.push_back(t.photons());
@@ -85,7 +93,8 @@ void write_result_header(h5::File& f, const ResultFile& r) {
 }
 
 void describe_result_file(h5::File& f, const ResultFile& r) {
-  write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
+  write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value(),
+                   r.settings.fiber.medulla.has_value());
   describe_bins_and_source(f);
   describe_result_datasets(f);
   if (f.exists("/exact")) describe_exact_datasets(f);

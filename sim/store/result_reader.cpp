@@ -130,7 +130,7 @@ ResultFile read_result(const std::string& path) {
   // Every shape follows from the stored configuration.
   const Settings& s = r.settings;
   const std::vector<Settings::Incidence> inc = s.incidences();
-  const Shape d{inc.size(), static_cast<hsize_t>(s.tally.lobes),
+  const Shape d{inc.size(), static_cast<hsize_t>(s.tally_lobes()),
                 static_cast<hsize_t>(s.tally.n_theta), static_cast<hsize_t>(s.tally.n_phi),
                 s.fiber.sigma_a.size()};
   const std::string sizes = fmt::format("K = {} incident directions, L = {} lobes, n_theta = {}, "

@@ -306,7 +306,7 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   h.theta_i = f.read_doubles("/source/theta_i");
   h.phi_i = f.read_doubles("/source/phi_i");
   h.photons = f.read_uint64s("/tally/photons");
-  h.lobes = h.settings.tally.lobes;
+  h.lobes = h.settings.tally_lobes();
   h.channels = static_cast<int>(h.settings.fiber.sigma_a.size());
   shape_ = shape_of(h);
   const std::size_t K = h.photons.size();

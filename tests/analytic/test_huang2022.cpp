@@ -5,7 +5,9 @@
 // roughness does); the incident flux onto the tilted mesonormal at normal
 // incidence (cos tilt, in closed form); mirror symmetries; the sign of the
 // tilt; the paper's pointwise density (R by its arc integral, TT with the
-// last interface evaluated analytically) against the push-forward bins.
+// last interface evaluated analytically) against the push-forward bins;
+// Cycles' eval() residual (`residual=cycles_eval`) against its closed form
+// on a smooth circle, derived here from the formula.
 // Each test names the mutation of the model it was checked to catch.
 #include <gtest/gtest.h>
 
@@ -328,6 +330,10 @@ TEST(Huang2022, ParameterTable) {
   apply_setting("huang2022", p, "tilt=3");
   apply_setting("huang2022", p, "masking=correlated");
   apply_setting("huang2022", p, "quadrature_points=4096");
+  EXPECT_EQ(p.huang_residual, 0);
+  apply_setting("huang2022", p, "residual=cycles_eval");
+  EXPECT_EQ(p.huang_residual, 1);
+  EXPECT_THROW(apply_setting("huang2022", p, "residual=eval"), Error);
   EXPECT_DOUBLE_EQ(p.ggx_roughness, 0.1);
   EXPECT_NEAR(p.scale_tilt, deg_to_rad(3.0), 1e-15);
   EXPECT_EQ(p.huang_masking, 1);
@@ -340,4 +346,86 @@ TEST(Huang2022, ParameterTable) {
   EXPECT_EQ(m->name(), "huang2022");
   const BinGrid g = BinGrid::make(6, 8, ThetaBinning::Uniform);
   EXPECT_EQ(m->bin_probabilities(g, 0.3, 0.0).size(), 4u * 6 * 8 * 3);
+}
+
+namespace {
+
+// Unpolarised Fresnel reflectance of a dielectric of relative index eta at
+// the cosine c of the angle of incidence (written out here, not the
+// library's: the closed form below must not share the model's code).
+double fresnel_here(double c, double eta) {
+  const double s2 = (1.0 - c * c) / (eta * eta);
+  if (s2 >= 1.0) return 1.0;
+  const double ct = std::sqrt(1.0 - s2);
+  const double rs = (c - eta * ct) / (c + eta * ct), rp = (eta * c - ct) / (eta * c + ct);
+  return 0.5 * (rs * rs + rp * rp);
+}
+
+// Cycles' eval() residual energy on a smooth untilted circle (radius 1,
+// Cycles' projected width 2r = 2), from bsdf_hair_huang_eval_residual and
+// bsdf_hair_huang_eval_trrt: (2/pi) / (2 cos theta_i) times the integral
+// over the arc angle gamma in (-pi/2, pi/2) of T1 R2^2 T_avg A^3 /
+// (1 - A (1 - T_avg)), T_avg = 1 - R2. On a smooth circle the angle of
+// incidence at the second interface is the refraction angle at the first, so
+// R2 = R1 = F(cos theta_i cos gamma) (Fresnel's reciprocity) and T1 = 1 - F;
+// absorption is used at theta_i = 0 only, where the chord is 2 cos(gamma_t),
+// sin(gamma_t) = sin(gamma) / eta.
+double cycles_eval_residual_closed_form(double theta_i, double eta, double sigma_a) {
+  const GaussLegendre& gl = gauss_legendre(64);
+  double sum = 0.0;
+  const int panels = 32;
+  for (int k = 0; k < panels; ++k)
+    for (std::size_t q = 0; q < gl.x.size(); ++q) {
+      const double h = kPi / panels, g = -kPi / 2 + h * (k + 0.5 * (1.0 + gl.x[q]));
+      const double F = fresnel_here(std::cos(theta_i) * std::cos(g), eta);
+      const double A = std::exp(-sigma_a * 2.0 * std::sqrt(1.0 - std::pow(std::sin(g) / eta, 2)));
+      const double t_avg = 1.0 - F;
+      sum += 0.5 * h * gl.w[q] * (1.0 - F) * F * F * t_avg * A * A * A / (1.0 - A * (1.0 - t_avg));
+    }
+  return 2.0 / kPi * sum / (2.0 * std::cos(theta_i));
+}
+
+}  // namespace
+
+// residual=cycles_eval on a smooth circle: the residual lobe's energy is the
+// closed form above (white at theta_i 0, 40, 60 deg; absorbing at 0), and
+// 3.0-3.5x the sampler's there (the 2.6-3.2x on rough fibers).
+// Mutations caught: R2 instead of R2^2; the 1/cos(theta_i) dropped; the
+// weight per point taken from the projected width (cos gamma) instead of
+// uniform in gamma; A instead of A^3.
+TEST(Huang2022, CyclesEvalResidualIsItsClosedFormOnASmoothCircle) {
+  for (double ti_deg : {0.0, 40.0, 60.0}) {
+    Huang2022Params p = fiber(0.0);
+    p.residual = HuangResidual::CyclesEval;
+    const double ti = deg_to_rad(ti_deg);
+    const double got = Huang2022(p).energies(ti, 0.0).lobe[3];
+    const double want = cycles_eval_residual_closed_form(ti, p.eta, 0.0);
+    EXPECT_NEAR(got, want, 1e-4 * want) << "theta_i " << ti_deg;
+    Huang2022Params q = fiber(0.0);
+    const double sampler = Huang2022(q).energies(ti, 0.0).lobe[3];
+    EXPECT_GT(got / sampler, 2.9) << ti_deg;
+    EXPECT_LT(got / sampler, 3.6) << ti_deg;
+  }
+  Huang2022Params p = fiber(0.0);
+  p.residual = HuangResidual::CyclesEval;
+  p.sigma_a = {0.4};
+  const double got = Huang2022(p).energies(0.0, 0.0).lobe[3];
+  const double want = cycles_eval_residual_closed_form(0.0, p.eta, 0.4);
+  EXPECT_NEAR(got, want, 1e-4 * want);
+}
+
+// Cycles evaluates its residual inside the TRT branch: a TRT factor of 0
+// removes it (the sampler's residual is not scaled). The bins spread the
+// same energy. Mutation caught: the residual kept when TRT's factor is 0.
+TEST(Huang2022, CyclesEvalResidualFollowsTheTrtFactorAndFillsTheBins) {
+  Huang2022Params p = fiber(0.3, 1L << 14);
+  p.residual = HuangResidual::CyclesEval;
+  const double e = Huang2022(p).energies(0.3, 0.0).lobe[3];
+  const BinGrid g = BinGrid::make(24, 36, ThetaBinning::Uniform);
+  const auto bins = Huang2022(p).bin_probabilities(g, 0.3, 0.0);
+  const double binned = std::accumulate(bins.begin() + 3 * 24 * 36, bins.end(), 0.0);
+  EXPECT_NEAR(binned, e, 1e-9 * e);
+  EXPECT_GT(e, 0.1);
+  p.lobe_scale = {1.0, 1.0, 0.0};
+  EXPECT_EQ(Huang2022(p).energies(0.3, 0.0).lobe[3], 0.0);
 }

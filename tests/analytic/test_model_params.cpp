@@ -29,6 +29,7 @@ TEST(ModelParams, EveryTableKeyParses) {
       {"huang2022 roughness", "0.2"},
       {"huang2022 tilt", "3"},            {"huang2022 lobe_scale", "1,0.5,2"},
       {"huang2022 masking", "correlated"}, {"huang2022 flux", "macro"},
+      {"huang2022 residual", "cycles_eval"},
       {"huang2022 quadrature_points", "65536"}};
   for (const ModelInfo& m : registered_models()) {
     ModelParams p = default_params(m.name);

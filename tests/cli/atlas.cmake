@@ -3,3 +3,14 @@
 add_test(NAME atlas_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
 set_tests_properties(atlas_cli PROPERTIES TIMEOUT 300)
+# `fiberlab atlas` with model variants (configs/atlas_variants.yaml): named
+# in file, report and info; a variant without parameters equals its model;
+# one-line errors for bad entries.
+add_test(NAME atlas_variants_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_variants.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
+set_tests_properties(atlas_variants_cli PROPERTIES TIMEOUT 300)
+# `mpirun -np 2 fiberlab atlas` (and its --resume of a one-process
+# checkpoint) bit-identical to one process; skipped without mpirun.
+add_test(NAME atlas_mpi_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_mpi.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
+set_tests_properties(atlas_mpi_cli PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600)

@@ -106,14 +106,14 @@ TEST(Fit, KeysAreTheModelsOwn) {
 // scale_tilt moves every lobe by SPEC s7's shift rule.
 TEST(Fit, ScaleTiltIsTheShiftRule) {
   analytic::ModelParams p;
-  set_parameter(p, "scale_tilt", 3.0);
+  set_parameter("deon2011", p, "scale_tilt", 3.0);
   ASSERT_EQ(p.alpha.size(), 4u);
   EXPECT_NEAR(rad_to_deg(p.alpha[0]), -6.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(p.alpha[1]), 3.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(p.alpha[2]), 12.0, 1e-12);
   EXPECT_NEAR(rad_to_deg(p.alpha[3]), 0.0, 1e-12);
-  EXPECT_NEAR(get_parameter(p, "scale_tilt"), 3.0, 1e-12);
-  set_parameter(p, "beta_long[2]", 7.0);
+  EXPECT_NEAR(get_parameter("deon2011", p, "scale_tilt"), 3.0, 1e-12);
+  set_parameter("deon2011", p, "beta_long[2]", 7.0);
   EXPECT_NEAR(rad_to_deg(analytic::for_lobe(p.beta_long, 2)), 7.0, 1e-12);
 }
 

@@ -146,8 +146,8 @@ TEST_F(HostileRanks, DifferentSeedFlag) {
 }
 
 TEST_F(HostileRanks, DifferentPhotons) {
-  // Different photon counts once hung (one rank waiting in a collective call
-  // the other never made).
+  // Different photon counts would leave one rank waiting in a collective call
+  // the other never makes: refused before any tally.
   const std::string a = config("a.yaml", kBase);
   const std::string out = " --quiet -o " + path("out.h5");
   expect_refused(a + out, a + out + " --photons 5000", {"photons = 5000 on rank 1, 3000 on rank 0"});

@@ -201,7 +201,7 @@ TEST(MicrofacetDistribution, TiltedNormalInTheFiberFrame) {
   const double a = deg_to_rad(10.0);
   const Vec3 u(1, 0, 0), n0 = Vec3(0, std::cos(0.4), std::sin(0.4));
   const Vec3 n = std::cos(a) * n0 - std::sin(a) * u;
-  const MicrofacetFrame frame = MicrofacetFrame::about(n, u);
+  const MicrofacetFrame frame = MicrofacetFrame::about(n);  // about the fiber axis u
   EXPECT_NEAR(frame.t.dot(frame.n), 0.0, 1e-15);
   EXPECT_NEAR(frame.b.dot(frame.t), 0.0, 1e-15);
   EXPECT_NEAR(frame.t.cross(frame.b).dot(frame.n), 1.0, 1e-15);

@@ -97,12 +97,13 @@ TEST(PhotonFeed, SimulationTalliesOfScatteredRunsEqualOneRun) {
   EXPECT_EQ(one.photons(), kPhotons);
   EXPECT_EQ(fed.photons(), kPhotons);
   EXPECT_TRUE(one.exact().words() == fed.exact().words());
-  // The reference tracer's path (the microfacet models run there) takes the
-  // runs as well.
+  // A microfacet model (its own sampler, and with masking a list of losses
+  // per photon in flight) takes the runs as well.
   s.roughness.model = RoughnessModel::GGX;
   s.roughness.beta_long = {0.0};
   s.roughness.beta_azim = {0.0};
   s.roughness.alpha_long = s.roughness.alpha_azim = 0.1;
+  s.roughness.masking = Masking::SmithG1;
   const Simulation reference(s);
   Tally ref_one(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
   Tally ref_fed(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
@@ -110,7 +111,8 @@ TEST(PhotonFeed, SimulationTalliesOfScatteredRunsEqualOneRun) {
   reference.trace_photons(0, feed_of(scattered_runs()), ref_fed, counters);
   EXPECT_EQ(ref_fed.photons(), kPhotons);
   EXPECT_TRUE(ref_one.exact().words() == ref_fed.exact().words());
-  // Every exit scored: as many as the reference tracer finds photon by photon.
+  // Every exit scored: as many as the reference tracer finds photon by
+  // photon, and every loss booked.
   const Tracer tracer(s);
   const auto inc = s.incidences().front();
   std::uint64_t exits = 0;
@@ -120,6 +122,7 @@ TEST(PhotonFeed, SimulationTalliesOfScatteredRunsEqualOneRun) {
   }
   const std::vector<std::uint64_t> count = ref_fed.count();
   EXPECT_EQ(std::accumulate(count.begin(), count.end(), std::uint64_t{0}), exits);
+  EXPECT_GT(ref_fed.lost()[0], 0.0);
 }
 
 TEST(PhotonFeed, SingleRunHandsOutItsRunOnceThenNothing) {

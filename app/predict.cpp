@@ -1,0 +1,30 @@
+#include "app/predict.h"
+
+namespace fiberlab::app {
+
+ChosenModel choose_model(const sim::Settings& s, const compare::ModelSpec& spec,
+                         const std::vector<std::string>& sets) {
+  ChosenModel chosen;
+  chosen.spec = spec;
+  chosen.params = compare::params_for(s, spec, sets, &chosen.fiber_notes);
+  chosen.model = compare::make_model(spec.name, chosen.params);
+  return chosen;
+}
+
+compare::PredictionFile predict(const sim::Settings& s, const ChosenModel& chosen) {
+  compare::PredictionFile pred;
+  pred.model = chosen.spec.name;
+  pred.grid = BinGrid::make(s.tally.n_theta, s.tally.n_phi, s.tally.theta_bins);
+  pred.lobes = chosen.params.lobes;
+  pred.channels = static_cast<int>(chosen.params.sigma_a.size());
+  for (const sim::Settings::Incidence& inc : s.incidences()) {
+    pred.theta_i.push_back(inc.theta_i);
+    pred.phi_i.push_back(inc.phi_i);
+    const std::vector<double> p = compare::predict_bins(*chosen.model, pred.grid, inc.theta_i, inc.phi_i,
+                                                        pred.lobes, pred.channels, s.fiber.eccentricity != 1.0);
+    pred.probability.insert(pred.probability.end(), p.begin(), p.end());
+  }
+  return pred;
+}
+
+}  // namespace fiberlab::app
