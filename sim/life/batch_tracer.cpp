@@ -159,14 +159,18 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
   const std::uint64_t truncated =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kTruncated))), lanes);
-  const std::uint64_t lost = ~(exited | truncated);
+  const std::uint64_t ended =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
+  const std::uint64_t lost = ~(exited | truncated | ended);
   alignas(64) double segments[W];
   pack_store(s.segments, lanes, segments);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = (lost >> j) & 1;
+    f.ended[n + j] = (ended >> j) & 1;
     f.last[n + j] = true;
+    f.roulette[n + j] = 0.0;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
     f.scattered[n + j] = (scattered >> j) & 1;
   }
@@ -191,9 +195,10 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   f.n = n + k;
 }
 
-// The exits that the lanes `lanes` scored by expected value this step
-// (PhotonState::scored), appended to the block f as rows that are not the
-// photon's last (sim/life/finished_photons.h). A model's exit direction draws
+// The exits that the lanes `lanes` scored by expected value this step, and
+// the weight Russian roulette created or destroyed there (PhotonState::scored),
+// appended to the block f as rows that are not the photon's last
+// (sim/life/finished_photons.h). A model's exit direction draws
 // from the stream scored_exit_stream derives (sim/life/tracer.h), as the
 // reference Tracer does.
 template <class Model, class Light>
@@ -208,6 +213,9 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
   pack_store(s.scored.d.z, lanes, f.dz + n);
   pack_store(s.scored.path, lanes, f.path + n);
   pack_store(s.scored.weight, lanes, f.weight + n);
+  pack_store(s.scored.roulette, lanes, f.roulette + n);
+  const std::uint64_t exited =
+      life::pack_bits(life::lane_bits(s.scored.weight > Lanes(0.0)), lanes);
   pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
   const std::uint64_t scattered =
       life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
@@ -219,8 +227,9 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
   pack_store(s.scored.segments, lanes, segments);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
-    f.exited[n + j] = true;
+    f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = false;
+    f.ended[n + j] = false;
     f.last[n + j] = false;
     f.scattered[n + j] = (scattered >> j) & 1;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
@@ -229,6 +238,7 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
     alignas(64) std::uint64_t w[4][W];
     for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
     for (int j = 0; j < k; ++j) {
+      if (!f.exited[n + j]) continue;
       PhotonRandom rng = scored_exit_stream(w[0][j], w[1][j], w[2][j], w[3][j]);
       const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
                                        f.segments[n + j], rng);
@@ -396,8 +406,10 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
       if (expected_value) {
-        // A photon's scored exit goes before its end, if it ended this step.
-        const std::uint64_t scored = life::lane_bits(live & (s.scored.weight > Lanes(0.0)));
+        // A photon's scored exit (or roulette) goes before its end, if it
+        // ended this step.
+        const std::uint64_t scored = life::lane_bits(
+            live & ((s.scored.weight > Lanes(0.0)) | (s.scored.roulette != Lanes(0.0))));
         if (scored != 0) hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
         if (finished != 0) {
           alignas(64) std::uint64_t freed[W];

@@ -182,8 +182,10 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
 
 // A photon's rows in order (sim/life/finished_photons.h): its exits added up
 // per bin, each row's weight booked in fixed point within the room its
-// earlier rows left of its unit weight, and its masking losses (at its last
-// row) booked against all it kept.
+// earlier rows left of its unit weight (plus what Russian roulette created
+// for it), the weight roulette created or destroyed booked in the ledger's
+// roulette term, and its masking losses (at its last row) booked against
+// all it kept.
 void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin,
                                            Tally& tally) {
   constexpr int kCap = FinishedPhotons::kCapacity;
@@ -192,9 +194,10 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   std::size_t j = 0;  // the next of f.losses (in row order)
   for (int i = 0; i < f.n; ++i) {
     OpenPhoton& p = open_photon(f.slot[i]);
+    if (!f.last[i] && f.roulette[i] != 0.0) score_roulette(f, i, p, tally);
     if (f.exited[i]) {
       score_scored_exit(bin[i], weights_.data() + i, kCap, p, tally);
-    } else if (!f.lost[i]) {
+    } else if (f.last[i] && !f.lost[i] && !f.ended[i]) {
       book(weights_.data() + i, kCap, p);
       tally.score_truncated_fixed(fixed_.data());
     }
@@ -205,18 +208,25 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
         const WeightLoss& l = f.losses[j].loss;
         for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
       }
-      tally.score_lost(weight, p.booked.data());
+      // Room for the losses: 1 + created - booked (Tally::score_lost's 1 - kept).
+      fixed_.resize(channels);
+      for (int c = 0; c < channels; ++c) fixed_[c] = p.booked[c] - p.created[c];
+      tally.score_lost(weight, fixed_.data());
     }
     p.bins.clear();
     p.totals.clear();
     std::fill(p.booked.begin(), p.booked.end(), Tally::Fixed{0});
+    std::fill(p.created.begin(), p.created.end(), Tally::Fixed{0});
   }
 }
 
 ExitScorer::OpenPhoton& ExitScorer::open_photon(std::uint32_t slot) {
   if (slot >= open_.size()) {
     open_.resize(slot + 1);
-    for (OpenPhoton& p : open_) p.booked.resize(sigma_a_.size(), Tally::Fixed{0});
+    for (OpenPhoton& p : open_) {
+      p.booked.resize(sigma_a_.size(), Tally::Fixed{0});
+      p.created.resize(sigma_a_.size(), Tally::Fixed{0});
+    }
   }
   return open_[slot];
 }
@@ -233,7 +243,7 @@ void ExitScorer::book(const double* weight, std::size_t stride, OpenPhoton& p) {
   fixed_.resize(channels);
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
-    const Tally::Fixed room = Tally::kOne - p.booked[c];
+    const Tally::Fixed room = Tally::kOne + p.created[c] - p.booked[c];
     if (w > room) {
       if (w - room > Tally::kRoundingAllowance)
         throw Error(fmt::format("internal error: a photon's exits and truncated weight exceed 1 "
@@ -243,6 +253,32 @@ void ExitScorer::book(const double* weight, std::size_t stride, OpenPhoton& p) {
     p.booked[c] += w;
     fixed_[c] = w;
   }
+}
+
+// Row i's Russian roulette (f.roulette[i], before absorption), absorbed along
+// the path to it: weight created widens the photon's room; weight destroyed
+// is booked like an exit (within the room), and the ledger's roulette term
+// gains the signed amount.
+void ExitScorer::score_roulette(const FinishedPhotons& f, int i, OpenPhoton& p, Tally& tally) {
+  const std::size_t channels = sigma_a_.size();
+  const double r = f.roulette[i];
+  growth_.resize(channels);
+  for (std::size_t c = 0; c < channels; ++c) {
+    double exponent = -sigma_a_[c] * f.path[i];
+    if (!medulla_sigma_a_.empty()) exponent -= medulla_sigma_a_[c] * f.medulla_path[i];
+    growth_[c] = std::abs(r) * std::exp(exponent);
+  }
+  if (r > 0.0) {
+    fixed_.resize(channels);
+    for (std::size_t c = 0; c < channels; ++c) {
+      fixed_[c] = Tally::to_fixed(growth_[c]);
+      p.created[c] += fixed_[c];
+    }
+  } else {
+    book(growth_.data(), 1, p);
+    for (std::size_t c = 0; c < channels; ++c) fixed_[c] = -fixed_[c];
+  }
+  tally.score_roulette_fixed(fixed_.data());
 }
 
 void ExitScorer::score_scored_exit(std::size_t bin, const double* weight, std::size_t stride,

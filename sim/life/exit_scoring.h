@@ -47,6 +47,7 @@ class ExitScorer {
     std::vector<std::size_t> bins;
     std::vector<double> totals;
     std::vector<Tally::Fixed> booked;
+    std::vector<Tally::Fixed> created;  // [channel]: weight Russian roulette created for it
   };
   std::vector<OpenPhoton> open_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
@@ -55,6 +56,7 @@ class ExitScorer {
   void book(const double* weight, std::size_t stride, OpenPhoton& p);
   void score_scored_exit(std::size_t bin, const double* weight, std::size_t stride, OpenPhoton& p,
                          Tally& tally);
+  void score_roulette(const FinishedPhotons& f, int i, OpenPhoton& p, Tally& tally);
   void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within
   // a margin), so that most vectors of bins need no settling on the edges.

@@ -3,9 +3,10 @@
 // (structure of arrays), so that weights are computed vectorised and the
 // tally's cells fetched ahead, instead of one call per photon.
 //
-// A row is a photon's end (exited, truncated or lost; `last`), or, with
-// expected-value scoring (Settings::estimator), an exit it scored on the
-// way (exited, not `last`). A photon's rows come in the order it made them,
+// A row is a photon's end (exited, truncated, lost or ended; `last`), or,
+// with expected-value scoring (Settings::estimator), a point on its way
+// (not `last`) where it scored an exit (`exited`, weight > 0), or Russian
+// roulette created or destroyed weight (`roulette` != 0), or both. A photon's rows come in the order it made them,
 // its end last, and carry the tracer's `slot` for the photon: no other
 // photon uses that slot until the photon's last row, so the scorer can add
 // up a photon's exits per bin (SPEC section 6: S2 holds the square of a
@@ -32,7 +33,9 @@ struct FinishedPhotons {
   int segments[kCapacity];
   bool exited[kCapacity];
   bool lost[kCapacity];  // killed by masking (its weight is in `losses`)
-  bool last[kCapacity];  // the photon's end (false: an exit scored on the way)
+  bool ended[kCapacity];  // ended by Russian roulette (its weight is in an earlier row's `roulette`)
+  bool last[kCapacity];  // the photon's end (false: a point on its way)
+  double roulette[kCapacity];  // not `last`: Russian roulette's signed weight there, before absorption
   std::uint32_t slot[kCapacity];  // the photon's slot in its tracer
   // Weight removed by masking from the block's photons (empty
   // without masking): photon slot, weight, path length at the removal.
@@ -52,11 +55,13 @@ struct FinishedPhotons {
     for (double* column : {path, weight, phi_i, dx, dy, dz, medulla_path})
       std::fill(column + n, column + end, 0.0);
   }
-  // An exit that photon `index` scored by expected value (one photon at a
-  // time: slot 0).
+  // A point on photon `index`'s way (an exit it scored by expected value,
+  // Russian roulette; one photon at a time: slot 0).
   void add_scored(std::uint64_t index, double incident_phi, const ScoredExitOutcome& e) {
     if (n == 0) losses.clear();  // a new block (callers reset n after scoring)
     weight[n] = e.weight;
+    roulette[n] = e.roulette;
+    ended[n] = false;
     lost[n] = false;
     last[n] = false;
     slot[n] = 0;
@@ -66,7 +71,7 @@ struct FinishedPhotons {
     medulla_path[n] = e.medulla_path;
     scattered[n] = e.scattered;
     segments[n] = e.segments;
-    exited[n] = true;
+    exited[n] = e.weight > 0.0;
     theta[n] = inclination(e.direction);
     phi[n] = azimuth(e.direction);
     dx[n] = e.direction.x();
@@ -81,7 +86,9 @@ struct FinishedPhotons {
     last[n] = true;
     slot[n] = 0;
     weight[n] = o.weight;
+    roulette[n] = 0.0;
     lost[n] = o.fate == PhotonFate::Lost;
+    ended[n] = o.fate == PhotonFate::Ended;
     photon[n] = index;
     phi_i[n] = incident_phi;
     path[n] = o.path_length;
@@ -98,7 +105,10 @@ struct FinishedPhotons {
   }
   PhotonOutcome outcome(int i) const {
     PhotonOutcome o;
-    o.fate = exited[i] ? PhotonFate::Exited : lost[i] ? PhotonFate::Lost : PhotonFate::Truncated;
+    o.fate = exited[i] ? PhotonFate::Exited
+             : lost[i] ? PhotonFate::Lost
+             : ended[i] ? PhotonFate::Ended
+                        : PhotonFate::Truncated;
     o.weight = weight[i];
     for (const Loss& l : losses)
       if (l.slot == i) o.losses.push_back(l.loss);

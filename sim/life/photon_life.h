@@ -28,18 +28,24 @@
 
 namespace fiberlab::sim::life {
 
-// Expected-value scoring of exits (Settings::estimator, SPEC section 5) runs
-// while the photon's throughput weight is at least this; below it the
-// photon's choices are analog, so that its path ends by an exit as in the
-// analog estimator instead of running on at ever smaller weight (this is
-// the unbiased end of the path that docs/PHYSICS.md "Estimator" names: no
-// Russian roulette, and the ledger closes per photon to rounding). Each
-// event's choice between the two rules depends only on the weight before
-// it, so the expectation is unchanged.
-inline constexpr double kExpectedValueMinWeight = 0x1.0p-7;
+// Russian roulette with expected-value scoring of exits (SPEC section 5;
+// docs/PHYSICS.md "Estimator"): a photon at a boundary point whose
+// throughput weight w has fallen below kRouletteBelow survives with
+// probability w / kRouletteWeight and then carries kRouletteWeight, else its
+// path ends (fate Ended). The expectation of its weight is w either way, so
+// every tally is unbiased; the weight created (kRouletteWeight - w) and
+// destroyed (w) is booked, absorbed along the path so far, in the signed
+// ledger term `roulette`, whose expectation is 0. At 0.03 most photons have
+// scored their R, TT and TRT exits first (w ~ F ~ 0.05 after TT on a smooth
+// fiber, ~F^2 after TRT). Of the pairs (below, weight) tried, (0.003, 0.05),
+// (0.01, 0.05 / 0.1 / 0.25 / 1) and (0.03, 0.3), this one gave the most error
+// per second on bench/configs cases b and c (docs/PHYSICS.md "Estimator").
+inline constexpr double kRouletteBelow = 0.03;
+inline constexpr double kRouletteWeight = 0.3;
 
 // What a photon does next.
-enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kLost = 4 };
+// kEnded: ended by Russian roulette (expected-value scoring only).
+enum LaneCode : int { kAtBoundary = 0, kExited = 1, kTruncated = 2, kTravel = 3, kLost = 4, kEnded = 5 };
 
 // The fixed parts of one configuration.
 struct LifeConfig {
@@ -60,13 +66,14 @@ struct LifeConfig {
     const EllipseCrossSection e(s.fiber.eccentricity);
     return {e.r_v(), e.r_w(), m.radius, m.sigma_s, m.g, s.fiber.eta, m.eta, s.max_segments};
   }
-  bool expected_value;  // expected-value scoring of exits (kExpectedValueMinWeight)
+  bool expected_value;  // expected-value scoring of exits, with Russian roulette (kRouletteBelow)
 };
 
 // The exit a photon scored at its last interface event by expected value
-// (weight 0: none), before its next segment: where and how it left. Not
-// part of the photon's lasting state (the batched tracer hands it over after
-// each step and does not keep it).
+// (weight 0: none), before its next segment: where and how it left; and the
+// weight Russian roulette created (> 0) or destroyed (< 0) before that event
+// (0: none), at the same path length. Not part of the photon's lasting state
+// (the batched tracer hands it over after each step and does not keep it).
 template <class T>
 struct ScoredExit {
   T weight;       // throughput before absorption: weight times the leaving probability
@@ -75,6 +82,7 @@ struct ScoredExit {
   T segments;     // the lobe index p
   T medulla_path;  // 3D path length inside the medulla so far
   T scatters;      // scattering events in the medulla so far
+  T roulette;      // signed weight of this step's Russian roulette, before absorption
 };
 
 template <class T, class Light>
@@ -102,7 +110,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          zero, zero, {zero, d, zero, zero, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -132,7 +140,12 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
     s.losses.add(r.scored & (w.factor < T(1.0)), exit_weight * (T(1.0) - w.factor), s.path);
     exit_weight = select(r.scored, select(w.lost, T(0.0), exit_weight * w.factor), T(0.0));
   }
-  s.scored = {exit_weight, r.leave_direction, s.path, s.segments, s.medulla_path, s.scatters};
+  s.scored.weight = exit_weight;
+  s.scored.d = r.leave_direction;
+  s.scored.path = s.path;
+  s.scored.segments = s.segments;
+  s.scored.medulla_path = s.medulla_path;
+  s.scored.scatters = s.scatters;
   s.weight = select(r.scored, s.weight * (T(1.0) - r.p_leave), s.weight);
 }
 
@@ -156,8 +169,7 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   const MaskOf<T> act = f.ready;  // never failed too (sim/roughness/roughness_model.h)
   const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
                                 select(inside, T(c.eta), T(1.0 / c.eta))};
-  const MaskOf<T> eligible = act & (s.weight >= T(kExpectedValueMinWeight));
-  const ExitScoring<T> scoring{c.expected_value, eligible, inside, n0};
+  const ExitScoring<T> scoring{c.expected_value, act, inside, n0};
   const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng, scoring);
   const Vec3Of<T> d = select(act, r.direction, s.d);
   if (c.expected_value) score_leaving_branch(model, s, r, frame, f.m, inside);
@@ -218,13 +230,33 @@ template <class T, class Light>
   s.code = select(stuck, T(kTruncated), s.code);
 }
 
+// Russian roulette (kRouletteBelow) for the photons in `live` at a boundary
+// point, before their interface event; gives back the lanes that go on.
+// Draws from a lane's stream only where it plays, so the analog estimator's
+// streams are untouched.
+template <class T, class Light>
+MaskOf<T> russian_roulette(PhotonState<T, Light>& s, const MaskOf<T>& live) {
+  s.scored.roulette = T(0.0);
+  const MaskOf<T> play = live & (s.weight < T(kRouletteBelow)) & (s.weight > T(0.0));
+  if (!any(play)) return live;
+  const T u = s.rng.uniform(play);
+  const MaskOf<T> survive = play & (u * T(kRouletteWeight) < s.weight);
+  const MaskOf<T> ended = play & !survive;
+  s.scored.roulette =
+      select(survive, T(kRouletteWeight) - s.weight, select(ended, -s.weight, T(0.0)));
+  s.weight = select(survive, T(kRouletteWeight), select(ended, T(0.0), s.weight));
+  s.code = select(ended, T(kEnded), s.code);
+  return live & !ended;
+}
+
 // One step of the life for the photons in `live`, all at a boundary point:
 // an interface event, then the next segment for those that go on inside.
 template <class T, class Model, class Light>
 void step(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
           const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
-  interface_event(c, model, s, live, counts, rounds);
-  travel(c, s, live);
+  const MaskOf<T> go = c.expected_value ? russian_roulette(s, live) : live;
+  interface_event(c, model, s, go, counts, rounds);
+  travel(c, s, go);
 }
 
 }  // namespace fiberlab::sim::life

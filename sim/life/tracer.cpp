@@ -25,11 +25,15 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   std::vector<ScoredExitOutcome> scored;
   while (s.code == static_cast<double>(life::kAtBoundary)) {
     step(config_, model, s, true, counts, kMaxNormalTries);
-    if (config_.expected_value && s.scored.weight > 0.0) {
-      PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
+    if (config_.expected_value && (s.scored.weight > 0.0 || s.scored.roulette != 0.0)) {
       const int p = static_cast<int>(s.scored.segments);
-      scored.push_back({exit_direction_of(model, s.scored.d.to_vec3(), p, blur), p, s.scored.path,
-                        s.scored.weight, s.scored.medulla_path, s.scored.scatters > 0.0});
+      Vec3 d = s.scored.d.to_vec3();
+      if (s.scored.weight > 0.0) {
+        PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
+        d = exit_direction_of(model, d, p, blur);
+      }
+      scored.push_back({d, p, s.scored.path, s.scored.weight, s.scored.medulla_path,
+                        s.scored.scatters > 0.0, s.scored.roulette});
     }
   }
   rng.core() = s.rng;

@@ -14,7 +14,9 @@
 namespace fiberlab::sim {
 
 // Lost: a roughness model ended the path (its weight is booked as lost).
-enum class PhotonFate { Exited, Truncated, Lost };
+// Ended: Russian roulette ended the path (expected-value scoring; the
+// weight it had is booked in the ledger's roulette term).
+enum class PhotonFate { Exited, Truncated, Lost, Ended };
 
 // An exit scored by expected value (Settings::estimator) before the
 // photon's life ended: it left along `direction` after `segments` segments
@@ -25,6 +27,9 @@ struct ScoredExitOutcome {
   double path_length, weight;
   double medulla_path = 0.0;  // with a medulla: the length inside it so far
   bool scattered = false;     // scattered in the medulla so far (lobe `scattered`)
+  // Weight Russian roulette created (> 0) or destroyed (< 0) at this point,
+  // before absorption; a row with weight 0 carries only this.
+  double roulette = 0.0;
 };
 
 struct PhotonOutcome {
@@ -69,6 +74,7 @@ struct TracerCounters {
 inline PhotonFate fate_of(int code) {
   return code == life::kExited      ? PhotonFate::Exited
          : code == life::kTruncated ? PhotonFate::Truncated
+         : code == life::kEnded     ? PhotonFate::Ended
                                     : PhotonFate::Lost;
 }
 

@@ -17,7 +17,8 @@ ExactTally::ExactTally(const TallyShape& s)
       exited(static_cast<std::size_t>(s.lobes) * s.channels, 0),
       absorbed(s.channels, 0),
       truncated(s.channels, 0),
-      lost(s.channels, 0) {}
+      lost(s.channels, 0),
+      roulette(s.channels, 0) {}
 
 namespace {
 
@@ -44,27 +45,28 @@ ExactTally& ExactTally::operator+=(const ExactTally& o) {
   add_words(absorbed, o.absorbed);
   add_words(truncated, o.truncated);
   add_words(lost, o.lost);
+  add_words(roulette, o.roulette);  // two's complement: exact modulo 2^128
   return *this;
 }
 
 std::vector<ExactTally::Word> ExactTally::words() const {
   std::vector<Word> w;
-  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size());
+  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 4 * absorbed.size());
   w.push_back(photons);
   w.insert(w.end(), count.begin(), count.end());
-  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
+  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost, &roulette})
     w.insert(w.end(), v->begin(), v->end());
   return w;
 }
 
 void ExactTally::from_words(const std::vector<Word>& w) {
   const std::size_t expected =
-      1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size();
+      1 + count.size() + 2 * weight_sum.size() + exited.size() + 4 * absorbed.size();
   if (w.size() != expected) throw Error("internal error: tally words of the wrong size");
   std::size_t i = 0;
   photons = static_cast<std::uint64_t>(w[i++]);
   for (auto& c : count) c = static_cast<std::uint64_t>(w[i++]);
-  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
+  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost, &roulette})
     for (auto& x : *v) x = w[i++];
 }
 
@@ -111,6 +113,12 @@ double nearest_double(ExactTally::Word e) {
 }
 
 }  // namespace
+
+std::vector<double> ExactTally::to_double_signed(const std::vector<Word>& v) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(static_cast<__int128>(v[i])) / kScale;
+  return out;
+}
 
 void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out) {
   out.resize(v.size());

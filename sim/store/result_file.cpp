@@ -76,6 +76,7 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
     append(r.absorbed, t.absorbed());
     append(r.truncated, t.truncated());
     append(r.lost, t.lost());
+    append(r.roulette, t.roulette());
   }
   return r;
 }
@@ -122,6 +123,7 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
     f.write("/ledger/lost", {K, C}, r.lost);
+    if (r.settings.estimator == Estimator::ExpectedValue) f.write("/ledger/roulette", {K, C}, r.roulette);
     describe_result_file(f, r);
     describe_tally_photons(f);
     f.close();

@@ -27,6 +27,9 @@ struct ResultFile {
   std::vector<double> exited;           // K x L x C
   std::vector<double> absorbed, truncated;  // K x C
   std::vector<double> lost;  // K x C: removed by masking (0 unless roughness.masking)
+  // K x C, signed: weight Russian roulette created minus destroyed (0 with
+  // the analog estimator, whose files have no /ledger/roulette).
+  std::vector<double> roulette;
 
   std::size_t configs() const { return photons.size(); }
   std::size_t bin_cells() const {

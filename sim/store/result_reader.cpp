@@ -97,12 +97,14 @@ class Reader {
         fail(fmt::format("/tally/count sums to {} for incident direction {} (must be at most "
                          "/tally/photons[{}] = {})", static_cast<double>(counted), k, k, n));
       for (std::size_t c = 0; c < d.C; ++c) {
-        double total = r.absorbed[k * d.C + c] + r.truncated[k * d.C + c] + r.lost[k * d.C + c];
+        double total = r.absorbed[k * d.C + c] + r.truncated[k * d.C + c] + r.lost[k * d.C + c] -
+                       r.roulette[k * d.C + c];
         for (std::size_t l = 0; l < d.L; ++l) total += r.exited[(k * d.L + l) * d.C + c];
         const double N = static_cast<double>(n);
         if (!(std::fabs(total - N) <= kLedgerTolerance * N))
           fail(fmt::format("/ledger does not balance for incident direction {}, channel {}: "
-                           "exited + absorbed + truncated + lost = {} (must equal /tally/photons[{}] = {})",
+                           "exited + absorbed + truncated + lost - roulette = {} (must equal "
+                           "/tally/photons[{}] = {})",
                            k, c, total, k, n));
       }
     }
@@ -172,6 +174,16 @@ ResultFile read_result(const std::string& path) {
     rd.check_sums("/ledger/lost", r.lost);
   } else {
     r.lost.assign(d.K * d.C, 0.0);
+  }
+  // /ledger/roulette (signed; expected-value scoring only): absent, 0.
+  if (f.exists("/ledger/roulette")) {
+    r.roulette = f.read_doubles("/ledger/roulette", {d.K, d.C}, "K x C, " + sizes);
+    for (std::size_t i = 0; i < r.roulette.size(); ++i)
+      if (!std::isfinite(r.roulette[i]))
+        rd.fail(fmt::format("/ledger/roulette holds {} at flat index {} (must be finite)",
+                            r.roulette[i], i));
+  } else {
+    r.roulette.assign(d.K * d.C, 0.0);
   }
   rd.check_balance(r, d);
   return r;

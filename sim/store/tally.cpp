@@ -13,6 +13,7 @@ Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
       memory_(bins() * block() * sizeof(Fixed)), touched_(pages(), 0) {
   truncated_.assign(channels, 0);
   lost_.assign(channels, 0);
+  roulette_.assign(channels, 0);
 }
 
 Tally::Tally(const Tally& o) : Tally(o.lobes_, o.n_theta_, o.n_phi_, o.channels_) { add(o); }
@@ -32,6 +33,7 @@ void Tally::clear() {
   photons_ = 0;
   std::fill(truncated_.begin(), truncated_.end(), Fixed{0});
   std::fill(lost_.begin(), lost_.end(), Fixed{0});
+  std::fill(roulette_.begin(), roulette_.end(), Fixed{0});
 }
 
 void Tally::score_truncated(const double* weight) {
@@ -75,6 +77,7 @@ void Tally::add(const Tally& o, int threads) {
   for (int c = 0; c < channels_; ++c) {
     truncated_[c] += o.truncated_[c];
     lost_[c] += o.lost_[c];
+    roulette_[c] += o.roulette_[c];
   }
 }
 
@@ -82,7 +85,8 @@ bool Tally::is_zero() const {
   const auto zero = [](auto x) { return x == 0; };
   return photons_ == 0 && std::all_of(touched_.begin(), touched_.end(), zero) &&
          std::all_of(truncated_.begin(), truncated_.end(), zero) &&
-         std::all_of(lost_.begin(), lost_.end(), zero);
+         std::all_of(lost_.begin(), lost_.end(), zero) &&
+         std::all_of(roulette_.begin(), roulette_.end(), zero);
 }
 
 ExactTally Tally::exact() const {
@@ -97,6 +101,7 @@ ExactTally Tally::exact() const {
   e.absorbed = std::move(ledger.absorbed);
   e.truncated = std::move(ledger.truncated);
   e.lost = std::move(ledger.lost);
+  e.roulette = std::move(ledger.roulette);
   return e;
 }
 
@@ -160,9 +165,11 @@ ExactLedger Tally::exact_ledger() const {
     Fixed absorbed = static_cast<Fixed>(photons_) << 60;
     for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
     absorbed -= truncated_[c] + lost_[c];
+    absorbed += roulette_[c];
     e.absorbed.push_back(static_cast<ExactTally::Word>(absorbed));
     e.truncated.push_back(static_cast<ExactTally::Word>(truncated_[c]));
     e.lost.push_back(static_cast<ExactTally::Word>(lost_[c]));
+    e.roulette.push_back(static_cast<ExactTally::Word>(roulette_[c]));  // two's complement
   }
   return e;
 }
@@ -188,6 +195,7 @@ void Tally::add(const ExactTally& e) {
   for (std::size_t c = 0; c < C; ++c) {
     truncated_[c] += static_cast<Fixed>(e.truncated[c]);
     lost_[c] += static_cast<Fixed>(e.lost[c]);
+    roulette_[c] += static_cast<Fixed>(e.roulette[c]);
   }
 }
 
@@ -218,7 +226,9 @@ std::vector<std::uint64_t> Tally::count() const {
 }
 // The ledger (SPEC section 4) from the bins: exited is the sum of S1 over a
 // lobe's bins, and every photon launched left a weight w that exited or was
-// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed.
+// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed
+// (with Russian roulette, 1 + the weight it created - the weight it
+// destroyed - w - lost: the signed term `roulette` is added to absorbed).
 // Integer sums: exactly what per-photon counters would hold.
 std::vector<Tally::Fixed> Tally::exited_fixed() const {
   std::vector<Fixed> out(static_cast<std::size_t>(lobes_) * channels_, 0);
@@ -237,6 +247,7 @@ std::vector<double> Tally::exited() const { return to_double(exited_fixed()); }
 std::vector<double> Tally::absorbed() const { return ExactTally::to_double(exact_ledger().absorbed); }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
 std::vector<double> Tally::lost() const { return to_double(lost_); }
+std::vector<double> Tally::roulette() const { return to_double(roulette_); }
 
 std::vector<std::size_t> Tally::touched_bins_per_lobe() const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;

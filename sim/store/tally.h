@@ -77,6 +77,13 @@ class Tally {
   void score_truncated_fixed(const Fixed* weight) {
     for (int c = 0; c < channels_; ++c) truncated_[c] += weight[c];
   }
+  // Weight Russian roulette created (> 0) or destroyed (< 0) in fixed point,
+  // absorbed along the path before it (expected-value scoring): the ledger's
+  // signed `roulette`, with exited + absorbed + truncated + lost - roulette
+  // = launched (sim/life/photon_life.h kRouletteBelow).
+  void score_roulette_fixed(const Fixed* delta) {
+    for (int c = 0; c < channels_; ++c) roulette_[c] += delta[c];
+  }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static constexpr Fixed kOne = Fixed{1} << 60;
   // What a photon's parts may exceed its unit weight by, in fixed point, as
@@ -140,6 +147,7 @@ class Tally {
   std::vector<double> absorbed() const;   // [channel]
   std::vector<double> truncated() const;  // [channel]
   std::vector<double> lost() const;       // [channel]
+  std::vector<double> roulette() const;   // [channel], signed
 
  private:
   // Bins are tracked in pages of kPageBins consecutive bins.
@@ -164,6 +172,7 @@ class Tally {
   std::vector<std::uint8_t> touched_;   // [page]: 1 once a cell of the page was written
   std::vector<Fixed> truncated_;
   std::vector<Fixed> lost_;
+  std::vector<Fixed> roulette_;  // signed
 };
 
 }  // namespace fiberlab::sim

@@ -1,8 +1,14 @@
 // Expected-value scoring of exits (Settings::estimator, SPEC sections 5 and
 // 6; docs/PHYSICS.md "Estimator"):
-// - every photon's scored exits, its end and its masking losses add up to
-//   its starting weight, to rounding (no Russian roulette: the ledger closes
-//   per photon), with scalar and Stokes light and with Smith G1 masking;
+// - every photon's scored exits, its end and its masking losses, minus the
+//   weight Russian roulette created for it (plus what it destroyed), add up
+//   to its starting weight, to rounding, with scalar and Stokes light and
+//   with Smith G1 masking;
+// - the roulette term has expectation 0: its mean over many photons is
+//   within 4 of its standard errors of 0 (mutation: survivors carrying twice
+//   kRouletteWeight while the term books kRouletteWeight - w fails it), and
+//   the file's ledger exited + absorbed + truncated + lost - roulette =
+//   launched holds to rounding;
 // - the reported standard errors agree with the spread of the estimates over
 //   many seeds, lobe by lobe, the last lobe (which collects several exits of
 //   one photon in one bin) included. Mutations caught: S2 as the sum of the
@@ -25,7 +31,8 @@ namespace fiberlab::sim {
 namespace {
 
 // Each photon's scored exits + its final weight (exited or truncated) + its
-// losses = 1 (white fiber: nothing absorbed), to rounding.
+// losses - what roulette created or destroyed = 1 (white fiber: nothing
+// absorbed), to rounding.
 void expect_ledger_closes(const Settings& s, const char* what) {
   const Tracer tracer(s);
   const auto inc = s.incidences().front();
@@ -35,7 +42,7 @@ void expect_ledger_closes(const Settings& s, const char* what) {
     LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, false);
     const PhotonOutcome o = tracer.trace(p.wi, p.h, p.rng);
     double total = o.fate == PhotonFate::Lost ? 0.0 : o.weight;
-    for (const ScoredExitOutcome& e : o.scored) total += e.weight;
+    for (const ScoredExitOutcome& e : o.scored) total += e.weight - e.roulette;
     for (const WeightLoss& l : o.losses) total += l.weight;
     scored += o.scored.size();
     worst = std::max(worst, std::abs(total - 1.0));
@@ -68,6 +75,41 @@ TEST(Estimator, FileLedgerClosesOnWhiteFiber) {
   testing::make_rough(s, 10.0, 3.0);
   const ResultFile r = testing::run(s, 2);
   EXPECT_NEAR(r.absorbed[0], 0.0, 1e-9);
+  EXPECT_NE(r.roulette[0], 0.0);  // roulette was played, and booked
+}
+
+// Russian roulette's term per photon (its rows' roulette, absorbed along
+// the path to each), over 200,000 photons of an absorbing rough tilted
+// ellipse: mean within 4 standard errors of 0 (the term is a sum of
+// independent per-photon terms with expectation 0; 4 sigma: a false alarm
+// once in ~16,000 runs of a fixed seed).
+TEST(Estimator, RouletteTermHasExpectationZero) {
+  Settings s = testing::smooth_circle(30.0, 1);
+  s.estimator = Estimator::ExpectedValue;
+  testing::make_rough(s, 10.0, 3.0);
+  s.fiber.eccentricity = 0.8;
+  const double sigma_a = 0.2;
+  const Tracer tracer(s);
+  const auto inc = s.incidences().front();
+  constexpr int kPhotons = 200000;
+  double sum = 0.0, sum_sq = 0.0;
+  int played = 0;
+  for (std::uint64_t i = 0; i < kPhotons; ++i) {
+    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, false);
+    const PhotonOutcome o = tracer.trace(p.wi, p.h, p.rng);
+    double r = 0.0;
+    for (const ScoredExitOutcome& e : o.scored) {
+      r += e.roulette * std::exp(-sigma_a * e.path_length);
+      played += e.roulette != 0.0;
+    }
+    sum += r;
+    sum_sq += r * r;
+  }
+  const double mean = sum / kPhotons;
+  const double se = std::sqrt((sum_sq / kPhotons - mean * mean) / (kPhotons - 1));
+  std::printf("roulette played %d times; mean term %.3g, standard error %.3g\n", played, mean, se);
+  EXPECT_GT(played, kPhotons / 10);
+  EXPECT_LT(std::abs(mean), 4.0 * se);
 }
 
 // The spread of P_b over M seeds against the mean reported SE_b^2, summed
