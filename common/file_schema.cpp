@@ -72,6 +72,11 @@ void describe_result_datasets(h5::File& f) {
   describe(f, "/ledger/lost", "incidence,channel", "weight",
            "weight removed by masking (roughness.masking smith_g1: 1 - G1 at each event, and paths "
            "killed on the wrong side of the mean surface); 0 otherwise (divide by N)");
+  if (f.exists("/tally/lobe_weight_sq_sum"))
+    describe(f, "/tally/lobe_weight_sq_sum", "incidence,lobe,channel", "weight^2",
+             "per lobe, the sum over photons of the square of each photon's total in the lobe "
+             "(estimator expected_value: a photon may leave in several bins of a lobe); the "
+             "lobe energy's standard error sqrt((S2/N - E^2)/(N - 1)), E = exited/N");
   if (f.exists("/ledger/roulette"))
     describe(f, "/ledger/roulette", "incidence,channel", "weight",
              "signed: weight Russian roulette created minus weight it destroyed (estimator "
@@ -97,6 +102,9 @@ void describe_exact_datasets(h5::File& f) {
   for (const char* name : {"absorbed", "truncated", "lost"})
     describe(f, std::string("/exact/") + name, "incidence,channel,word", "weight x 2^60",
              fmt::format("exact /ledger/{}: {}", name, pairs));
+  if (f.exists("/exact/lobe_weight_sq_sum"))
+    describe(f, "/exact/lobe_weight_sq_sum", "incidence,lobe,channel,word", "weight^2 x 2^60",
+             std::string("exact /tally/lobe_weight_sq_sum: ") + pairs);
   if (f.exists("/exact/roulette"))
     describe(f, "/exact/roulette", "incidence,channel,word", "weight x 2^60",
              "exact /ledger/roulette: (high, low) 64-bit words of the exact sum x 2^60, a signed "

@@ -93,6 +93,7 @@ ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lob
       medulla_sigma_a_(std::move(medulla_sigma_a)),
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()), expected_value_(expected_value),
+      bins_per_lobe_(static_cast<std::size_t>(grid.n_theta()) * grid.n_phi()),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -213,6 +214,10 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
       for (int c = 0; c < channels; ++c) fixed_[c] = p.booked[c] - p.created[c];
       tally.score_lost(weight, fixed_.data());
     }
+    for (std::size_t e = 0; e < p.lobes.size(); ++e)
+      tally.score_lobe_square(p.lobes[e], p.lobe_totals.data() + e * channels);
+    p.lobes.clear();
+    p.lobe_totals.clear();
     p.bins.clear();
     p.totals.clear();
     std::fill(p.booked.begin(), p.booked.end(), Tally::Fixed{0});
@@ -286,6 +291,15 @@ void ExitScorer::score_scored_exit(std::size_t bin, const double* weight, std::s
   const std::size_t channels = sigma_a_.size();
   book(weight, stride, p);
   growth_.resize(channels);
+  // The photon's total in the bin's lobe (the lobe's S2 holds its square).
+  const int lobe = static_cast<int>(bin / bins_per_lobe_);
+  std::size_t entry = 0;
+  while (entry < p.lobes.size() && p.lobes[entry] != lobe) ++entry;
+  if (entry == p.lobes.size()) {
+    p.lobes.push_back(lobe);
+    p.lobe_totals.insert(p.lobe_totals.end(), channels, 0.0);
+  }
+  for (std::size_t c = 0; c < channels; ++c) p.lobe_totals[entry * channels + c] += weight[c * stride];
   for (std::size_t e = 0; e < p.bins.size(); ++e) {
     if (p.bins[e] != bin) continue;
     // (t + w)^2 - t^2 = w (2 t + w): S2 ends with the square of the photon's total.

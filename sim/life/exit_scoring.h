@@ -40,6 +40,7 @@ class ExitScorer {
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
   bool expected_value_;
+  std::size_t bins_per_lobe_;  // a bin index / this = its lobe (Tally::bin_index)
   // Per slot, the photon in it so far: the bins it left in with its total
   // weight there ([entry][channel]), and its exited weight ([channel]).
   // weight so far in fixed point ([channel]: what it booked in the tally).
@@ -48,6 +49,8 @@ class ExitScorer {
     std::vector<double> totals;
     std::vector<Tally::Fixed> booked;
     std::vector<Tally::Fixed> created;  // [channel]: weight Russian roulette created for it
+    std::vector<int> lobes;             // the lobes it left in, with its total there
+    std::vector<double> lobe_totals;    // ([entry][channel]), for Tally::score_lobe_square
   };
   std::vector<OpenPhoton> open_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked

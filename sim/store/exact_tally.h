@@ -30,6 +30,7 @@ struct ExactLedger {
   std::uint64_t photons = 0;
   std::vector<unsigned __int128> exited, absorbed, truncated, lost;
   std::vector<unsigned __int128> roulette;  // signed, two's complement (ExactTally::roulette)
+  std::vector<unsigned __int128> lobe_weight_sq_sum;  // [lobe][channel] (ExactTally's)
 };
 
 struct ExactTally {
@@ -49,18 +50,25 @@ struct ExactTally {
   // (expected-value scoring; 0 otherwise), a signed 128-bit integer held in
   // two's complement: sums wrap modulo 2^128 and stay exact.
   std::vector<Word> roulette;
+  // [lobe][channel]: the sum over photons of the square of each photon's
+  // total in the lobe (expected-value scoring, Tally::score_lobe_square).
+  // All 0 for the analog estimator, whose lobe S2 is the sum of its bins' S2.
+  std::vector<Word> lobe_weight_sq_sum;
+  bool has_lobe_weight_sq_sum() const;
 
   // Exact sum; throws fiberlab::Error when a count would overflow 64 bits.
   ExactTally& operator+=(const ExactTally& other);
 
   // Every number as one flat array of words (photons, count, weight_sum,
-  // weight_sq_sum, exited, absorbed, truncated, lost, roulette), for element-wise sums
+  // weight_sq_sum, exited, absorbed, truncated, lost, roulette,
+  // lobe_weight_sq_sum), for element-wise sums
   // across MPI ranks; from_words() is its inverse.
   std::vector<Word> words() const;
   void from_words(const std::vector<Word>& w);
 
-  // Per lobe and channel, the lobe's S1 (= exited) and S2 (sum over its bins):
-  // [lobe][channel], S1 first, then S2. What --target-error judges.
+  // Per lobe and channel, the lobe's S1 (= exited) and S2 (lobe_weight_sq_sum
+  // where kept, else the sum over its bins): [lobe][channel], S1 first, then
+  // S2. What --target-error judges.
   std::vector<Word> lobe_moments() const;
 
   // Lobe l's bins in file order, as the result file stores them (the result
@@ -71,7 +79,9 @@ struct ExactTally {
   void lobe_counts(int l, std::vector<std::uint64_t>& out) const;
   void lobe_sums(int l, BinSum which, std::vector<double>& value,
                  std::vector<std::int64_t>& residual) const;
-  ExactLedger ledger() const { return {photons, exited, absorbed, truncated, lost, roulette}; }
+  ExactLedger ledger() const {
+    return {photons, exited, absorbed, truncated, lost, roulette, lobe_weight_sq_sum};
+  }
 
   static std::vector<double> to_double(const std::vector<Word>& v);
   // The same for a signed (two's complement) sum: `roulette`.

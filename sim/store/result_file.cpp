@@ -77,6 +77,8 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
     append(r.truncated, t.truncated());
     append(r.lost, t.lost());
     append(r.roulette, t.roulette());
+    if (settings.estimator == Estimator::ExpectedValue)
+      append(r.lobe_weight_sq_sum, ExactTally::to_double(t.exact_ledger().lobe_weight_sq_sum));
   }
   return r;
 }
@@ -123,7 +125,10 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
     f.write("/ledger/lost", {K, C}, r.lost);
-    if (r.settings.estimator == Estimator::ExpectedValue) f.write("/ledger/roulette", {K, C}, r.roulette);
+    if (r.settings.estimator == Estimator::ExpectedValue) {
+      f.write("/ledger/roulette", {K, C}, r.roulette);
+      f.write("/tally/lobe_weight_sq_sum", {K, L, C}, r.lobe_weight_sq_sum);
+    }
     describe_result_file(f, r);
     describe_tally_photons(f);
     f.close();
@@ -147,11 +152,15 @@ Estimate bin_estimate(double s1, double s2, std::uint64_t n) {
 }
 
 Estimate lobe_energy(const ResultFile& r, std::size_t k, int lobe, int c) {
-  // Each photon lands in one bin, so the lobe's S2 is the sum of its bins' S2.
+  const double s1 = r.exited[(k * r.lobes + lobe) * r.channels + c];
+  // Expected-value scoring: a photon may leave in several bins of a lobe,
+  // and the lobe's S2 is the sum over photons of the square of its total.
+  if (!r.lobe_weight_sq_sum.empty())
+    return bin_estimate(s1, r.lobe_weight_sq_sum[(k * r.lobes + lobe) * r.channels + c], r.photons[k]);
+  // Analog: each photon lands in one bin, so the lobe's S2 is the sum of its bins' S2.
   double s2 = 0.0;
   for (int i = 0; i < r.grid.n_theta(); ++i)
     for (int j = 0; j < r.grid.n_phi(); ++j) s2 += r.weight_sq_sum[r.cell(k, lobe, i, j, c)];
-  const double s1 = r.exited[(k * r.lobes + lobe) * r.channels + c];
   return bin_estimate(s1, s2, r.photons[k]);
 }
 

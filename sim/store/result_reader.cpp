@@ -185,6 +185,12 @@ ResultFile read_result(const std::string& path) {
   } else {
     r.roulette.assign(d.K * d.C, 0.0);
   }
+  // /tally/lobe_weight_sq_sum (expected-value scoring): absent, the lobes'
+  // S2 are their bins' (lobe_energy).
+  if (f.exists("/tally/lobe_weight_sq_sum")) {
+    r.lobe_weight_sq_sum = f.read_doubles("/tally/lobe_weight_sq_sum", {d.K, d.L, d.C}, "K x L x C, " + sizes);
+    rd.check_sums("/tally/lobe_weight_sq_sum", r.lobe_weight_sq_sum);
+  }
   rd.check_balance(r, d);
   return r;
 }

@@ -56,7 +56,9 @@ constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", Stored::Float64, 2},
 // The ledger's signed `roulette` (Russian roulette): written by the
 // expected-value estimator only; a file without it has 0.
 constexpr DatasetShape kRouletteDatasets[] = {{"/ledger/roulette", Stored::Float64, 2},
-                                              {"/exact/roulette", Stored::Pairs, 2}};
+                                              {"/exact/roulette", Stored::Pairs, 2},
+                                              {"/tally/lobe_weight_sq_sum", Stored::Float64, 3},
+                                              {"/exact/lobe_weight_sq_sum", Stored::Pairs, 3}};
 
 bool plays_roulette(const ResultFile& header) {
   return header.settings.estimator == Estimator::ExpectedValue;
@@ -259,6 +261,8 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   if (plays_roulette(header_)) {
     f.write_slab("/ledger/roulette", k, ExactTally::to_double_signed(ledger.roulette));
     f.write_slab("/exact/roulette", k, ExactTally::to_pairs(ledger.roulette));
+    f.write_slab("/tally/lobe_weight_sq_sum", k, ExactTally::to_double(ledger.lobe_weight_sq_sum));
+    f.write_slab("/exact/lobe_weight_sq_sum", k, ExactTally::to_pairs(ledger.lobe_weight_sq_sum));
   }
 }
 
@@ -383,8 +387,11 @@ ExactTally ResultReader::read(std::size_t k) const {
   t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
   if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
-  if (has_roulette_)
+  if (has_roulette_) {
     t.roulette = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/roulette", k));
+    t.lobe_weight_sq_sum =
+        ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lobe_weight_sq_sum", k));
+  }
   // Sums that break a tally's identities were damaged or edited: never added.
   if (const std::string why = tally_inconsistency(t, header_.settings.estimator == Estimator::Analog);
       !why.empty())

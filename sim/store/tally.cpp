@@ -14,6 +14,7 @@ Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
   truncated_.assign(channels, 0);
   lost_.assign(channels, 0);
   roulette_.assign(channels, 0);
+  lobe_sq_.assign(static_cast<std::size_t>(lobes) * channels, 0);
 }
 
 Tally::Tally(const Tally& o) : Tally(o.lobes_, o.n_theta_, o.n_phi_, o.channels_) { add(o); }
@@ -34,6 +35,7 @@ void Tally::clear() {
   std::fill(truncated_.begin(), truncated_.end(), Fixed{0});
   std::fill(lost_.begin(), lost_.end(), Fixed{0});
   std::fill(roulette_.begin(), roulette_.end(), Fixed{0});
+  std::fill(lobe_sq_.begin(), lobe_sq_.end(), Fixed{0});
 }
 
 void Tally::score_truncated(const double* weight) {
@@ -79,6 +81,7 @@ void Tally::add(const Tally& o, int threads) {
     lost_[c] += o.lost_[c];
     roulette_[c] += o.roulette_[c];
   }
+  for (std::size_t i = 0; i < lobe_sq_.size(); ++i) lobe_sq_[i] += o.lobe_sq_[i];
 }
 
 bool Tally::is_zero() const {
@@ -86,7 +89,8 @@ bool Tally::is_zero() const {
   return photons_ == 0 && std::all_of(touched_.begin(), touched_.end(), zero) &&
          std::all_of(truncated_.begin(), truncated_.end(), zero) &&
          std::all_of(lost_.begin(), lost_.end(), zero) &&
-         std::all_of(roulette_.begin(), roulette_.end(), zero);
+         std::all_of(roulette_.begin(), roulette_.end(), zero) &&
+         std::all_of(lobe_sq_.begin(), lobe_sq_.end(), zero);
 }
 
 ExactTally Tally::exact() const {
@@ -102,6 +106,7 @@ ExactTally Tally::exact() const {
   e.truncated = std::move(ledger.truncated);
   e.lost = std::move(ledger.lost);
   e.roulette = std::move(ledger.roulette);
+  e.lobe_weight_sq_sum = std::move(ledger.lobe_weight_sq_sum);
   return e;
 }
 
@@ -171,6 +176,7 @@ ExactLedger Tally::exact_ledger() const {
     e.lost.push_back(static_cast<ExactTally::Word>(lost_[c]));
     e.roulette.push_back(static_cast<ExactTally::Word>(roulette_[c]));  // two's complement
   }
+  for (Fixed x : lobe_sq_) e.lobe_weight_sq_sum.push_back(static_cast<ExactTally::Word>(x));
   return e;
 }
 
@@ -197,6 +203,8 @@ void Tally::add(const ExactTally& e) {
     lost_[c] += static_cast<Fixed>(e.lost[c]);
     roulette_[c] += static_cast<Fixed>(e.roulette[c]);
   }
+  for (std::size_t i = 0; i < lobe_sq_.size(); ++i)
+    lobe_sq_[i] += static_cast<Fixed>(e.lobe_weight_sq_sum[i]);
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {

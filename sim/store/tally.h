@@ -84,6 +84,15 @@ class Tally {
   void score_roulette_fixed(const Fixed* delta) {
     for (int c = 0; c < channels_; ++c) roulette_[c] += delta[c];
   }
+  // The square of one photon's total weight[c] in `lobe` (expected-value
+  // scoring: a photon may leave in several bins of a lobe, and the lobe's
+  // standard error needs the sum over photons of the square of its total
+  // there, not the sum of its bins' S2). The analog estimator books none:
+  // there each photon leaves once and the lobe's S2 is its bins' S2.
+  void score_lobe_square(int lobe, const double* total) {
+    Fixed* s = lobe_sq_.data() + static_cast<std::size_t>(lobe) * channels_;
+    for (int c = 0; c < channels_; ++c) s[c] += to_fixed(total[c] * total[c]);
+  }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static constexpr Fixed kOne = Fixed{1} << 60;
   // What a photon's parts may exceed its unit weight by, in fixed point, as
@@ -173,6 +182,7 @@ class Tally {
   std::vector<Fixed> truncated_;
   std::vector<Fixed> lost_;
   std::vector<Fixed> roulette_;  // signed
+  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_lobe_square
 };
 
 }  // namespace fiberlab::sim
