@@ -26,7 +26,7 @@ enum class Polarization { Scalar, Stokes };
 // finally leaves. `expected_value`: at an event where one branch leaves the
 // fiber at once, that branch is scored with the weight times its probability
 // and the photon goes on along the other with the weight times one minus it
-// (analog once the weight is below life::kExpectedValueMinWeight).
+// (Russian roulette once the weight is below life::kRouletteBelow).
 enum class Estimator { Analog, ExpectedValue };
 
 // `fiber.medulla` (docs/FUR.md): a scattering core, the cross-section scaled
@@ -109,8 +109,8 @@ struct Settings {
   int max_segments = 1000;
   int max_events_per_point = 1000;  // consistency-rule bound (SPEC section 5)
   Polarization polarization = Polarization::Scalar;
-  // analog: the one with more error per CPU second on bench/configs cases b,
-  // c and ggx (bench/figure_of_merit.py; docs/PHYSICS.md "Estimator").
+  // analog: the one with more error per CPU second on bench/configs cases b
+  // and c (bench/figure_of_merit.py; docs/PHYSICS.md "Estimator").
   Estimator estimator = Estimator::Analog;
 
   // The incident configurations: every theta_i combined with every phi_i

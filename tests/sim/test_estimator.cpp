@@ -5,8 +5,9 @@
 //   to its starting weight, to rounding, with scalar and Stokes light and
 //   with Smith G1 masking;
 // - the roulette term has expectation 0: its mean over many photons is
-//   within 4 of its standard errors of 0 (mutation: survivors carrying twice
-//   kRouletteWeight while the term books kRouletteWeight - w fails it), and
+//   within 4 of its standard errors of 0 (mutation: survival with
+//   probability w / (2 kRouletteWeight) instead of w / kRouletteWeight gives
+//   a mean 37 standard errors below 0), and
 //   the file's ledger exited + absorbed + truncated + lost - roulette =
 //   launched holds to rounding;
 // - the reported standard errors agree with the spread of the estimates over
