@@ -253,7 +253,7 @@ void Chiang2016::density(int lobe, double theta_i, double, double theta_r, doubl
     if (lobe_of(p, L) != lobe) continue;
     const double v = std::max(variance(p), kDensityMinV);
     const double m =
-        std::exp(log_mp(params_.pbrt_v4_mp, v, rotated_theta_i(p, theta_i), theta_r)) * std::cos(theta_r);
+        std::exp(log_mp(params_.mp == Chiang2016Mp::PbrtV4, v, rotated_theta_i(p, theta_i), theta_r)) * std::cos(theta_r);
     std::fill(n.begin(), n.end(), 0.0);
     if (p < kResidualP) {
       logistic_nodes(p, att.eta_p(), s, {phi}, true, 1.0, nodes);
@@ -295,7 +295,7 @@ std::vector<double> Chiang2016::bin_probabilities(const BinGrid& grid, double th
   std::vector<HNode> nodes;
   for (int p = 0; p <= kResidualP; ++p) {
     theta_w.assign(nt, 0.0);
-    theta_bin_integrals(params_.pbrt_v4_mp, variance(p), rotated_theta_i(p, theta_i), grid, refine_, theta_w);
+    theta_bin_integrals(params_.mp == Chiang2016Mp::PbrtV4, variance(p), rotated_theta_i(p, theta_i), grid, refine_, theta_w);
     phi_w.assign(static_cast<std::size_t>(np) * C, 0.0);
     if (p == kResidualP) {
       // The residual is uniform in phi: E_3 / n_phi per bin.
@@ -329,23 +329,11 @@ std::unique_ptr<Model> make_chiang2016(const Chiang2016Params& params) {
   return std::make_unique<Chiang2016>(params);
 }
 
-std::unique_ptr<Model> make_chiang2016(const ModelParams& mp) {
-  Chiang2016Params p;
-  p.eta = mp.eta;
-  p.sigma_a = mp.sigma_a;
-  p.beta_m = mp.beta_m;
-  p.beta_n = mp.beta_n;
-  p.alpha = mp.scale_tilt;
-  p.lobes = mp.lobes;
-  p.pbrt_v4_mp = mp.chiang_mp == 1;
-  return std::make_unique<Chiang2016>(p);
-}
-
 namespace {
 
-std::vector<std::string> chiang_approximations(const ModelParams& p) {
+std::vector<std::string> chiang_approximations(const Chiang2016Params& p) {
   return {"far field: pbrt's BCSDF averaged over h, with pbrt's wo read as our wi (A_p at theta_i)",
-          p.chiang_mp == 1
+          p.mp == Chiang2016Mp::PbrtV4
               ? "M_p: pbrt-v4's as shipped (10-term I0, its log I0 above 12, csch(1/v) ~ 2 exp(-1/v) for v <= 0.1); "
                 "tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha"
               : "M_p: d'Eon's von Mises-Fisher lobe; tilt as rotations of theta_i by 2 alpha, -alpha, -4 alpha",
@@ -354,54 +342,61 @@ std::vector<std::string> chiang_approximations(const ModelParams& p) {
           "absorption: the chord (SPEC s7)"};
 }
 
+// The rule from a simulated fiber (physical_defaults.h): circular fibers
+// only; the tilt itself; the widths as for d'Eon's M_p (the same function),
+// then through the inverse mappings: an approximate width match; smooth
+// gives 0 exactly.
+void chiang2016_from_fiber(const PhysicalFiber& f, Chiang2016Params& p, FiberMapping& mapping) {
+  if (f.eccentricity != 1.0)
+    throw Error(fmt::format("model chiang2016: circular fibers only; this fiber has eccentricity {:g}",
+                            f.eccentricity));
+  apply_fiber_basics(f, p);
+  p.alpha = f.scale_tilt;
+  LobeWidths w;
+  apply_fiber_roughness(f, w, deon2011_width_calibration(), mapping);
+  p.beta_m = chiang2016::beta_m_for_width(for_lobe(w.beta_long, 0));
+  p.beta_n = chiang2016::beta_n_for_scale(for_lobe(w.beta_azim, 0) * std::sqrt(3.0) / kPi);
+}
+
 }  // namespace
 
 ModelInfo chiang2016_info() {
-  ModelInfo m;
+  using P = Chiang2016Params;
+  ModelDefinition<P> m;
   m.name = "chiang2016";
   m.reference =
       "Chiang, Bitterli, Tappan, Burley 2016, A Practical and Controllable Hair and Fur Model for "
       "Production Path Tracing (pbrt-v4 HairBxDF), far field";
   auto unit_interval = [](double x) { return x >= 0.0 && x <= 1.0; };
   ParamSpec beta_m = number_param("beta_m", "longitudinal roughness: v = (0.726 b + 0.812 b^2 + 3.7 b^20)^2 (R; TT v/4, TRT 4v)",
-                                  "", "0.3", "a number in [0, 1]", &ModelParams::beta_m, unit_interval);
+                                  "", "0.3", "a number in [0, 1]", &P::beta_m, unit_interval);
   beta_m.from_fiber = "roughness: R's sqrt(v) = the R lobe's calibrated theta_r width";
   ParamSpec beta_n = number_param("beta_n", "azimuthal roughness: logistic s = sqrt(pi/8)(0.265 b + 1.194 b^2 + 5.372 b^22)",
-                                  "", "0.3", "a number in [0, 1]", &ModelParams::beta_n, unit_interval);
+                                  "", "0.3", "a number in [0, 1]", &P::beta_n, unit_interval);
   beta_n.from_fiber = "roughness: s pi / sqrt(3) = the R lobe's azimuthal width";
   ParamSpec alpha = number_param("alpha",
                                  "cuticle scale tilt, > 0 towards the root (R at theta_r = -theta_i - 2 alpha); "
                                  "pbrt-v4's alpha is its negative",
-                                 "deg", "2", "degrees in (-45, 45)", &ModelParams::scale_tilt,
+                                 "deg", "2", "degrees in (-45, 45)", &P::alpha,
                                  [](double x) { return std::abs(x) < 45.0; });
   alpha.from_fiber = "fiber.scale_tilt";
   // Free parameters (what `fiberlab atlas` fits), in the table's ranges.
-  m.params = {eta_param(),
-              sigma_a_param(),
+  m.params = {eta_param<P>(),
+              sigma_a_param<P>(),
               fittable(beta_m, 0.0, 1.0),
               fittable(beta_n, 0.0, 1.0),
               fittable(alpha, -45.0 + 1e-6, 45.0 - 1e-6),
-              choice_param("mp",
-                           "longitudinal function M_p: exact (d'Eon 2011 Eq. 7, the paper's) or pbrt_v4 (pbrt-v4's "
-                           "HairBxDF numerics as shipped: 10-term I0, its asymptotic log I0 above 12)",
-                           "exact", {"exact", "pbrt_v4"}, [](ModelParams& p, int i) { p.chiang_mp = i; },
-                           [](const ModelParams& p) { return p.chiang_mp; }),
-              lobes_param()};
-  m.make = [](const ModelParams& p) { return make_chiang2016(p); };
+              enum_param("mp",
+                         "longitudinal function M_p: exact (d'Eon 2011 Eq. 7, the paper's) or pbrt_v4 (pbrt-v4's "
+                         "HairBxDF numerics as shipped: 10-term I0, its asymptotic log I0 above 12)",
+                         "exact", {"exact", "pbrt_v4"}, &P::mp),
+              lobes_param<P>()};
+  m.make = [](const P& p) { return make_chiang2016(p); };
   m.approximations = chiang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
-    if (f.eccentricity != 1.0)
-      throw Error(fmt::format("model chiang2016: circular fibers only; this fiber has eccentricity {:g}",
-                              f.eccentricity));
-    apply_fiber_basics(f, p);
-    p.scale_tilt = f.scale_tilt;
-    // Widths as for d'Eon's M_p (the same function), then through the
-    // inverse mappings: an approximate width match; smooth gives 0 exactly.
-    apply_fiber_roughness(f, p, deon2011_width_calibration(), mapping);
-    p.beta_m = chiang2016::beta_m_for_width(for_lobe(p.beta_long, 0));
-    p.beta_n = chiang2016::beta_n_for_scale(for_lobe(p.beta_azim, 0) * std::sqrt(3.0) / kPi);
-  };
-  return m;
+  m.from_fiber = chiang2016_from_fiber;
+  // The lobes' centres move as SPEC s7's shifts of the tilt (chiang2016.h).
+  m.theta_r_shifts = [](const P& p) { return tilt_shifts(p.alpha); };
+  return define_model(std::move(m));
 }
 
 }  // namespace fiberlab::analytic

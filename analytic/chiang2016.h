@@ -81,15 +81,20 @@ double beta_n_for_scale(double s);
 
 }  // namespace chiang2016
 
+// The longitudinal function M_p (`mp=exact|pbrt_v4`): d'Eon 2011 Eq. 7
+// exactly (the paper's function), or pbrt-v4's numerics as shipped
+// (analytic/pbrt_v4_mp.h).
+enum class Chiang2016Mp { Exact, PbrtV4 };
+
+// The model's parameters (its table, chiang2016_info() in chiang2016.cpp,
+// binds `--set` keys to these fields; `alpha` is the scale tilt).
 struct Chiang2016Params {
   double eta = 1.55;                    // > 1
   std::vector<double> sigma_a{0.0};     // 1/R per channel, >= 0
   double beta_m = 0.3, beta_n = 0.3;    // in [0, 1]
   double alpha = 0.0;                   // scale tilt, radians (sign: see above)
   int lobes = 4;                        // 1..4
-  // M_p: false d'Eon 2011 Eq. 7 exactly (the paper's function); true
-  // pbrt-v4's numerics as shipped (analytic/pbrt_v4_mp.h).
-  bool pbrt_v4_mp = false;
+  Chiang2016Mp mp = Chiang2016Mp::Exact;
 };
 
 class Chiang2016 : public Model {
@@ -127,10 +132,7 @@ class Chiang2016 : public Model {
   double refine_ = 1.0;
 };
 
-std::unique_ptr<Model> make_chiang2016(const Chiang2016Params& params);
-// From ModelParams: eta, sigma_a, lobes, beta_m, beta_n, scale_tilt (its
-// parameter table, chiang2016_info() in the .cpp, names the last `alpha`).
 // Chord absorption always (the model's own).
-std::unique_ptr<Model> make_chiang2016(const ModelParams& params);
+std::unique_ptr<Model> make_chiang2016(const Chiang2016Params& params);
 
 }  // namespace fiberlab::analytic

@@ -63,7 +63,7 @@ constexpr double kFourierTol = 1e-13;
 
 // The last order traced explicitly when judged at exit inclination theta_r
 // (cylinder::last_order with kResidualTol).
-int last_explicit_order(const ModelParams& params, double theta_i, double theta_r, int p_first, int max_order) {
+int last_explicit_order(const Deon2011Params& params, double theta_i, double theta_r, int p_first, int max_order) {
   std::vector<double> res;
   const cylinder::Attenuation att(params.eta, 0.5 * (theta_r - theta_i), params.sigma_a, params.absorption);
   return cylinder::last_order(att, p_first, kResidualTol, max_order, res);
@@ -87,7 +87,7 @@ constexpr int kFineOrders = 20;
 // order, judged at the specular direction, the M_p peak and 3 sigma either
 // side, and fixed for the whole theta_r range so that N_p stays smooth in
 // theta_r.
-std::vector<Term> lobe_terms(const ModelParams& params, double theta_i, int max_order) {
+std::vector<Term> lobe_terms(const Deon2011Params& params, double theta_i, int max_order) {
   const int L = params.lobes;
   const int list_len = static_cast<int>(std::max({params.beta_long.size(), params.beta_azim.size(), params.alpha.size()}));
   std::vector<Term> terms;
@@ -185,7 +185,7 @@ class HalfAngleRLobe {
 // (Eq. 10 with the detector of Eq. 11): nb[j * C + c].
 class AzimuthalBins {
  public:
-  AzimuthalBins(const ModelParams& params, double theta_i, int np, double refine, const HalfAngleRLobe* r_lobe)
+  AzimuthalBins(const Deon2011Params& params, double theta_i, int np, double refine, const HalfAngleRLobe* r_lobe)
       : params_(params), theta_i_(theta_i), np_(np), C_(static_cast<int>(params.sigma_a.size())),
         refine_(refine), r_lobe_(r_lobe), a_(C_) {}
 
@@ -238,7 +238,7 @@ class AzimuthalBins {
     }
   }
 
-  const ModelParams& params_;
+  const Deon2011Params& params_;
   double theta_i_;
   int np_, C_;
   double refine_;
@@ -310,12 +310,9 @@ int chebyshev_points(const Term& t, double width, double refine) {
 
 }  // namespace
 
-Deon2011::Deon2011(ModelParams params) : params_(std::move(params)), max_order_(params_.max_order) {
+Deon2011::Deon2011(Deon2011Params params) : params_(std::move(params)), max_order_(params_.max_order) {
   auto bad = [](const std::string& what) { throw Error("deon2011: " + what); };
   if (!(params_.eta > 1.0)) bad(fmt::format("eta = {} must be > 1", params_.eta));
-  if (params_.eccentricity != 1.0)
-    bad(fmt::format("eccentricity = {} unsupported (the model is for circular fibers: 1)",
-                    params_.eccentricity));
   if (params_.lobes < 1) bad("lobes must be >= 1");
   if (params_.sigma_a.empty()) bad("sigma_a needs at least one channel");
   if (params_.beta_long.empty() || params_.beta_azim.empty() || params_.alpha.empty())
@@ -427,7 +424,7 @@ std::vector<double> Deon2011::bin_probabilities(const BinGrid& grid, double thet
   return out;
 }
 
-std::unique_ptr<Model> make_deon2011(const ModelParams& params) {
+std::unique_ptr<Model> make_deon2011(const Deon2011Params& params) {
   return std::make_unique<Deon2011>(params);
 }
 
@@ -438,7 +435,7 @@ std::unique_ptr<Model> make_deon2011(const ModelParams& params) {
 namespace fiberlab::analytic {
 
 namespace {
-std::vector<std::string> deon_approximations(const ModelParams& p) {
+std::vector<std::string> deon_approximations(const Deon2011Params& p) {
   std::vector<std::string> out;
   out.push_back(p.absorption == Absorption::Published
                     ? "absorption=published: exp(-4 sigma_a' cos^2 gamma_t) (as published; not the chord)"
@@ -454,43 +451,51 @@ std::vector<std::string> deon_approximations(const ModelParams& p) {
                             p.max_order));
   return out;
 }
+
+// The rule from a simulated fiber (physical_defaults.h): circular fibers
+// only; the tilt as SPEC s7's shifts; the widths by the calibrated rule in
+// d'Eon's theta_r variable.
+void deon2011_from_fiber(const PhysicalFiber& f, Deon2011Params& p, FiberMapping& mapping) {
+  if (f.eccentricity != 1.0)
+    throw Error(fmt::format("model deon2011: circular fibers only; this fiber has eccentricity {:g}",
+                            f.eccentricity));
+  apply_fiber_basics(f, p);
+  p.alpha = tilt_shifts(f.scale_tilt);
+  LobeWidths w;
+  apply_fiber_roughness(f, w, deon2011_width_calibration(), mapping);
+  p.beta_long = w.beta_long;
+  p.beta_azim = w.beta_azim;
+}
 }  // namespace
 
 ModelInfo deon2011_info() {
-  ModelInfo m;
+  using P = Deon2011Params;
+  ModelDefinition<P> m;
   m.name = "deon2011";
   m.reference = "d'Eon, Francois, Hill, Letteri, Aubry 2011, An Energy-Conserving Hair Reflectance Model";
   m.params = {
-      eta_param(),
-      sigma_a_param(),
-      beta_long_param("longitudinal width per lobe p: v_p = beta_long_p^2 in M_p (Eq. 7), ~ the sd of theta_r"),
-      beta_azim_param("azimuthal width per lobe p: sd of the Gaussian detector D_p (Eq. 11)"),
-      alpha_param("shift of theta_r per lobe p (M_p(theta_r - alpha_p))"),
-      absorption_param("published"),
-      lobes_param(),
+      eta_param<P>(),
+      sigma_a_param<P>(),
+      beta_long_param<P>("longitudinal width per lobe p: v_p = beta_long_p^2 in M_p (Eq. 7), ~ the sd of theta_r"),
+      beta_azim_param<P>("azimuthal width per lobe p: sd of the Gaussian detector D_p (Eq. 11)"),
+      alpha_param<P>("shift of theta_r per lobe p (M_p(theta_r - alpha_p))"),
+      absorption_param<P>("published"),
+      lobes_param<P>(),
       integer_param("quadrature_order", "Gauss-Legendre order of the N_p integral over h (density())", "35",
-                    &ModelParams::quadrature_order, 1),
-      choice_param(
+                    &P::quadrature_order, 1),
+      choice_param<P>(
           "r_fresnel", "Fresnel of the R lobe: Eq. 12 half angle (published) or Eq. 14 per h", "half_angle",
-          {"half_angle", "per_h"}, [](ModelParams& p, int i) { p.r_half_angle_fresnel = i == 0; },
-          [](const ModelParams& p) { return p.r_half_angle_fresnel ? 0 : 1; }),
-      integer_param("max_order", "highest order p traced explicitly in the last lobe", "40",
-                    &ModelParams::max_order, 1),
-      choice_param(
-          "n_theta_d", "theta_d of N_p: the exit direction's (published) or the specular cone's", "exit",
-          {"exit", "specular"}, [](ModelParams& p, int i) { p.specular_theta_d = i == 1; },
-          [](const ModelParams& p) { return p.specular_theta_d ? 1 : 0; }),
+          {"half_angle", "per_h"}, [](P& p, int i) { p.r_half_angle_fresnel = i == 0; },
+          [](const P& p) { return p.r_half_angle_fresnel ? 0 : 1; }),
+      integer_param("max_order", "highest order p traced explicitly in the last lobe", "40", &P::max_order, 1),
+      bool_param("n_theta_d", "theta_d of N_p: the exit direction's (published) or the specular cone's", "exit",
+                 {"exit", "specular"}, &P::specular_theta_d),
   };
   m.make = make_deon2011;
   m.approximations = deon_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
-    if (f.eccentricity != 1.0)
-      throw Error(fmt::format("model deon2011: circular fibers only; this fiber has eccentricity {:g}",
-                              f.eccentricity));
-    apply_fiber_basics(f, p);
-    apply_fiber_roughness(f, p, deon2011_width_calibration(), mapping);
-  };
-  return m;
+  m.from_fiber = deon2011_from_fiber;
+  m.theta_r_shifts = [](const P& p) { return p.alpha; };
+  return define_model(std::move(m));
 }
 
 }  // namespace fiberlab::analytic

@@ -19,13 +19,13 @@
 //   Eq. 14 like the other orders (r_fresnel=per_h). They agree for v, beta -> 0;
 //   only per_h conserves energy exactly for rough fibers.
 // - Lobes: 0..L-2 one order each; lobe L-1 sums p >= L-1: orders up to the
-//   first P (<= ModelParams::max_order, default 40) after which the remaining energy, computed in
+//   first P (<= Deon2011Params::max_order, default 40) after which the remaining energy, computed in
 //   closed form per h (sum_{p>P} A = (1-f)^2 f^P T^(P+1) / (1 - f T)), is
 //   below 1e-6, then that remainder spread uniformly in phi (d'Eon's and
 //   pbrt's residual term), with the last lobe's M. Energy is exact; only the
 //   remainder's phi shape is approximate.
 // - theta_d of N_p: the exit direction's (published) or, with
-//   ModelParams::specular_theta_d, the specular cone's -theta_i, which makes
+//   Deon2011Params::specular_theta_d, the specular cone's -theta_i, which makes
 //   the model the simulator's exit_blur exactly (SPEC s3).
 // - Per-lobe parameters: v_p = beta_long_p^2, beta_p = beta_azim_p, alpha_p
 //   (lists indexed by p, the last entry for every larger p).
@@ -70,9 +70,38 @@ double F_half_angle(double eta, double theta_i, double theta_r, double phi);
 
 }  // namespace deon2011
 
+// The model's parameters (its table, deon2011_info() in deon2011.cpp, binds
+// `--set` keys to these fields). Lists are indexed by lobe p, the last entry
+// for every larger p; angles in radians. The defaults are neutral values for
+// code that builds the model directly (tests); the command line's are the
+// table's.
+struct Deon2011Params {
+  double eta = 1.55;
+  std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
+  std::vector<double> beta_long{0.0};          // v_p = beta_long_p^2
+  std::vector<double> beta_azim{0.0};          // Gaussian detector sd beta_p
+  std::vector<double> alpha{0.0};              // shift of theta_r per p
+  Absorption absorption = Absorption::Published;
+  int lobes = 4;  // lobes 0..L-2 separately, lobe L-1 = every p >= L-1
+  // Gauss-Legendre order of the N_p integral over h (density()).
+  int quadrature_order = 35;
+  // The R lobe's Fresnel term. true = Eq. 12 as published, F(eta,
+  // arccos(wi.wr)/2) at the exit direction; false = Eq. 14 per h,
+  // F(eta, arccos(cos theta_d cos gamma_i)) (`r_fresnel=half_angle|per_h`).
+  bool r_half_angle_fresnel = true;
+  // Highest order p traced explicitly in the last lobe; the energy of the
+  // orders above goes to the uniform residual (`max_order=N`).
+  int max_order = 40;
+  // theta_d at which N_p is evaluated. false (published): theta_d =
+  // (theta_r - theta_i)/2 of the exit direction; true: theta_d = -theta_i,
+  // the specular cone's, so that S = M_p(theta_r) N_p(phi) is a product:
+  // exactly the simulator's `exit_blur` (SPEC s3) (`n_theta_d=exit|specular`).
+  bool specular_theta_d = false;
+};
+
 class Deon2011 : public Model {
  public:
-  explicit Deon2011(ModelParams params);
+  explicit Deon2011(Deon2011Params params);
   std::string name() const override { return "deon2011"; }
   int lobes() const override { return params_.lobes; }
   void density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
@@ -113,11 +142,11 @@ class Deon2011 : public Model {
   void set_max_order(int p) { max_order_ = p; }
 
  private:
-  ModelParams params_;
+  Deon2011Params params_;
   double refine_ = 1.0;
   int max_order_;
 };
 
-std::unique_ptr<Model> make_deon2011(const ModelParams& params);
+std::unique_ptr<Model> make_deon2011(const Deon2011Params& params);
 
 }  // namespace fiberlab::analytic

@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
+#include <variant>
 
 #include "analytic/longitudinal_lobes.h"
 #include "analytic/model_params.h"
@@ -672,30 +674,14 @@ std::unique_ptr<Model> make_huang2022(const Huang2022Params& params) {
   return std::make_unique<Huang2022>(params);
 }
 
-std::unique_ptr<Model> make_huang2022(const ModelParams& mp) {
-  Huang2022Params p;
-  p.eta = mp.eta;
-  p.sigma_a = mp.sigma_a;
-  p.roughness = mp.ggx_roughness;
-  p.tilt = mp.scale_tilt;
-  p.eccentricity = mp.eccentricity;
-  p.lobe_scale = mp.lobe_scale;
-  p.masking = static_cast<HuangMasking>(mp.huang_masking);
-  p.mesonormal_flux = mp.mesonormal_flux;
-  p.residual = static_cast<HuangResidual>(mp.huang_residual);
-  p.lobes = mp.lobes;
-  p.quadrature_points = static_cast<long>(mp.quadrature_points);
-  return std::make_unique<Huang2022>(p);
-}
-
 namespace {
 
-std::vector<std::string> huang_approximations(const ModelParams& p) {
+std::vector<std::string> huang_approximations(const Huang2022Params& p) {
   std::vector<std::string> a = {
       "far field: Cycles' wi read as our wi (the light); S normalised by the light's projected width",
       "TT, TRT: the paper's sampled microfacet normals as a fixed Halton point set (deterministic quadrature)",
       "no GGX glass albedo correction (Cycles' energy_scale table)"};
-  if (p.huang_residual == static_cast<int>(HuangResidual::CyclesEval))
+  if (p.residual == HuangResidual::CyclesEval)
     a.push_back("p >= 3: the residual of Cycles' eval() (T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second "
                 "interface, uniform over the arc angle; kept for every exit direction where Cycles drops it inside a "
                 "refraction cone when the second reflection leaves its side), M_p with v = 4 alpha, uniform in phi");
@@ -705,7 +691,7 @@ std::vector<std::string> huang_approximations(const ModelParams& p) {
   if (p.mesonormal_flux)
     a.push_back("flux onto the mesonormal (wi.ns) at the entry: not the projected width's once tilted (paper; Cycles' eval "
         "also rescales at the inner interfaces, not done here)");
-  if (p.huang_masking == static_cast<int>(HuangMasking::Correlated))
+  if (p.masking == HuangMasking::Correlated)
     a.push_back("masking: height-correlated G2 (Cycles' code)");
   return a;
 }
@@ -720,52 +706,65 @@ double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
                             "(alpha in [0, 1]), or --set roughness=A",
                             why));
   };
-  double alpha = 0.0;
-  switch (f.roughness) {
-    case PhysicalFiber::Roughness::Smooth: return 0.0;
-    case PhysicalFiber::Roughness::ExitBlur: return refuse("an exit_blur fiber has no microfacets");
-    case PhysicalFiber::Roughness::GGX:
-    case PhysicalFiber::Roughness::Beckmann:
-      if (f.alpha_long != f.alpha_azim)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      alpha = f.alpha_long;
-      if (f.roughness == PhysicalFiber::Roughness::Beckmann)
-        // Beckmann and GGX of the same alpha have the same density at the
-        // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
-        mapping.notes.push_back(fmt::format(
-            "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
-            "tails differ)",
-            f.roughness_text()));
-      break;
-    case PhysicalFiber::Roughness::Gaussian: {
-      const double bl = for_lobe(f.beta_long, 0), ba = f.beta_azim.empty() ? bl : for_lobe(f.beta_azim, 0);
-      if (bl != ba)
-        return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
-      // Equal density at the mean normal: a Gaussian tilt of sd beta per
-      // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
-      alpha = std::sqrt(2.0) * std::tan(bl);
-      mapping.notes.push_back(fmt::format(
-          "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
-          "normal)",
-          f.roughness_text(), alpha));
-      break;
-    }
-  }
+  // Every roughness type has its rule here: a type without one does not compile.
+  const double alpha = std::visit(
+      [&](const auto& g) -> double {
+        using G = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<G, roughness::Smooth>) {
+          return 0.0;
+        } else if constexpr (std::is_same_v<G, roughness::ExitBlur>) {
+          return refuse("an exit_blur fiber has no microfacets");
+        } else if constexpr (std::is_base_of_v<roughness::MicrofacetAlpha, G>) {
+          if (g.alpha_long != g.alpha_azim)
+            return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+          if constexpr (std::is_same_v<G, roughness::Beckmann>)
+            // Beckmann and GGX of the same alpha have the same density at the
+            // mean normal, D = 1/(pi alpha^2) (Walter et al. 2007, Eqs. 25, 33).
+            mapping.notes.push_back(fmt::format(
+                "roughness: the {} fiber read as ggx of the same alpha (equal density at the mean normal; the "
+                "tails differ)",
+                f.roughness_text()));
+          return g.alpha_long;
+        } else {
+          static_assert(std::is_same_v<G, roughness::Gaussian>, "a roughness type without a rule");
+          if (g.beta_long != g.beta_azim)
+            return refuse(fmt::format("{} is anisotropic (huang2022's GGX is isotropic)", f.roughness_text()));
+          // Equal density at the mean normal: a Gaussian tilt of sd beta per
+          // axis has slope density 1/(2 pi tan^2 beta) there, GGX 1/(pi alpha^2).
+          const double a = std::sqrt(2.0) * std::tan(g.beta_long);
+          mapping.notes.push_back(fmt::format(
+              "roughness: the {} fiber read as ggx alpha = sqrt(2) tan(beta) = {:g} (equal density at the mean "
+              "normal)",
+              f.roughness_text(), a));
+          return a;
+        }
+      },
+      f.roughness);
   if (!(alpha >= 0.0 && alpha <= 1.0))
     return refuse(fmt::format("{} gives alpha = {:g}, outside [0, 1]", f.roughness_text(), alpha));
   return alpha;
 }
 
+// The rule from a simulated fiber (physical_defaults.h): eccentricity and
+// tilt themselves, the roughness by huang_roughness() unless --set.
+void huang2022_from_fiber(const PhysicalFiber& f, Huang2022Params& p, FiberMapping& mapping) {
+  apply_fiber_basics(f, p);
+  p.eccentricity = f.eccentricity;
+  p.tilt = f.scale_tilt;
+  if (!mapping.user_sets("roughness")) p.roughness = huang_roughness(f, mapping);
+}
+
 }  // namespace
 
 ModelInfo huang2022_info() {
-  ModelInfo m;
+  using P = Huang2022Params;
+  ModelDefinition<P> m;
   m.name = "huang2022";
   m.reference =
       "Huang, Hullin, Hanika 2022, A Microfacet-based Hair Scattering Model (Cycles' Principled Hair "
       "Huang), far field";
   ParamSpec roughness = number_param("roughness", "GGX microfacet roughness alpha about the mesonormal (0: smooth)",
-                                     "", "0.3", "a number in [0, 1]", &ModelParams::ggx_roughness,
+                                     "", "0.3", "a number in [0, 1]", &P::roughness,
                                      [](double x) { return x >= 0.0 && x <= 1.0; });
   roughness.from_fiber =
       "roughness (smooth: 0; ggx: alpha; beckmann: alpha, approximate; gaussian: sqrt(2) tan(beta), approximate; "
@@ -773,50 +772,46 @@ ModelInfo huang2022_info() {
   ParamSpec tilt = number_param("tilt",
                                 "cuticle scale tilt of the mesonormal, > 0 towards the root as fiber.scale_tilt "
                                 "(Cycles' Huang Tilt)",
-                                "deg", "0", "degrees in (-45, 45)", &ModelParams::scale_tilt,
+                                "deg", "0", "degrees in (-45, 45)", &P::tilt,
                                 [](double x) { return std::abs(x) < 45.0; });
   tilt.from_fiber = "fiber.scale_tilt";
-  ParamSpec ecc = eccentricity_param();
+  ParamSpec ecc = eccentricity_param<P>();
   ecc.meaning = "minor/major axis ratio of the ellipse (Cycles' aspect ratio)";
   ParamSpec scale = list_param("lobe_scale", "factors of the R, TT, TRT lobes (Cycles' modulation; 1 = physical)",
-                               "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &ModelParams::lobe_scale,
+                               "", "1,1,1", "a comma list of numbers >= 0 (R, TT, TRT)", &P::lobe_scale,
                                [](double x) { return x >= 0.0; });
-  ParamSpec masking = choice_param(
+  ParamSpec masking = enum_param(
       "masking",
       "Smith masking: separable G1(i) G1(o) (the paper's ground truth, simulator smith_g1); correlated "
       "1/(1 + L_i + L_o) (Cycles); none (no masking of leaving light)",
-      "separable", {"separable", "correlated", "none"},
-      [](ModelParams& p, int i) { p.huang_masking = i; }, [](const ModelParams& p) { return p.huang_masking; });
-  ParamSpec flux = choice_param(
+      "separable", {"separable", "correlated", "none"}, &P::masking);
+  ParamSpec flux = choice_param<P>(
       "flux", "light reaching the arc: mesonormal (wi.ns) dl (paper; Cycles' eval at the entry) or macro (wi.n0) dl "
       "(Cycles' sampler)",
       "mesonormal", {"mesonormal", "macro"},
-      [](ModelParams& p, int i) { p.mesonormal_flux = i == 0; },
-      [](const ModelParams& p) { return p.mesonormal_flux ? 0 : 1; });
-  ParamSpec residual = choice_param(
+      [](P& p, int i) { p.mesonormal_flux = i == 0; },
+      [](const P& p) { return p.mesonormal_flux ? 0 : 1; });
+  ParamSpec residual = enum_param(
       "residual",
       "p >= 3: sampler (Cycles' sampler: the series from the TRT path's third interface) or cycles_eval (Cycles' "
       "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
-      "sampler", {"sampler", "cycles_eval"},
-      [](ModelParams& p, int i) { p.huang_residual = i; }, [](const ModelParams& p) { return p.huang_residual; });
+      "sampler", {"sampler", "cycles_eval"}, &P::residual);
   ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
                                   "integer", "4194304", "an integer in [1024, 1073741824]",
-                                  &ModelParams::quadrature_points, [](double x) {
+                                  &P::quadrature_points, [](double x) {
                                     return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
                                   });
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
-  m.params = {eta_param(),   sigma_a_param(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
-              ecc,           scale,           masking,
-              flux,          residual,        lobes_param(),   points};
-  m.make = [](const ModelParams& p) { return make_huang2022(p); };
+  m.params = {eta_param<P>(), sigma_a_param<P>(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
+              ecc,            scale,              masking,
+              flux,           residual,           lobes_param<P>(), points};
+  m.make = [](const P& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
-    apply_fiber_basics(f, p);
-    p.eccentricity = f.eccentricity;
-    p.scale_tilt = f.scale_tilt;
-    if (!mapping.user_sets("roughness")) p.ggx_roughness = huang_roughness(f, mapping);
-  };
-  return m;
+  m.from_fiber = huang2022_from_fiber;
+  // The tilt is the fiber's cuticle tilt (same sign as scale_tilt): SPEC s7's
+  // shifts of it (rays through the fiber's centre), as for the simulator.
+  m.theta_r_shifts = [](const P& p) { return tilt_shifts(p.tilt); };
+  return define_model(std::move(m));
 }
 
 }  // namespace fiberlab::analytic

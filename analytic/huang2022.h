@@ -134,6 +134,8 @@ enum class HuangMasking { Separable, Correlated, None };
 // or its eval()'s (from the second interface; see huang2022.cpp).
 enum class HuangResidual { Sampler, CyclesEval };
 
+// The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
+// `--set` keys to these fields).
 struct Huang2022Params {
   double eta = 1.55;                       // > 1
   std::vector<double> sigma_a{0.0};        // 1/R per channel, >= 0
@@ -189,9 +191,5 @@ class Huang2022 : public Model {
 };
 
 std::unique_ptr<Model> make_huang2022(const Huang2022Params& params);
-// From ModelParams: eta, sigma_a, eccentricity, scale_tilt (its table calls
-// it `tilt`), ggx_roughness (`roughness`), lobe_scale, huang_masking,
-// quadrature_points, lobes.
-std::unique_ptr<Model> make_huang2022(const ModelParams& params);
 
 }  // namespace fiberlab::analytic

@@ -578,7 +578,7 @@ namespace m3 = marschner2003;
 
 class Marschner2003 final : public Model {
  public:
-  Marschner2003(const ModelParams& params, bool interpolate_theta)
+  Marschner2003(const Marschner2003Params& params, bool interpolate_theta)
       : params_(params), interpolate_theta_(interpolate_theta) {
     if (!(params.eta > 1.0))
       throw Error(fmt::format("marschner2003: eta = {} must be > 1", params.eta));
@@ -826,7 +826,7 @@ class Marschner2003 final : public Model {
     }
   }
 
-  ModelParams params_;
+  Marschner2003Params params_;
   m3::CausticParams caustic_;
   bool interpolate_theta_ = true;
   // Measured against the per-node reference (90 x 180 bins, beta 0.5 to 10
@@ -842,11 +842,11 @@ thread_local std::vector<double> Marschner2003::n_;
 
 }  // namespace
 
-std::unique_ptr<Model> make_marschner2003(const ModelParams& params) {
+std::unique_ptr<Model> make_marschner2003(const Marschner2003Params& params) {
   return std::make_unique<Marschner2003>(params, true);
 }
 
-std::unique_ptr<Model> make_marschner2003_reference(const ModelParams& params) {
+std::unique_ptr<Model> make_marschner2003_reference(const Marschner2003Params& params) {
   return std::make_unique<Marschner2003>(params, false);
 }
 
@@ -857,7 +857,7 @@ std::unique_ptr<Model> make_marschner2003_reference(const ModelParams& params) {
 namespace fiberlab::analytic {
 
 namespace {
-std::vector<std::string> marschner_approximations(const ModelParams& p) {
+std::vector<std::string> marschner_approximations(const Marschner2003Params& p) {
   std::vector<std::string> out;
   out.push_back(p.absorption == Absorption::Published
                     ? "absorption=published: exp(-4 sigma_a' cos^2 gamma_t) (s4.3; not the chord)"
@@ -879,50 +879,54 @@ std::vector<std::string> marschner_approximations(const ModelParams& p) {
   out.push_back("lobes p >= 3 are not modelled (zero)");
   return out;
 }
+// The rule from a simulated fiber (physical_defaults.h): the eccentricity
+// itself; the tilt as SPEC s7's shifts; the longitudinal widths by the
+// calibrated rule in the model's width variable, floored at
+// kMinMarschnerBeta (the Gaussian M needs beta > 0).
+void marschner2003_from_fiber(const PhysicalFiber& f, Marschner2003Params& p, FiberMapping& mapping) {
+  apply_fiber_basics(f, p);
+  p.alpha = tilt_shifts(f.scale_tilt);
+  p.eccentricity = f.eccentricity;
+  LobeWidths w;
+  apply_fiber_roughness(f, w, marschner2003_width_calibration(p.two_theta_h), mapping, kMinMarschnerBeta);
+  p.beta_long = w.beta_long;
+}
+
 }  // namespace
 
 ModelInfo marschner2003_info() {
-  ModelInfo m;
+  using P = Marschner2003Params;
+  ModelDefinition<P> m;
   m.name = "marschner2003";
   m.reference = "Marschner, Jensen, Cammarano, Worley, Hanrahan 2003, Light Scattering from Human Hair Fibers";
   m.params = {
-      eta_param(),
-      sigma_a_param(),
-      beta_long_param("sd of the Gaussian M_p per lobe p, in theta_h (published) or 2 theta_h; > 0"),
-      alpha_param("shift of theta_r per lobe p (Marschner's alpha_p, a shift of theta_h, is half)"),
-      absorption_param("published"),
-      lobes_param(),
-      eccentricity_param(),
-      choice_param(
-          "longitudinal", "variable of the Gaussian M: theta_h (published) or 2 theta_h (Zinke & Weber)",
-          "theta_h", {"theta_h", "two_theta_h"}, [](ModelParams& p, int i) { p.two_theta_h = i == 1; },
-          [](const ModelParams& p) { return p.two_theta_h ? 1 : 0; }),
-      choice_param(
-          "roots", "roots of Phi(p, h) = phi: the cubic of Eq. 10 (published) or Eq. 3 exactly", "cubic",
-          {"cubic", "exact"}, [](ModelParams& p, int i) { p.exact_roots = i == 1; },
-          [](const ModelParams& p) { return p.exact_roots ? 1 : 0; }),
+      eta_param<P>(),
+      sigma_a_param<P>(),
+      beta_long_param<P>("sd of the Gaussian M_p per lobe p, in theta_h (published) or 2 theta_h; > 0"),
+      alpha_param<P>("shift of theta_r per lobe p (Marschner's alpha_p, a shift of theta_h, is half)"),
+      absorption_param<P>("published"),
+      lobes_param<P>(),
+      eccentricity_param<P>(),
+      bool_param("longitudinal", "variable of the Gaussian M: theta_h (published) or 2 theta_h (Zinke & Weber)",
+                 "theta_h", {"theta_h", "two_theta_h"}, &P::two_theta_h),
+      bool_param("roots", "roots of Phi(p, h) = phi: the cubic of Eq. 10 (published) or Eq. 3 exactly", "cubic",
+                 {"cubic", "exact"}, &P::exact_roots),
       // Ranges: Table 1's, widened (k_g, delta_eta), or the variable's own
       // (an azimuthal width up to a half turn, an impact parameter in [0, 1]).
-      number_param("k_g", "glint scale factor k_G (Table 1: 0.5 to 5)", "", "0.5", "a number in [0, 10]",
-                   &ModelParams::k_g, [](double x) { return x >= 0.0 && x <= 10.0; }),
-      number_param("w_c", "azimuthal width of the caustic (Table 1: 10 to 25 deg); 0 = no caustic smoothing",
-                   "deg", "10", "degrees in [0, 180]", &ModelParams::w_c,
-                   [](double x) { return x >= 0.0 && x <= 180.0; }),
-      number_param("delta_eta", "fade range of eta' past the caustic merge (Table 1: 0.2 to 0.4)", "", "0.3",
-                   "a number in [0, 10]", &ModelParams::delta_eta,
+      number_param("k_g", "glint scale factor k_G (Table 1: 0.5 to 5)", "", "0.5", "a number in [0, 10]", &P::k_g,
                    [](double x) { return x >= 0.0 && x <= 10.0; }),
+      number_param("w_c", "azimuthal width of the caustic (Table 1: 10 to 25 deg); 0 = no caustic smoothing",
+                   "deg", "10", "degrees in [0, 180]", &P::w_c, [](double x) { return x >= 0.0 && x <= 180.0; }),
+      number_param("delta_eta", "fade range of eta' past the caustic merge (Table 1: 0.2 to 0.4)", "", "0.3",
+                   "a number in [0, 10]", &P::delta_eta, [](double x) { return x >= 0.0 && x <= 10.0; }),
       number_param("delta_h_m", "caustic intensity limit Delta h_M (Table 1: 0.5)", "", "0.5",
-                   "a number in [0, 1]", &ModelParams::delta_h_m,
-                   [](double x) { return x >= 0.0 && x <= 1.0; }),
+                   "a number in [0, 1]", &P::delta_h_m, [](double x) { return x >= 0.0 && x <= 1.0; }),
   };
   m.make = make_marschner2003;
   m.approximations = marschner_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping& mapping) {
-    apply_fiber_basics(f, p);
-    p.eccentricity = f.eccentricity;
-    apply_fiber_roughness(f, p, marschner2003_width_calibration(p.two_theta_h), mapping, kMinMarschnerBeta);
-  };
-  return m;
+  m.from_fiber = marschner2003_from_fiber;
+  m.theta_r_shifts = [](const P& p) { return p.alpha; };
+  return define_model(std::move(m));
 }
 
 }  // namespace fiberlab::analytic

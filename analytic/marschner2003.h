@@ -18,11 +18,11 @@
 // that is the energy the model misses (SPEC section 8: 0.8% at theta_i = 0,
 // 14% at theta_i = 85 deg for eta = 1.55).
 //
-// Parameters (ModelParams, angles in radians):
+// Parameters (Marschner2003Params below, angles in radians):
 // - beta_long[p]: standard deviation of the Gaussian M_p (section 5.1) in the
 //   variable the Gaussian is written in: theta_h (published) or 2 theta_h
-//   (two_theta_h). beta must be > 0. beta_azim is not used: the published
-//   model has no azimuthal roughness other than the caustic width w_c.
+//   (two_theta_h). beta must be > 0. There is no azimuthal width: the
+//   published model has no azimuthal roughness other than the caustic width w_c.
 // - alpha[p]: shift of theta_r for lobe p (SPEC section 7). Marschner's alpha_p
 //   is a shift of theta_h, i.e. alpha[p] / 2; with two_theta_h the Gaussian is
 //   g(beta; 2 theta_h - alpha[p]) = g(beta; theta_r + theta_i - alpha[p]).
@@ -53,14 +53,32 @@
 
 namespace fiberlab::analytic {
 
+// The model's parameters (see above; its table, marschner2003_info() in
+// marschner2003.cpp, binds `--set` keys to these fields). Lists are indexed
+// by lobe p, the last entry for every larger p. The defaults are neutral
+// values for code that builds the model directly (tests); the command
+// line's are the table's.
+struct Marschner2003Params {
+  double eta = 1.55;
+  std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
+  std::vector<double> beta_long{0.0};          // per p
+  std::vector<double> alpha{0.0};              // shift of theta_r per p
+  Absorption absorption = Absorption::Published;
+  int lobes = 4;                   // lobes 0..L-2 separately, lobe L-1 = every p >= L-1
+  bool two_theta_h = false;        // longitudinal=theta_h|two_theta_h
+  bool exact_roots = false;        // roots=cubic|exact
+  double eccentricity = 1.0;       // a = minor/major
+  double k_g = 0.5, w_c = 0.0, delta_eta = 0.0, delta_h_m = 0.0;  // caustics
+};
+
 // The Marschner 2003 model. Throws fiberlab::Error for parameters it cannot
 // represent (beta_long <= 0, eta <= 1, a <= 0, w_c < 0, no channels).
-std::unique_ptr<Model> make_marschner2003(const ModelParams& params);
+std::unique_ptr<Model> make_marschner2003(const Marschner2003Params& params);
 // The same model whose bin_probabilities() evaluates N's phi-bin integrals
 // exactly at every theta_r quadrature node (no interpolation in theta_r):
 // ~2x slower (90 x 180 bins, beta 5 deg), the reference the interpolation is
 // tested against.
-std::unique_ptr<Model> make_marschner2003_reference(const ModelParams& params);
+std::unique_ptr<Model> make_marschner2003_reference(const Marschner2003Params& params);
 
 namespace marschner2003 {
 

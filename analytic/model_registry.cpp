@@ -35,22 +35,37 @@ const ModelInfo& model_info(const std::string& name) {
   throw Error(fmt::format("--model {}: unknown model; allowed: {}", name, fmt::join(model_names(), " | ")));
 }
 
-ModelParams default_params(const std::string& name) { return table_defaults(model_info(name).params); }
-
-ModelParams params_for_fiber(const std::string& name, const PhysicalFiber& fiber) {
+namespace {
+// The model called `name`, after checking that `params` hold its struct: a
+// table applied to another model's struct would read the wrong fields.
+const ModelInfo& owner(const std::string& name, const ModelParameters& params) {
   const ModelInfo& m = model_info(name);
-  ModelParams p = table_defaults(m.params);
+  if (!m.owns(params))
+    throw Error(fmt::format("model {}: the parameters given are not {}'s ({})", name, name,
+                            params.empty() ? "none" : "another model's"));
+  return m;
+}
+}  // namespace
+
+ModelParameters default_params(const std::string& name) {
+  const ModelInfo& m = model_info(name);
+  return table_defaults(m.params, m.blank());
+}
+
+ModelParameters params_for_fiber(const std::string& name, const PhysicalFiber& fiber) {
+  const ModelInfo& m = model_info(name);
+  ModelParameters p = table_defaults(m.params, m.blank());
   FiberMapping mapping;
   m.from_fiber(fiber, p, mapping);
   return p;
 }
 
-void apply_setting(const std::string& name, ModelParams& params, const std::string& key_value) {
-  const ModelInfo& m = model_info(name);
+void apply_setting(const std::string& name, ModelParameters& params, const std::string& key_value) {
+  const ModelInfo& m = owner(name, params);
   apply_setting(m.name, m.params, params, key_value);
 }
 
-void apply_settings(const std::string& name, ModelParams& params,
+void apply_settings(const std::string& name, ModelParameters& params,
                     const std::vector<std::string>& key_values) {
   // Each key once: a repeated key would keep its last value silently.
   std::map<std::string, std::string> seen;
@@ -69,22 +84,45 @@ void apply_settings(const std::string& name, ModelParams& params,
   }
 }
 
-std::unique_ptr<Model> make_model(const std::string& name, const ModelParams& params) {
-  const ModelInfo& m = model_info(name);
+std::unique_ptr<Model> make_model(const std::string& name, const ModelParameters& params) {
+  const ModelInfo& m = owner(name, params);
   check_params(m.name, m.params, params);
   return m.make(params);
 }
 
-std::string describe_params(const std::string& name, const ModelParams& params) {
-  return describe(model_info(name).params, params);
+std::string describe_params(const std::string& name, const ModelParameters& params) {
+  if (params.empty()) return "";  // no parameters (a model not fitted): nothing to describe
+  return describe(owner(name, params).params, params);
 }
 
-std::vector<ParamAttribute> param_attributes(const std::string& name, const ModelParams& params) {
-  return to_attributes(model_info(name).params, params);
+std::vector<ParamAttribute> param_attributes(const std::string& name, const ModelParameters& params) {
+  return to_attributes(owner(name, params).params, params);
 }
 
-std::vector<std::string> approximations(const std::string& name, const ModelParams& params) {
-  return model_info(name).approximations(params);
+std::vector<std::string> approximations(const std::string& name, const ModelParameters& params) {
+  return owner(name, params).approximations(params);
+}
+
+std::vector<double> theta_r_shifts(const std::string& name, const ModelParameters& params) {
+  return owner(name, params).theta_r_shifts(params);
+}
+
+namespace {
+// The value of `key` in its table entry's file form (every model has lobes and sigma_a).
+std::vector<double> table_numbers(const std::string& name, const ModelParameters& params, const std::string& key) {
+  const ModelInfo& m = owner(name, params);
+  const ParamSpec* spec = find_param(m.params, key);
+  if (!spec) throw Error(fmt::format("model {} has no parameter '{}'", name, key));
+  return spec->attribute(params).numbers;
+}
+}  // namespace
+
+int predicted_lobes(const std::string& name, const ModelParameters& params) {
+  return static_cast<int>(table_numbers(name, params, "lobes").at(0));
+}
+
+int predicted_channels(const std::string& name, const ModelParameters& params) {
+  return static_cast<int>(table_numbers(name, params, "sigma_a").size());
 }
 
 std::string models_listing(bool markdown) {

@@ -4,24 +4,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <type_traits>
+#include <variant>
 
 #include "common/units.h"
 
 namespace fiberlab::analytic {
 
-std::string PhysicalFiber::roughness_text() const {
-  switch (roughness) {
-    case Roughness::Smooth: return "smooth";
-    case Roughness::Gaussian: {
-      const double bl = beta_long.empty() ? 0.0 : beta_long.front();
-      return fmt::format("gaussian beta = [{:g}, {:g}] deg", rad_to_deg(bl),
-                         rad_to_deg(beta_azim.empty() ? bl : beta_azim.front()));
-    }
-    case Roughness::ExitBlur: return "exit_blur";
-    case Roughness::Beckmann: return fmt::format("beckmann alpha = [{:g}, {:g}]", alpha_long, alpha_azim);
-    case Roughness::GGX: return fmt::format("ggx alpha = [{:g}, {:g}]", alpha_long, alpha_azim);
-  }
-  return "";
+const roughness::MicrofacetAlpha* microfacet_alpha(const Roughness& g) {
+  if (const auto* b = std::get_if<roughness::Beckmann>(&g)) return b;
+  if (const auto* x = std::get_if<roughness::Ggx>(&g)) return x;
+  return nullptr;
 }
 
 bool FiberMapping::user_sets(const std::string& key) const {
@@ -68,50 +61,40 @@ LobeWidths gaussian_lobe_widths(double beta_long, double beta_azim, double eta, 
 
 namespace fiberlab::analytic {
 
-void apply_fiber_basics(const PhysicalFiber& f, ModelParams& p) {
-  p.eta = f.eta;
-  p.sigma_a = f.sigma_a;
-  p.lobes = f.lobes;
-  p.alpha = tilt_shifts(f.scale_tilt);
-}
-
-void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& p, const WidthCalibration& cal,
+void apply_fiber_roughness(const PhysicalFiber& fiber, LobeWidths& p, const WidthCalibration& cal,
                            FiberMapping& mapping, double min_beta_long) {
   PhysicalFiber f = fiber;
-  if (f.microfacet()) {
-    f.roughness = PhysicalFiber::Roughness::Gaussian;
-    f.beta_long = {microfacet_as_gaussian(f.alpha_long)};
-    f.beta_azim = {microfacet_as_gaussian(f.alpha_azim)};
+  if (const auto* m = microfacet_alpha(f.roughness)) {
+    const roughness::Gaussian g{microfacet_as_gaussian(m->alpha_long), microfacet_as_gaussian(m->alpha_azim)};
+    f.roughness = g;
     mapping.notes.push_back(fmt::format(
         "roughness: the {} fiber read as the gaussian fiber of the same RMS facet slope per axis, beta = "
         "atan(alpha / sqrt 2) = [{:g}, {:g}] deg, then the calibrated rule (nominal: fit or --set the widths)",
-        fiber.roughness_text(), rad_to_deg(f.beta_long.front()), rad_to_deg(f.beta_azim.front())));
+        fiber.roughness_text(), rad_to_deg(g.beta_long), rad_to_deg(g.beta_azim)));
   }
-  const std::vector<double>& azim = f.beta_azim.empty() ? f.beta_long : f.beta_azim;
-  switch (f.roughness) {
-    case PhysicalFiber::Roughness::ExitBlur:
-      // SPEC s3: the exit blur's vMF is d'Eon's M_p (a theta_r width); a
-      // theta_h Gaussian needs half of it.
-      p.beta_long = f.beta_long;
-      if (cal.variable == WidthVariable::ThetaH)
-        for (double& b : p.beta_long) b *= 0.5;
-      p.beta_azim = azim;
-      break;
-    case PhysicalFiber::Roughness::Smooth:
-      p.beta_long = {0.0};
-      p.beta_azim = {0.0};
-      break;
-    case PhysicalFiber::Roughness::Gaussian: {
-      const double bl = f.beta_long.empty() ? 0.0 : f.beta_long.front();
-      const double ba = azim.empty() ? bl : azim.front();
-      const LobeWidths w = gaussian_lobe_widths(bl, ba, f.eta, f.lobes, cal);
-      p.beta_long = w.beta_long;
-      p.beta_azim = w.beta_azim;
-      break;
-    }
-    case PhysicalFiber::Roughness::Beckmann:
-    case PhysicalFiber::Roughness::GGX: break;  // mapped to Gaussian above
-  }
+  // Every roughness type has its rule here: a type without one does not compile.
+  std::visit(
+      [&](const auto& g) {
+        using G = std::decay_t<decltype(g)>;
+        if constexpr (std::is_same_v<G, roughness::ExitBlur>) {
+          // SPEC s3: the exit blur's vMF is d'Eon's M_p (a theta_r width); a
+          // theta_h Gaussian needs half of it.
+          p.beta_long = g.beta_long;
+          if (cal.variable == WidthVariable::ThetaH)
+            for (double& b : p.beta_long) b *= 0.5;
+          p.beta_azim = g.beta_azim;
+        } else if constexpr (std::is_same_v<G, roughness::Smooth>) {
+          p.beta_long = {0.0};
+          p.beta_azim = {0.0};
+        } else if constexpr (std::is_same_v<G, roughness::Gaussian>) {
+          const LobeWidths w = gaussian_lobe_widths(g.beta_long, g.beta_azim, f.eta, f.lobes, cal);
+          p.beta_long = w.beta_long;
+          p.beta_azim = w.beta_azim;
+        } else {
+          static_assert(std::is_base_of_v<roughness::MicrofacetAlpha, G>, "a roughness type without a rule");
+        }  // microfacet: read as gaussian above
+      },
+      f.roughness);
   for (double& b : p.beta_long) b = std::max(b, min_beta_long);
 }
 

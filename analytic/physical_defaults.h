@@ -28,24 +28,17 @@
 #include <string>
 #include <vector>
 
+#include "common/fiber.h"
+
 namespace fiberlab::analytic {
 
-struct PhysicalFiber {
-  enum class Roughness { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
-  double eta = 1.55;
-  double eccentricity = 1.0;
-  double scale_tilt = 0.0;  // radians, towards the root
-  std::vector<double> sigma_a{0.0, 0.0, 0.0};
-  Roughness roughness = Roughness::Smooth;
-  std::vector<double> beta_long{0.0};  // radians; indexed by p for exit_blur
-  std::vector<double> beta_azim;       // radians; empty: beta_long
-  // beckmann / ggx: the facets' roughness along the fiber axis and about it.
-  double alpha_long = 0.0, alpha_azim = 0.0;
+// What a model's rule is given: the simulated fiber (common/fiber.h) and the
+// number of lobes its tally separates.
+struct PhysicalFiber : Fiber {
   int lobes = 4;
 
-  bool microfacet() const { return roughness == Roughness::Beckmann || roughness == Roughness::GGX; }
   // "ggx alpha = [0.3, 0.1]": the roughness as the config gives it, for notes and errors.
-  std::string roughness_text() const;
+  std::string roughness_text() const { return roughness::text(roughness); }
 };
 
 // What a model's rule (ModelInfo::from_fiber) knows and says besides the
@@ -57,6 +50,9 @@ struct FiberMapping {
   std::vector<std::string> notes;
   bool user_sets(const std::string& key) const;
 };
+
+// The alpha of a beckmann or ggx fiber; null for the other roughness models.
+const roughness::MicrofacetAlpha* microfacet_alpha(const Roughness& g);
 
 // The gaussian fiber of the same RMS facet slope per axis: Beckmann's slopes
 // are Normal(0, alpha^2 / 2) per axis, so beta = atan(alpha / sqrt 2). A
@@ -111,20 +107,21 @@ double first_order_spread(double eta, int p);
 
 inline constexpr double kMinMarschnerBeta = 0.1 * 3.14159265358979323846 / 180.0;  // 0.1 deg
 
-}  // namespace fiberlab::analytic
-
-#include "analytic/model.h"
-
-namespace fiberlab::analytic {
-
 // The part of every model's physical defaults that is the same for all:
-// eta, sigma_a, lobes copied, alpha from the tilt (tilt_shifts).
-void apply_fiber_basics(const PhysicalFiber& fiber, ModelParams& params);
+// eta, sigma_a, lobes copied into the model's struct P (each model's own
+// rule adds its tilt: the theta_r shifts tilt_shifts() for a model with
+// per-lobe shifts, the scale tilt itself for a model with one).
+template <class P>
+void apply_fiber_basics(const PhysicalFiber& fiber, P& params) {
+  params.eta = fiber.eta;
+  params.sigma_a = fiber.sigma_a;
+  params.lobes = fiber.lobes;
+}
 // beta_long / beta_azim from the roughness (see the top of this file), in
 // the model's width variable; every beta_long at least min_beta_long.
 // A beckmann / ggx fiber goes through microfacet_as_gaussian() per axis, as
 // a gaussian fiber, and the mapping is noted in `mapping`.
-void apply_fiber_roughness(const PhysicalFiber& fiber, ModelParams& params,
+void apply_fiber_roughness(const PhysicalFiber& fiber, LobeWidths& widths,
                            const WidthCalibration& calibration, FiberMapping& mapping,
                            double min_beta_long = 0.0);
 

@@ -63,11 +63,8 @@ SmoothCylinderPrediction smooth_cylinder_prediction(double eta, double theta_i,
   return r;
 }
 
-SmoothCylinder::SmoothCylinder(ModelParams params) : params_(std::move(params)) {
+SmoothCylinder::SmoothCylinder(ExactParams params) : params_(std::move(params)) {
   if (!(params_.eta > 1.0)) throw Error(fmt::format("exact model: eta = {} must be > 1", params_.eta));
-  if (params_.eccentricity != 1.0)
-    throw Error(fmt::format("exact model: eccentricity = {} unsupported (circular fiber only, 1)",
-                            params_.eccentricity));
   if (params_.lobes < 1) throw Error("exact model: lobes must be >= 1");
   if (params_.sigma_a.empty()) throw Error("exact model: sigma_a needs at least one channel");
 }
@@ -142,7 +139,7 @@ std::vector<double> SmoothCylinder::bin_probabilities(const BinGrid& grid, doubl
   return out;
 }
 
-std::unique_ptr<Model> make_smooth_cylinder(const ModelParams& params) {
+std::unique_ptr<Model> make_smooth_cylinder(const ExactParams& params) {
   return std::make_unique<SmoothCylinder>(params);
 }
 
@@ -153,7 +150,7 @@ std::unique_ptr<Model> make_smooth_cylinder(const ModelParams& params) {
 namespace fiberlab::analytic {
 
 namespace {
-std::vector<std::string> exact_approximations(const ModelParams& p) {
+std::vector<std::string> exact_approximations(const ExactParams& p) {
   std::vector<std::string> out{
       "smooth circular fiber, no tilt: light only on the specular cone theta_r = -theta_i"};
   if (p.absorption == Absorption::Published)
@@ -163,23 +160,28 @@ std::vector<std::string> exact_approximations(const ModelParams& p) {
     out.push_back("absorption=chord: the exact chord length (SPEC s7)");
   return out;
 }
+// The rule from a simulated fiber (physical_defaults.h): circular fibers
+// only; no roughness and no tilt in this model.
+void exact_from_fiber(const PhysicalFiber& f, ExactParams& p, FiberMapping&) {
+  if (f.eccentricity != 1.0)
+    throw Error(fmt::format("model exact: circular fibers only; this fiber has eccentricity {:g}",
+                            f.eccentricity));
+  apply_fiber_basics(f, p);
+}
+
 }  // namespace
 
 ModelInfo exact_info() {
-  ModelInfo m;
+  using P = ExactParams;
+  ModelDefinition<P> m;
   m.name = "exact";
   m.reference = "the exact smooth circular cylinder (SPEC s7): every order p, 3D Fresnel, chord absorption";
-  m.params = {eta_param(), sigma_a_param(), absorption_param("chord"), lobes_param()};
+  m.params = {eta_param<P>(), sigma_a_param<P>(), absorption_param<P>("chord"), lobes_param<P>()};
   m.make = make_smooth_cylinder;
   m.approximations = exact_approximations;
-  m.from_fiber = [](const PhysicalFiber& f, ModelParams& p, FiberMapping&) {
-    if (f.eccentricity != 1.0)
-      throw Error(fmt::format("model exact: circular fibers only; this fiber has eccentricity {:g}",
-                              f.eccentricity));
-    apply_fiber_basics(f, p);
-    p.alpha = {0.0};  // no tilt in this model
-  };
-  return m;
+  m.from_fiber = exact_from_fiber;
+  m.theta_r_shifts = [](const P&) { return std::vector<double>{0.0}; };  // no tilt in this model
+  return define_model(std::move(m));
 }
 
 }  // namespace fiberlab::analytic

@@ -48,13 +48,21 @@ SmoothCylinderPrediction smooth_cylinder_prediction(double eta, double theta_i,
                                                     Absorption absorption, int lobes, int n_phi,
                                                     double residual_tol = 1e-7, int max_p = 100);
 
-// The Model: ModelParams eta, sigma_a, absorption, lobes (roughness ignored;
-// eccentricity must be 1). density() is the delta's weight N_p(phi) per
+// The model's parameters (its table, exact_info() in smooth_cylinder.cpp,
+// binds `--set` keys to these fields): a smooth circular fiber has no others.
+struct ExactParams {
+  double eta = 1.55;
+  std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
+  Absorption absorption = Absorption::Published;
+  int lobes = 4;  // lobes 0..L-2 separately, lobe L-1 = every p >= L-1
+};
+
+// The Model. density() is the delta's weight N_p(phi) per
 // unit phi, evaluated from the roots of Phi = phi (infinite at a caustic) and
 // valid on theta_r = -theta_i only (0 elsewhere).
 class SmoothCylinder : public Model {
  public:
-  explicit SmoothCylinder(ModelParams params);
+  explicit SmoothCylinder(ExactParams params);
   std::string name() const override { return "exact"; }
   int lobes() const override { return params_.lobes; }
   void density(int lobe, double theta_i, double phi_i, double theta_r, double phi,
@@ -63,9 +71,9 @@ class SmoothCylinder : public Model {
                                         double phi_i) const override;
 
  private:
-  ModelParams params_;
+  ExactParams params_;
 };
 
-std::unique_ptr<Model> make_smooth_cylinder(const ModelParams& params);
+std::unique_ptr<Model> make_smooth_cylinder(const ExactParams& params);
 
 }  // namespace fiberlab::analytic

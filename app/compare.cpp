@@ -4,6 +4,7 @@
 
 #include <sstream>
 
+#include "analytic/model_registry.h"
 #include "app/fit.h"
 #include "app/comma_list.h"
 #include "common/error.h"
@@ -77,13 +78,13 @@ Comparison set_up(const CompareRequest& o) {
 }
 
 Predicted predicted_by_model(const sim::ResultFile& result, const compare::ModelSpec& spec,
-                             const analytic::ModelParams& params,
+                             const analytic::ModelParameters& params,
                              const std::vector<std::string>& fiber_notes) {
   Predicted p;
   p.label = spec.label;
   p.header = compare::model_header(spec, params, fiber_notes);
   p.bins = compare::predict_result(*compare::make_model(spec.name, params), result);
-  p.alpha = params.alpha;
+  p.alpha = analytic::theta_r_shifts(spec.name, params);
   return p;
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "compare/comparison.h"
 #include "compare/fit.h"
 #include "compare/models.h"
@@ -45,7 +46,7 @@ struct Comparison {
   double max_chi2 = 0.0;         // 0: the five-sigma rule
   bool from_file = false;
   compare::ModelSpec spec;         // --model
-  analytic::ModelParams params;    // --model, before any fit
+  analytic::ModelParameters params;    // --model, before any fit
   std::vector<std::string> fiber_notes;  // the approximate mappings from the simulated fiber
   std::vector<std::string> fit_keys;
   Predicted file_prediction;  // --prediction: the file's bins
@@ -57,7 +58,7 @@ Comparison set_up(const CompareRequest& request);
 
 // The model's bins for the result.
 Predicted predicted_by_model(const sim::ResultFile& result, const compare::ModelSpec& spec,
-                             const analytic::ModelParams& params,
+                             const analytic::ModelParameters& params,
                              const std::vector<std::string>& fiber_notes = {});
 
 // The verdict on `predicted`.

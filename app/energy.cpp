@@ -63,8 +63,9 @@ std::vector<std::string> split(const std::string& text, char sep) {
   return parts;
 }
 
-std::vector<double> parse_degrees(const std::string& option, const std::string& text,
-                                  const DegreeRange& range) {
+// The angles in degrees, checked against `range`.
+std::vector<double> parse_degree_values(const std::string& option, const std::string& text,
+                                        const DegreeRange& range) {
   const std::string usage = fmt::format("expected degrees A,B,C or FROM:TO:STEP, {}", range.text);
   std::vector<double> degrees;
   if (text.find(':') != std::string::npos) {
@@ -90,13 +91,18 @@ std::vector<double> parse_degrees(const std::string& option, const std::string& 
                               degrees.size(), kMaxSweep));
   }
   if (degrees.empty()) throw Error(fmt::format("command line: {} '{}': no values ({})", option, text, usage));
-  std::vector<double> out;
-  for (double d : degrees) {
+  for (double d : degrees)
     if (!range.contains(d))
       throw Error(fmt::format("command line: {} '{}': {} is out of range ({})", option, text, d,
                               range.text));
-    out.push_back(deg_to_rad(d));
-  }
+  return degrees;
+}
+
+// The same angles in radians.
+std::vector<double> parse_degrees(const std::string& option, const std::string& text,
+                                  const DegreeRange& range) {
+  std::vector<double> out;
+  for (double d : parse_degree_values(option, text, range)) out.push_back(deg_to_rad(d));
   return out;
 }
 
@@ -179,15 +185,15 @@ EnergyResult energy(const EnergyRequest& o) {
 
   std::vector<compare::EnergyCurve> curves;
   if (simulated) curves.push_back(compare::simulation_energy(result));
-  std::vector<double> betas;
-  if (!o.beta_sweep.empty()) betas = parse_degrees("--beta-sweep", o.beta_sweep, kBetaRange);
+  std::vector<double> betas;  // degrees, as the parameter table takes them
+  if (!o.beta_sweep.empty()) betas = parse_degree_values("--beta-sweep", o.beta_sweep, kBetaRange);
   std::vector<std::string> skipped;
   for (const std::string& m : model_specs) {
     const compare::ModelSpec spec = compare::parse_model_spec(m);
     std::vector<std::string> sets;
     for (const std::string& kv : o.settings)
       if (has_key(spec.name, kv)) sets.push_back(kv);
-    analytic::ModelParams base;
+    analytic::ModelParameters base;
     std::unique_ptr<analytic::Model> model;
     try {
       base = compare::params_for(settings, spec, sets);
@@ -207,9 +213,11 @@ EnergyResult energy(const EnergyRequest& o) {
       add(*model, spec.label, -1.0);
       continue;
     }
-    for (double b : betas) {
-      analytic::ModelParams p = base;
-      p.beta_long = {b};
+    const analytic::ParamSpec& beta_long = *analytic::find_param(analytic::model_info(spec.name).params, "beta_long");
+    for (double degrees : betas) {
+      analytic::ModelParameters p = base;
+      beta_long.set_entry(p, -1, degrees);  // one width for every lobe
+      const double b = deg_to_rad(degrees);
       add(*compare::make_model(spec.name, p), fmt::format("{} beta_long={:g}", spec.label, rad_to_deg(b)), b);
     }
   }

@@ -2,16 +2,18 @@
 
 #include <set>
 
+#include "analytic/model_registry.h"
 #include "common/error.h"
 #include "compare/models.h"
 
 namespace fiberlab::app {
 
 compare::Verdict judge_model(const sim::ResultFile& result, const std::string& name,
-                             const analytic::ModelParams& params, const compare::Options& options,
+                             const analytic::ModelParameters& params, const compare::Options& options,
                              double max_chi2) {
   const auto model = compare::make_model(name, params);
-  return compare::judge(compare::compare(result, compare::predict_result(*model, result), params.alpha, options),
+  return compare::judge(compare::compare(result, compare::predict_result(*model, result),
+                                        analytic::theta_r_shifts(name, params), options),
                         max_chi2);
 }
 

@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "compare/comparison.h"
 #include "compare/fit.h"
 #include "compare/verdict.h"
@@ -22,7 +23,7 @@ inline constexpr int kFitIterations = 40;
 // The verdict (compare::judge, max_chi2 0: the five-sigma rule) on model
 // `name` with `params` against `result`.
 compare::Verdict judge_model(const sim::ResultFile& result, const std::string& name,
-                             const analytic::ModelParams& params, const compare::Options& options,
+                             const analytic::ModelParameters& params, const compare::Options& options,
                              double max_chi2);
 
 struct FitRequest {
@@ -36,7 +37,7 @@ struct FitRequest {
 };
 
 struct FitReport {
-  analytic::ModelParams start;
+  analytic::ModelParameters start;
   compare::FitResult fit;
   compare::Verdict before, after;
 };

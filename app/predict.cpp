@@ -1,5 +1,7 @@
 #include "app/predict.h"
 
+#include "analytic/model_registry.h"
+
 namespace fiberlab::app {
 
 ChosenModel choose_model(const sim::Settings& s, const compare::ModelSpec& spec,
@@ -15,8 +17,8 @@ compare::PredictionFile predict(const sim::Settings& s, const ChosenModel& chose
   compare::PredictionFile pred;
   pred.model = chosen.spec.name;
   pred.grid = BinGrid::make(s.tally.n_theta, s.tally.n_phi, s.tally.theta_bins);
-  pred.lobes = chosen.params.lobes;
-  pred.channels = static_cast<int>(chosen.params.sigma_a.size());
+  pred.lobes = analytic::predicted_lobes(chosen.spec.name, chosen.params);
+  pred.channels = analytic::predicted_channels(chosen.spec.name, chosen.params);
   for (const sim::Settings::Incidence& inc : s.incidences()) {
     pred.theta_i.push_back(inc.theta_i);
     pred.phi_i.push_back(inc.phi_i);

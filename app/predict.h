@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "compare/models.h"
 #include "compare/prediction_file.h"
 #include "sim/run/settings.h"
@@ -18,7 +19,7 @@ namespace fiberlab::app {
 // (which makes the model's own checks).
 struct ChosenModel {
   compare::ModelSpec spec;
-  analytic::ModelParams params;
+  analytic::ModelParameters params;
   std::vector<std::string> fiber_notes;  // the approximate mappings from the simulated fiber
   std::unique_ptr<analytic::Model> model;
 };

@@ -17,8 +17,8 @@ using namespace fiberlab::analytic;
 
 // Table 1 typical values: beta_R 7.5, beta_TT 3.75, beta_TRT 15 deg (as
 // theta_h widths), alpha_R -7.5 deg of theta_h = -15 deg of theta_r.
-ModelParams bench_params(bool exact, bool glints, double eccentricity) {
-  ModelParams p;
+Marschner2003Params bench_params(bool exact, bool glints, double eccentricity) {
+  Marschner2003Params p;
   p.eta = 1.55;
   p.sigma_a = {0.2, 0.4, 0.8};
   p.beta_long = {deg_to_rad(7.5), deg_to_rad(3.75), deg_to_rad(15.0)};

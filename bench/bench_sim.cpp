@@ -44,16 +44,14 @@ Settings bench_case(char which) {
   s.tally.lobes = 8;
   if (which == 'a') {
     s.fiber.sigma_a = {0.0};
-    s.roughness.model = RoughnessModel::Smooth;
+    s.fiber.roughness = fiberlab::roughness::Smooth{};
     s.source.theta_i = {deg_to_rad(30.0)};
     return s;
   }
   s.fiber.sigma_a = {0.2, 0.4, 0.8};
   s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.model = RoughnessModel::Gaussian;
   const double beta = deg_to_rad(which == 'c' ? 7.5 : 5.0);
-  s.roughness.beta_long = {beta};
-  s.roughness.beta_azim = {beta};
+  s.fiber.roughness = fiberlab::roughness::Gaussian{beta, beta};
   s.source.theta_i = {deg_to_rad(which == 'c' ? 17.0 : 30.0)};
   s.source.phi_i = {deg_to_rad(which == 'c' ? 11.0 : 0.0)};
   if (which == 'c') s.fiber.eccentricity = 0.8;
@@ -65,12 +63,11 @@ Settings bench_case(char which) {
     s.fiber.eccentricity = 0.8;
     s.source.theta_i = {deg_to_rad(17.0)};
     s.source.phi_i = {deg_to_rad(11.0)};
-    s.roughness.model = which == 'k' ? RoughnessModel::Beckmann : RoughnessModel::GGX;
-    s.roughness.alpha_long = s.roughness.alpha_azim = which == 'm' ? 0.3 : 0.19;
-    if (which == 'm') {
-      s.fiber.sigma_a = {0.0};
-      s.roughness.masking = Masking::SmithG1;
-    }
+    const double alpha = which == 'm' ? 0.3 : 0.19;
+    const fiberlab::Masking masking = which == 'm' ? fiberlab::Masking::SmithG1 : fiberlab::Masking::None;
+    if (which == 'k') s.fiber.roughness = fiberlab::roughness::Beckmann{{alpha, alpha, masking}};
+    else s.fiber.roughness = fiberlab::roughness::Ggx{{alpha, alpha, masking}};
+    if (which == 'm') s.fiber.sigma_a = {0.0};
   }
   return s;
 }

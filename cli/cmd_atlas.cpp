@@ -1,297 +1,94 @@
 // `fiberlab atlas CONFIG -o OUT.h5 [--report DIR] [--threads T] [--photons N] [--quiet]`
 // `fiberlab atlas --resume OUT.checkpoint.h5 [CONFIG] [--threads T] [--quiet]`
 // How wrong is each model for each physical fiber of a sweep, per lobe,
-// before and after fitting its free parameters? The sweep and the
-// judgement: compare/atlas.h; the config: compare/atlas_config.h; the file:
-// compare/atlas_file.h; the report: compare/atlas_report.h; the checkpoint
-// saved after each fiber (OUT.checkpoint.h5, as `fiberlab run`'s):
-// compare/atlas_checkpoint.h. Under `mpirun -np N` the fibers are spread
-// over the ranks and rank 0 alone writes (run_fibers_on_ranks; docs/ATLAS.md
-// "Many processes").
+// before and after fitting its free parameters? The workflow (checkpoint,
+// resume, the fibers spread over MPI ranks): app/atlas.h; here the flags
+// and what is printed.
 // Exit status 0 when written, 2 on bad input (nothing written), 128 + signal
 // when interrupted (the finished fibers kept in the checkpoint, no OUT).
 #include <fmt/core.h>
 
-#include <omp.h>
-
-#include <unistd.h>
-
-#include <cstring>
-#include <filesystem>
 #include <memory>
-#include <optional>
 
-#include "app/on_all_ranks.h"
+#include "app/atlas.h"
 #include "cli/commands.h"
-#include "common/atomic_output.h"
-#include "common/error.h"
 #include "common/interrupt.h"
-#include "compare/atlas.h"
-#include "compare/atlas_checkpoint.h"
-#include "compare/atlas_config.h"
-#include "compare/atlas_file.h"
-#include "compare/atlas_report.h"
-#include "sim/store/checkpoint.h"
-#include "sim/run/memory_budget.h"
 #include "sim/run/process_group.h"
-#include "sim/run/rank_agreement.h"
-#include "sim/run/settings.h"
-#include "sim/store/exact_tally.h"
 
 namespace fiberlab::cli {
 
 namespace {
 
-using app::on_all_ranks;
-
 struct AtlasOptions {
-  std::string config, output, report, threads, photons, resume;
+  app::AtlasRequest request;
   bool quiet = false;
 };
 
-std::string default_report_dir(const std::string& output) {
-  std::filesystem::path p(output);
-  return (p.parent_path() / (p.stem().string() + "_report")).string();
+void print_interrupted(const app::AtlasRun& r) {
+  const char* signal = signal_name(r.interrupted_by);
+  if (r.fibers.empty())
+    fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first {} finished; nothing written\n", signal,
+               r.ranks > 1 ? "fibers were" : "fiber was");
+  else
+    fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
+               "fiberlab atlas --resume {}\n", signal, r.fibers.size(), r.fibers_total, r.checkpoint, r.checkpoint);
 }
 
-// The report folder is made at the end; here only whether it can be.
-void check_report_dir(const std::string& dir) {
-  namespace fs = std::filesystem;
-  std::error_code ec;
-  if (fs::exists(dir, ec)) {
-    if (!fs::is_directory(dir, ec)) throw Error(fmt::format("--report {}: exists and is not a folder", dir));
-    return;
-  }
-  const fs::path parent = fs::path(dir).parent_path();
-  if (!parent.empty() && !fs::is_directory(parent, ec))
-    throw Error(fmt::format("--report {}: its parent folder {} does not exist", dir, parent.string()));
-}
-
-// What one invocation runs: a new atlas, or the rest of a checkpoint's.
-struct AtlasJob {
-  compare::AtlasRunSetup setup;
-  compare::AtlasConfig config;
-  std::vector<compare::AtlasFiberResult> fibers;  // finished (from the checkpoint when resuming)
-  std::string output, report, checkpoint;
-  std::vector<std::string> inputs;                // files read: never overwritten
-  bool resumed = false;
-};
-
-AtlasJob new_job(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group) {
-  if (o.config.empty()) throw Error("atlas: give a CONFIG file, or --resume CHECKPOINT");
-  if (o.output.empty()) throw Error("atlas: give the output file with -o OUT.h5");
-  AtlasJob job;
-  job.config = compare::load_atlas_config(o.config);
-  if (!o.photons.empty()) compare::override_photons(job.config, o.photons);
-  job.output = o.output;
-  job.report = o.report.empty() ? default_report_dir(o.output) : o.report;
-  job.checkpoint = sim::checkpoint_path(o.output);
-  job.inputs = {o.config};
-  if (group.is_root() && std::filesystem::exists(job.checkpoint))
-    throw Error(fmt::format("{} exists (an interrupted atlas of this output): resume it with "
-                            "`fiberlab atlas --resume {}`, or delete it", job.checkpoint, job.checkpoint));
-  job.setup = {o.config, job.config.yaml, o.photons, std::filesystem::path(o.output).filename().string(),
-               o.report.empty() ? "" : std::filesystem::absolute(o.report).string(), command};
-  return job;
-}
-
-// The checkpoint holds the config, the flags and OUT (in its own folder):
-// only --threads and --quiet may be given; CONFIG, if given, must be the same.
-AtlasJob resumed_job(const AtlasOptions& o) {
-  if (!o.output.empty() || !o.report.empty() || !o.photons.empty())
-    throw Error("--resume: -o, --report and --photons are the checkpoint's and cannot be changed "
-                "(only --threads and --quiet; CONFIG, if given, must be the checkpoint's)");
-  compare::AtlasCheckpoint c = compare::read_atlas_checkpoint(o.resume);
-  if (!o.config.empty()) compare::check_same_atlas_config(c, compare::load_atlas_config(o.config), o.resume);
-  AtlasJob job;
-  job.setup = std::move(c.setup);
-  job.config = std::move(c.config);
-  job.fibers = std::move(c.fibers);
-  job.output = (std::filesystem::path(o.resume).parent_path() / job.setup.output_name).string();
-  job.report = job.setup.report_dir.empty() ? default_report_dir(job.output) : job.setup.report_dir;
-  job.checkpoint = o.resume;
-  job.inputs = {o.resume};
-  if (!o.config.empty()) job.inputs.push_back(o.config);
-  job.resumed = true;
-  return job;
-}
-
-
-// Rank r's fiber bytes into rank 0: each rank's segment of a zeroed buffer,
-// summed exactly (the other ranks add zeros). Returns, on rank 0, every
-// rank's bytes (empty for a rank without a fiber this round).
-std::vector<std::vector<std::uint8_t>> gather_to_root(const sim::ProcessGroup& group,
-                                                      const std::vector<std::uint8_t>& mine) {
-  using Word = sim::ExactTally::Word;
-  const std::size_t ranks = static_cast<std::size_t>(group.size()), per_word = sizeof(Word);
-  std::vector<std::int64_t> sizes(ranks, 0);
-  sizes[group.rank()] = static_cast<std::int64_t>(mine.size());
-  group.max(sizes);
-  std::vector<std::size_t> first(ranks + 1, 0);
-  for (std::size_t r = 0; r < ranks; ++r) first[r + 1] = first[r] + (static_cast<std::size_t>(sizes[r]) + per_word - 1) / per_word;
-  std::vector<Word> words(first[ranks], 0);
-  std::memcpy(words.data() + first[group.rank()], mine.data(), mine.size());
-  group.sum_to_root(words);
-  std::vector<std::vector<std::uint8_t>> out(ranks);
-  if (!group.is_root()) return out;
-  for (std::size_t r = 0; r < ranks; ++r) {
-    out[r].resize(static_cast<std::size_t>(sizes[r]));
-    std::memcpy(out[r].data(), words.data() + first[r], out[r].size());
-  }
-  return out;
-}
-
-// Under an MPI launcher: fiber i of each round of N runs on rank i mod N;
-// rank 0 gathers the round, saves the checkpoint and, at the end, writes
-// OUT and the report. Returns false when a signal stopped the atlas (the
-// finished rounds kept in the checkpoint).
-bool run_fibers_on_ranks(const sim::ProcessGroup& group, AtlasJob& job, const compare::AtlasControl& control) {
-  const std::size_t n = job.config.fibers.size(), ranks = static_cast<std::size_t>(group.size());
-  const std::string scratch =
-      (std::filesystem::temp_directory_path() / fmt::format("fiberlab_atlas_{}_{}.h5", ::getpid(), group.rank()))
-          .string();
-  while (job.fibers.size() < n) {
-    const std::size_t mine = job.fibers.size() + static_cast<std::size_t>(group.rank());
-    std::vector<std::uint8_t> bytes;
-    std::vector<std::int64_t> stopped{0};
-    on_all_ranks(group, [&] {
-      try {
-        if (mine < n) bytes = compare::pack_atlas_fiber(job.config, mine, compare::run_atlas_fiber(job.config, mine, control),
-                                                        scratch);
-      } catch (const compare::AtlasInterrupted& s) {
-        stopped[0] = s.signal;
-      }
-    });
-    group.max(stopped);
-    if (stopped[0] != 0) {
-      if (group.is_root()) {
-        if (job.fibers.empty())
-          fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first fibers were finished; nothing "
-                     "written\n", signal_name(static_cast<int>(stopped[0])));
-        else
-          fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
-                     "fiberlab atlas --resume {}\n", signal_name(static_cast<int>(stopped[0])), job.fibers.size(), n,
-                     job.checkpoint, job.checkpoint);
-      }
-      exit_code = 128 + static_cast<int>(stopped[0]);
-      return false;
-    }
-    const auto received = gather_to_root(group, bytes);
-    on_all_ranks(group, [&] {
-      const std::size_t round = job.fibers.size();
-      for (std::size_t r = 0; r < ranks && round + r < n; ++r) {
-        if (group.is_root())
-          job.fibers.push_back(compare::unpack_atlas_fiber(job.config, round + r, received[r], scratch));
-        else
-          job.fibers.emplace_back();  // rank 0 keeps the results; the others only count them
-      }
-      if (group.is_root()) compare::write_atlas_checkpoint(job.checkpoint, job.setup, job.config, job.fibers);
-    });
-  }
-  return true;
-}
-
-void atlas_on_ranks(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group);
-
-void atlas_command(const AtlasOptions& o, const std::string& command) {
-  sim::ProcessGroup group;
-  try {
-    atlas_on_ranks(o, command, group);
-  } catch (const sim::FailedElsewhere&) {
+void atlas_command(const AtlasOptions& o) {
+  // The group (MPI) lives until this rank has printed.
+  const sim::ProcessGroup group;
+  const auto progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
+  const app::AtlasRun r =
+      app::run_atlas(group, o.request, o.quiet ? std::function<void(const std::string&)>{} : progress);
+  if (r.failed_elsewhere) {
     exit_code = 2;  // rank 0 reports
-  }
-}
-
-// One process: the fibers in order, the checkpoint after each. Under an MPI
-// launcher (several ranks): every rank reads CONFIG (or the checkpoint),
-// the ranks check they agree, the fibers are spread over them, and only
-// rank 0 writes (run_fibers_on_ranks).
-void atlas_on_ranks(const AtlasOptions& o, const std::string& command, const sim::ProcessGroup& group) {
-  AtlasJob job;
-  compare::AtlasControl control;
-  on_all_ranks(group, [&] {
-    job = o.resume.empty() ? new_job(o, command, group) : resumed_job(o);
-    if (!o.threads.empty()) {
-      control.threads = static_cast<int>(sim::parse_integer_flag("--threads", o.threads, 1, sim::kMaxThreads));
-      omp_set_num_threads(control.threads);
-    }
-    if (group.is_root()) {
-      check_output_target(job.output, job.inputs);
-      // The checkpoint is rewritten in place when resuming; never over CONFIG.
-      check_output_target(job.checkpoint, o.config.empty() ? std::vector<std::string>{} : std::vector{o.config});
-      remove_stale_temporaries(job.checkpoint);  // of an atlas killed while writing it
-      check_report_dir(job.report);
-    }
-  });
-  if (group.size() > 1)
-    on_all_ranks(group, [&] {
-      const std::string text = fmt::format("{}fibers done: {}\n", compare::atlas_config_identity(job.config),
-                                           job.fibers.size());
-      if (const auto disagreement = sim::ranks_disagree(group, text)) throw Error(*disagreement);
-    });
-  if (!o.quiet && group.is_root())
-    control.progress = [](const std::string& line) { fmt::print(stderr, "{}\n", line); };
-
-  install_interrupt_handlers();
-  const std::size_t n = job.config.fibers.size();
-  if (job.resumed && control.progress)
-    control.progress(fmt::format("resuming: {} of {} fibers from {}", job.fibers.size(), n, job.checkpoint));
-  if (group.size() > 1) {
-    if (!run_fibers_on_ranks(group, job, control) || !group.is_root()) return;
-  } else try {
-    while (job.fibers.size() < n) {
-      job.fibers.push_back(compare::run_atlas_fiber(job.config, job.fibers.size(), control));
-      compare::write_atlas_checkpoint(job.checkpoint, job.setup, job.config, job.fibers);
-    }
-  } catch (const compare::AtlasInterrupted& s) {
-    if (job.fibers.empty())
-      fmt::print(stderr, "fiberlab: atlas interrupted by {} before its first fiber was finished; nothing "
-                 "written\n", signal_name(s.signal));
-    else
-      fmt::print(stderr, "fiberlab: atlas interrupted by {}: {} of {} fibers saved in {}; resume with: "
-                 "fiberlab atlas --resume {}\n", signal_name(s.signal), job.fibers.size(), n, job.checkpoint,
-                 job.checkpoint);
-    exit_code = 128 + s.signal;
     return;
   }
-  compare::write_atlas_file(job.output, job.config, job.fibers);
-  fmt::print("wrote {}\n", job.output);
-  fmt::print("\n{}", compare::atlas_headline_markdown(job.config, job.fibers));
-  fmt::print("{}", compare::write_atlas_report(job.report, job.output, job.config, job.fibers, job.setup.command));
-  if (interrupt_requested()) {  // during the report (its plots run in a child process the signal reached too)
+  if (r.interrupted_by != 0) {
+    if (r.root) print_interrupted(r);
+    exit_code = 128 + r.interrupted_by;
+    return;
+  }
+  if (!r.written()) return;
+  fmt::print("wrote {}\n", r.output);
+  fmt::print("\n{}", r.headline);
+  const app::AtlasReportOutcome report = app::write_atlas_report(r);
+  fmt::print("{}", report.line);
+  if (report.interrupted_by != 0) {
     fmt::print(stderr, "fiberlab: atlas interrupted by {} while making its report: {} is written, the report may "
                "be incomplete; both are written again by: fiberlab atlas --resume {}\n",
-               signal_name(interrupt_signal()), job.output, job.checkpoint);
-    exit_code = 128 + interrupt_signal();
+               signal_name(report.interrupted_by), r.output, r.checkpoint);
+    exit_code = 128 + report.interrupted_by;
     return;
   }
-  // The file and the report are written: the checkpoint has served.
-  std::error_code ec;
-  if (!std::filesystem::remove(job.checkpoint, ec) && ec)
-    fmt::print(stderr, "fiberlab: warning: could not remove the checkpoint {}: {}\n", job.checkpoint, ec.message());
+  if (!report.checkpoint_left.empty())
+    fmt::print(stderr, "fiberlab: warning: could not remove the checkpoint {}: {}\n", r.checkpoint,
+               report.checkpoint_left);
 }
 
 }  // namespace
 
 void add_atlas_command(CLI::App& app) {
   auto o = std::make_shared<AtlasOptions>();
+  app::AtlasRequest& q = o->request;
   CLI::App* cmd = app.add_subcommand(
       "atlas",
       "Simulate a sweep of physical fibers and judge every registered model on each, before and after "
       "fitting its free parameters (configs/atlas_small.yaml; docs/ATLAS.md)");
-  cmd->add_option("config", o->config, "Atlas config (.yaml); with --resume, checked against the checkpoint's");
-  cmd->add_option("-o,--output", o->output, "Output file (.h5, format fiber-atlas)");
-  cmd->add_option("--report", o->report, "Report folder (default: OUT without .h5, plus _report)");
-  cmd->add_option("--threads", o->threads, "OpenMP threads (default: all cores)");
-  cmd->add_option("--photons", o->photons, "Photons per fiber and incident direction (overrides the config)");
-  cmd->add_option("--resume", o->resume,
+  cmd->add_option("config", q.config, "Atlas config (.yaml); with --resume, checked against the checkpoint's");
+  cmd->add_option("-o,--output", q.output, "Output file (.h5, format fiber-atlas)");
+  cmd->add_option("--report", q.report, "Report folder (default: OUT without .h5, plus _report)");
+  cmd->add_option("--threads", q.threads, "OpenMP threads (default: all cores)");
+  cmd->add_option("--photons", q.photons, "Photons per fiber and incident direction (overrides the config)");
+  cmd->add_option("--resume", q.resume,
                   "Finish the atlas saved in this checkpoint (OUT.checkpoint.h5, written after each fiber)");
   cmd->add_flag("--quiet", o->quiet, "No progress on stderr");
   cmd->callback([o] {
-    std::string command = "fiberlab atlas " + o->config + " -o " + o->output;
-    if (!o->report.empty()) command += " --report " + o->report;
-    if (!o->photons.empty()) command += " --photons " + o->photons;
-    atlas_command(*o, command);
+    app::AtlasRequest& q = o->request;
+    q.command = "fiberlab atlas " + q.config + " -o " + q.output;
+    if (!q.report.empty()) q.command += " --report " + q.report;
+    if (!q.photons.empty()) q.command += " --photons " + q.photons;
+    atlas_command(*o);
   });
 }
 

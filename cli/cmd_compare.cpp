@@ -53,7 +53,7 @@ void compare_command(const app::CompareRequest& o) {
   compare::Verdict v = app::judge(c, current);
   fmt::print("{}", compare::verdict_table(v, result.lobes));
 
-  analytic::ModelParams params = c.params;
+  analytic::ModelParameters params = c.params;
   std::string fit_json = "null", fit_md;
   if (!c.fit_keys.empty()) {
     app::JointFit fit = app::fit_jointly(c, print_progress);

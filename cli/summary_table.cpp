@@ -43,7 +43,7 @@ void print_summary(std::FILE* out, const sim::ResultFile& r) {
     fmt::print(out, "\n  {:<10}", "truncated");
     for (int c = 0; c < r.channels; ++c)
       fmt::print(out, " {:>24}", fmt::format("{:.3e}", r.truncated[k * r.channels + c] / N));
-    if (r.settings.roughness.masking != sim::Masking::None) {  // the weight masking removed
+    if (roughness::masking(r.settings.fiber.roughness) != Masking::None) {  // the weight masking removed
       fmt::print(out, "\n  {:<10}", "lost");
       for (int c = 0; c < r.channels; ++c)
         fmt::print(out, " {:>24}", fmt::format("{:.6f}", r.lost[k * r.channels + c] / N));

@@ -46,9 +46,9 @@ sim::ResultFile simulate(const sim::Settings& s, const AtlasControl& control) {
 }
 
 std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::string& name,
-                                        const analytic::ModelParams& p) {
+                                        const analytic::ModelParameters& p) {
   const auto model = compare::make_model(name, p);
-  return compare(r, predict_result(*model, r), p.alpha);
+  return compare(r, predict_result(*model, r), analytic::theta_r_shifts(name, p));
 }
 
 // "fitted (converged: why)", "fitted (at a bound: key = value; why)" or
@@ -61,17 +61,71 @@ std::string fit_status(const FitResult& fit) {
   return fmt::format("fitted ({}: {})", outcome_name(fit.outcome), fit.stop_reason);
 }
 
+// fit.per_lobe: whether the model has a per-lobe parameter among `keys`
+// (compare/fit.h per_lobe_keys renames at least one key for some lobe).
+bool has_per_lobe_keys(const std::string& model, const std::vector<std::string>& keys, int lobes) {
+  for (int l = 0; l < lobes; ++l)
+    if (per_lobe_keys(model, keys, l) != keys) return true;
+  return false;
+}
+
+// fit.per_lobe: each lobe of the fit fitted alone from the joint fit's
+// values (compare/atlas.h), and that lobe judged again with them.
+void fit_lobe_by_lobe(const AtlasConfig& config, const sim::ResultFile& r, const std::string& model,
+                      const std::string& name, const std::vector<std::string>& keys, AtlasModelResult& m,
+                      const AtlasControl& control) {
+  if (keys.empty()) {
+    m.lobe_fit_status = "not fitted lobe by lobe: its parameter table marks no parameter free";
+    return;
+  }
+  if (!m.fitted) {
+    m.lobe_fit_status = "not fitted lobe by lobe: no joint fit to start from";
+    return;
+  }
+  if (!has_per_lobe_keys(model, keys, r.lobes)) {
+    std::string joined;
+    for (const std::string& k : keys) joined += (joined.empty() ? "" : ", ") + k;
+    m.lobe_fit_status = fmt::format("not fitted lobe by lobe: no per-lobe parameter (its free keys {} are "
+                                    "shared by every lobe)", joined);
+    say(control, fmt::format("  {}: {}", name, m.lobe_fit_status));
+    return;
+  }
+  check_interrupt();
+  try {
+    Options fit_options;
+    fit_options.lobes = config.fit_lobes;
+    m.lobe_fits = fit_each_lobe(r, model, m.fit.params, keys, fit_options, config.max_iterations,
+                                [&](const std::string& line) {
+                                  check_interrupt();
+                                  say(control, "  " + name + " per-lobe " + line);
+                                });
+  } catch (const Error& e) {
+    m.lobe_fits.clear();
+    m.lobe_fit_status = std::string("per-lobe fit failed: ") + e.what();
+    say(control, fmt::format("  {}: {}", name, m.lobe_fit_status));
+    return;
+  }
+  m.lobe_fit_status = "fitted lobe by lobe";
+  for (const LobeFit& lf : m.lobe_fits) {
+    m.lobe_fit_lines.push_back(fit_status(lf.fit));
+    for (const LobeComparison& c : judge_model(r, model, lf.fit.params))
+      if (c.lobe == lf.lobe) m.after_lobe_fit.push_back(c);
+    say(control, fmt::format("  {} {}: {}", name, lobe_name(lf.lobe, r.lobes), m.lobe_fit_lines.back()));
+  }
+}
+
 AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fiber, const sim::ResultFile& r,
                                 const std::string& name, const AtlasControl& control) {
   const auto t0 = Clock::now();
   AtlasModelResult m;
   m.model = name;  // the entry's name; `model` is the registered model it runs
   const std::string& model = registered_model(config, name);
-  analytic::ModelParams p;
+  analytic::ModelParameters p;
   try {
     p = atlas_start_params(config, fiber, name);
   } catch (const Error& e) {
     m.status = std::string("not applicable: ") + e.what();
+    if (config.per_lobe) m.lobe_fit_status = "not fitted lobe by lobe: not applicable";
     say(control, fmt::format("  {}: {}", name, m.status));
     return m;
   }
@@ -100,6 +154,7 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
       m.status = std::string("fit failed: ") + e.what();
     }
   }
+  if (config.per_lobe) fit_lobe_by_lobe(config, r, model, name, keys, m, control);
   m.seconds = seconds_since(t0);
   say(control, fmt::format("  {}: {} ({:.1f} s)", name, m.status, m.seconds));
   return m;
@@ -107,11 +162,11 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
 
 }  // namespace
 
-analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+analytic::ModelParameters atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
                                          const std::string& entry) {
   const std::string& model = registered_model(config, entry);
   const auto fixed = config.model_parameters.find(entry);
-  const analytic::ModelParams p = params_for(
+  const analytic::ModelParameters p = params_for(
       fiber.settings,
       ModelSpec{model, fixed == config.model_parameters.end() ? std::vector<std::string>{} : fixed->second, entry},
       {});
@@ -165,6 +220,10 @@ AtlasLobeSummary summarize_lobe(const AtlasModelResult& m, int lobe) {
   };
   add(m.before, s.chi2_before, s.dof_before, s.max_abs_energy_error, true);
   add(m.after, s.chi2_after, s.dof_after, s.max_abs_energy_error_after, false);
+  for (const LobeFit& lf : m.lobe_fits) s.lobe_fitted = s.lobe_fitted || lf.lobe == lobe;
+  const bool judged = s.judged;  // judged before or after the joint fit, as above
+  add(m.after_lobe_fit, s.chi2_lobe_fit, s.dof_lobe_fit, s.max_abs_energy_error_lobe_fit, false);
+  s.judged = judged;
   return s;
 }
 

@@ -13,7 +13,17 @@
 // - one joint fit of every free parameter over all theta_i and channels
 //   (a model's parameters describe the fiber, not a lighting direction), and
 //   the comparison again ("after"). A model whose table marks no parameter
-//   free (exact) has no "after".
+//   free (exact) has no "after";
+// - with fit.per_lobe, then each lobe of the fit (fit.lobes, default every
+//   lobe) fitted alone from the joint fit's values (compare::fit_each_lobe:
+//   a per-lobe list key such as beta_long becomes the lobe's own entry
+//   beta_long[p], scale_tilt the lobe's shift alpha[p], scalars stay; each fit
+//   judges that lobe's bins only), and that lobe compared again with its own
+//   values ("after per-lobe fit"). The fit starts where the joint fit ended
+//   and takes only steps that lower that lobe's chi-square, so a lobe's
+//   chi-square after it is at most the one after the joint fit. A model
+//   whose free keys have no per-lobe entry (a scalar roughness) is not
+//   fitted lobe by lobe, and its per-lobe status says so.
 // The statistics are compare/'s own; the atlas adds none.
 #include <functional>
 #include <string>
@@ -33,6 +43,12 @@ struct AtlasModelResult {
   std::vector<LobeComparison> before, after;  // per (k, lobe, channel), compare()'s order
   FitResult fit;       // keys empty when not fitted
   double seconds = 0.0;
+  // fit.per_lobe: "" without it; else "fitted lobe by lobe" or "not fitted
+  // lobe by lobe: why".
+  std::string lobe_fit_status;
+  std::vector<LobeFit> lobe_fits;          // per lobe of the fit, in fit.lobes order
+  std::vector<std::string> lobe_fit_lines;  // per lobe fit: its status line (as `status` for the joint fit)
+  std::vector<LobeComparison> after_lobe_fit;  // each fitted lobe's rows at its own fitted values
 };
 
 struct AtlasFiberResult {
@@ -66,7 +82,7 @@ AtlasFiberResult run_atlas_fiber(const AtlasConfig& config, std::size_t fiber, c
 // fiber (ModelInfo::from_fiber) with the entry's fixed settings on top,
 // checked by the model. Throws fiberlab::Error when
 // the model refuses the fiber (then "not applicable").
-analytic::ModelParams atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
+analytic::ModelParameters atlas_start_params(const AtlasConfig& config, const AtlasFiber& fiber,
                                          const std::string& entry);
 
 // Summary per fiber, model and lobe, over every theta_i and channel.
@@ -77,6 +93,10 @@ struct AtlasLobeSummary {
   int dof_before = 0, dof_after = 0;
   double max_abs_energy_error_after = 0.0;
   bool judged = false;
+  // After the lobe's own fit (fit.per_lobe; lobe_fitted false otherwise).
+  double chi2_lobe_fit = 0.0, max_abs_energy_error_lobe_fit = 0.0;
+  int dof_lobe_fit = 0;
+  bool lobe_fitted = false;
 };
 AtlasLobeSummary summarize_lobe(const AtlasModelResult& m, int lobe);
 

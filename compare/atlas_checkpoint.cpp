@@ -133,6 +133,13 @@ struct Flat {
   std::vector<std::uint64_t> photons, shape, model_state;
   std::vector<double> seconds, theta_i, sim_energy, sim_error, model_seconds, comparisons, fit_numbers, fit_values;
   std::vector<std::string> labels, status, params_before, params_after, fit_keys;
+  // fit.per_lobe: per fiber and model (lobe fits, their comparison rows)
+  // and status; per lobe fit its lobe and fit numbers, its keys' values and
+  // its status line. Its comparison rows follow the model's "after" rows in
+  // `comparisons`.
+  std::vector<std::uint64_t> lobe_fit_state;
+  std::vector<double> lobe_fit_numbers, lobe_fit_values;
+  std::vector<std::string> lobe_fit_status, lobe_fit_lines;
 };
 
 constexpr std::size_t kFitNumbers = 7;  // chi2_start, chi2, residuals, dof, iterations, evaluations, converged
@@ -143,17 +150,32 @@ void add_comparisons(Flat& flat, const std::vector<LobeComparison>& list) {
     for_each_field(c, [&](const char*, const auto& x) { flat.comparisons.push_back(static_cast<double>(x)); });
 }
 
-void add_fit(Flat& flat, const FitResult& fit) {
-  flat.fit_keys.push_back(joined(fit.keys, ","));
+void add_fit_numbers(std::vector<double>& numbers, std::vector<double>& values, const FitResult& fit) {
   for (double x : {fit.chi2_start, fit.chi2, double(fit.residuals), double(fit.dof), double(fit.iterations),
                    double(fit.evaluations), double(fit.converged)})
-    flat.fit_numbers.push_back(x);
+    numbers.push_back(x);
   for (std::size_t j = 0; j < fit.keys.size(); ++j)
     for (double x : {fit.start[j], fit.value[j], fit.error[j], fit.error_unscaled[j], double(fit.at_bound[j])})
-      flat.fit_values.push_back(x);
+      values.push_back(x);
 }
 
-Flat flatten(const std::vector<AtlasFiberResult>& fibers) {
+void add_fit(Flat& flat, const FitResult& fit) {
+  flat.fit_keys.push_back(joined(fit.keys, ","));
+  add_fit_numbers(flat.fit_numbers, flat.fit_values, fit);
+}
+
+void add_lobe_fits(Flat& flat, const AtlasModelResult& m) {
+  flat.lobe_fit_state.insert(flat.lobe_fit_state.end(), {m.lobe_fits.size(), m.after_lobe_fit.size()});
+  flat.lobe_fit_status.push_back(m.lobe_fit_status);
+  for (std::size_t j = 0; j < m.lobe_fits.size(); ++j) {
+    flat.lobe_fit_numbers.push_back(m.lobe_fits[j].lobe);
+    add_fit_numbers(flat.lobe_fit_numbers, flat.lobe_fit_values, m.lobe_fits[j].fit);
+    flat.lobe_fit_lines.push_back(m.lobe_fit_lines.at(j));
+  }
+  add_comparisons(flat, m.after_lobe_fit);
+}
+
+Flat flatten(const std::vector<AtlasFiberResult>& fibers, bool per_lobe) {
   Flat flat;
   for (const AtlasFiberResult& r : fibers) {
     flat.labels.push_back(r.fiber.label);
@@ -172,6 +194,7 @@ Flat flatten(const std::vector<AtlasFiberResult>& fibers) {
       flat.params_after.push_back(m.params_after);
       add_comparisons(flat, m.before);
       add_comparisons(flat, m.after);
+      if (per_lobe) add_lobe_fits(flat, m);
       if (m.fitted && !m.fit.keys.empty()) add_fit(flat, m.fit);
     }
   }
@@ -197,6 +220,9 @@ std::uint64_t values_digest(const std::vector<T>& v) {
 constexpr const char* kDigestOrder =
     "photons,shape,seconds,theta_i,sim_energy,sim_error,model_state,model_seconds,comparisons,"
     "fit_numbers,fit_values";
+// With fit.per_lobe, the per-lobe fits' datasets in /lobe_fit_digests.
+constexpr const char* kLobeFitDigestOrder = "lobe_fit_state,lobe_fit_numbers,lobe_fit_values";
+constexpr std::size_t kLobeFitNumbers = 1 + kFitNumbers;  // lobe, then as fit_numbers
 
 template <class Arrays>
 std::vector<std::uint64_t> dataset_digests(const Arrays& a, const std::vector<double>& fit_numbers,
@@ -207,7 +233,31 @@ std::vector<std::uint64_t> dataset_digests(const Arrays& a, const std::vector<do
           values_digest(a.comparisons),  values_digest(fit_numbers),   values_digest(fit_values)};
 }
 
-void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std::size_t M) {
+std::vector<std::uint64_t> lobe_fit_digests(const std::vector<std::uint64_t>& state, const std::vector<double>& numbers,
+                                            const std::vector<double>& values) {
+  return {values_digest(state), values_digest(numbers), values_digest(values)};
+}
+
+void write_lobe_fits(h5::File& f, const Flat& flat, std::size_t F, std::size_t M) {
+  f.set_attr("/", "lobe_fit_digest_order", std::string(kLobeFitDigestOrder));
+  f.set_attr("/", "lobe_fit_digests",
+             lobe_fit_digests(flat.lobe_fit_state, flat.lobe_fit_numbers, flat.lobe_fit_values));
+  f.set_attr("/", "lobe_fit_status", lines_attr(flat.lobe_fit_status));
+  f.set_attr("/", "lobe_fit_lines", lines_attr(flat.lobe_fit_lines));
+  write_described(f, "/lobe_fit_state", {F, M, 2}, flat.lobe_fit_state, "fiber,model,field", "",
+                  "(per-lobe fits, their comparison rows) per fiber and model (fit.per_lobe)");
+  if (!flat.lobe_fit_lines.empty()) {
+    write_described(f, "/lobe_fit_numbers", {flat.lobe_fit_lines.size(), kLobeFitNumbers}, flat.lobe_fit_numbers,
+                    "lobe_fit,field", "",
+                    "lobe, chi2_start, chi2, residuals, dof, iterations, evaluations, converged per per-lobe fit");
+    write_described(f, "/lobe_fit_values", {flat.lobe_fit_values.size() / kFitValues, kFitValues},
+                    flat.lobe_fit_values, "fit_key,field", "the key's unit (degrees for angles)",
+                    "start, value, error, error_unscaled, at_bound per key of each per-lobe fit");
+  }
+}
+
+void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std::size_t M, bool per_lobe) {
+  if (per_lobe) write_lobe_fits(f, flat, F, M);
   f.set_attr("/", "dataset_digest_order", std::string(kDigestOrder));
   f.set_attr("/", "dataset_digests", dataset_digests(flat, flat.fit_numbers, flat.fit_values));
   const std::size_t columns = comparison_columns().size();
@@ -234,7 +284,8 @@ void write_flat(h5::File& f, const Flat& flat, std::size_t F, std::size_t K, std
   if (!flat.comparisons.empty())
     write_described(f, "/comparisons", {flat.comparisons.size() / columns, columns}, flat.comparisons, "row,field", "",
                     "per fiber and model, its LobeComparison rows (compare/comparison.h) before, then after "
-                    "the fit; fields named by comparison_columns, each in its member's unit");
+                    "the fit (then, with fit.per_lobe, after each lobe's own fit); fields named by "
+                    "comparison_columns, each in its member's unit");
   if (!flat.fit_numbers.empty()) {
     write_described(f, "/fit_numbers", {flat.fit_numbers.size() / kFitNumbers, kFitNumbers}, flat.fit_numbers,
                     "fitted_model,field", "",
@@ -286,7 +337,7 @@ T from_cell(const Reader& r, double v, const std::string& where) {
 
 // Walks the flat arrays in the order flatten() wrote them.
 struct Cursor {
-  std::size_t energy = 0, comparison = 0, fit = 0, fit_value = 0;
+  std::size_t energy = 0, comparison = 0, fit = 0, fit_value = 0, lobe_fit = 0, lobe_fit_value = 0;
 };
 
 std::vector<LobeComparison> read_comparisons(const Reader& r, const std::vector<double>& cells, std::size_t rows,
@@ -318,16 +369,14 @@ struct FitArrays {
   std::vector<std::string> keys;
 };
 
-FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const AtlasConfig& config,
-                   const AtlasFiber& fiber, const std::string& entry, const std::string& where) {
-  if (at.fit >= fits.keys.size()) r.fail("fit_keys has fewer lines than fitted models");
-  const std::string& model = registered_model(config, entry);
+// A fit of `keys` from its row of numbers `n` (fit_numbers' fields) and its
+// keys' rows of `values` from `value_at` on; the parameters at the minimum
+// as fit_model made them: `start` with each key set to its fitted value.
+FitResult fit_from(const Reader& r, const double* n, const std::vector<double>& values, std::size_t& value_at,
+                   const std::vector<std::string>& keys, const std::string& model,
+                   const analytic::ModelParameters& start, const std::string& where) {
   FitResult fit;
-  fit.keys = free_fit_keys(model);
-  if (fits.keys[at.fit] != joined(fit.keys, ","))
-    r.fail(fmt::format("{}: fit keys {} are not {}'s free keys {}", where, fits.keys[at.fit], model,
-                       joined(fit.keys, ",")));
-  const double* n = &fits.numbers[at.fit * kFitNumbers];
+  fit.keys = keys;
   fit.chi2_start = n[0];
   fit.chi2 = n[1];
   fit.residuals = from_cell<int>(r, n[2], where + ".fit.residuals");
@@ -335,11 +384,10 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
   fit.iterations = from_cell<int>(r, n[4], where + ".fit.iterations");
   fit.evaluations = from_cell<int>(r, n[5], where + ".fit.evaluations");
   fit.converged = from_cell<bool>(r, n[6], where + ".fit.converged");
-  ++at.fit;
-  if ((at.fit_value + fit.keys.size()) * kFitValues > fits.values.size())
-    r.fail("the dataset fit_values has fewer rows than the fitted models' keys");
-  for (std::size_t j = 0; j < fit.keys.size(); ++j, ++at.fit_value) {
-    const double* v = &fits.values[at.fit_value * kFitValues];
+  if ((value_at + fit.keys.size()) * kFitValues > values.size())
+    r.fail(fmt::format("{}: fewer rows of fitted values than the fitted keys", where));
+  for (std::size_t j = 0; j < fit.keys.size(); ++j, ++value_at) {
+    const double* v = &values[value_at * kFitValues];
     fit.start.push_back(v[0]);
     fit.value.push_back(v[1]);
     fit.error.push_back(v[2]);
@@ -350,10 +398,8 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
   // kept in the model's status line.
   const bool bound = std::find(fit.at_bound.begin(), fit.at_bound.end(), true) != fit.at_bound.end();
   fit.outcome = !fit.converged ? FitOutcome::NotConverged : bound ? FitOutcome::AtBound : FitOutcome::Converged;
-  // The parameters at the minimum, as fit_model made them: the start
-  // parameters with each key set to its fitted value.
   try {
-    fit.params = atlas_start_params(config, fiber, entry);
+    fit.params = start;
     for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
   } catch (const Error& e) {
     r.fail(fmt::format("{}: the fitted parameters are refused by {}: {}", where, model, e.what()));
@@ -361,14 +407,71 @@ FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const Atl
   return fit;
 }
 
+FitResult read_fit(const Reader& r, const FitArrays& fits, Cursor& at, const AtlasConfig& config,
+                   const AtlasFiber& fiber, const std::string& entry, const std::string& where) {
+  if (at.fit >= fits.keys.size()) r.fail("fit_keys has fewer lines than fitted models");
+  const std::string& model = registered_model(config, entry);
+  const std::vector<std::string> keys = free_fit_keys(model);
+  if (fits.keys[at.fit] != joined(keys, ","))
+    r.fail(fmt::format("{}: fit keys {} are not {}'s free keys {}", where, fits.keys[at.fit], model,
+                       joined(keys, ",")));
+  analytic::ModelParameters start;
+  try {
+    start = atlas_start_params(config, fiber, entry);
+  } catch (const Error& e) {
+    r.fail(fmt::format("{}: the fitted parameters are refused by {}: {}", where, model, e.what()));
+  }
+  const double* n = &fits.numbers[at.fit * kFitNumbers];
+  ++at.fit;
+  return fit_from(r, n, fits.values, at.fit_value, keys, model, start, where);
+}
+
 // Everything of the file, each array read with the shape the config and
 // model_state give it; then walked fiber by fiber.
+struct LobeFitArrays {
+  std::vector<std::uint64_t> state;
+  std::vector<double> numbers, values;
+  std::vector<std::string> status, lines;
+};
+
 struct Stored {
   std::vector<std::string> labels, status, params_before, params_after;
   std::vector<std::uint64_t> photons, shape, model_state;
   std::vector<double> seconds, theta_i, sim_energy, sim_error, model_seconds, comparisons;
   FitArrays fits;
+  LobeFitArrays lobe_fits;  // fit.per_lobe
 };
+
+// fit.per_lobe's arrays; returns the comparison rows they count. Their
+// values are checked against /lobe_fit_digests here (the rest of the file's
+// against /dataset_digests once it is read).
+std::size_t read_lobe_fits(const Reader& r, std::size_t F, const AtlasConfig& config, LobeFitArrays& out) {
+  const std::size_t M = config.models.size();
+  out.state = r.f.read_uint64s("lobe_fit_state", {F, M, 2}, "fibers_saved x models x 2");
+  out.status = r.lines("lobe_fit_status", F * M, "saved fiber and model");
+  std::size_t fits = 0, rows = 0, keys = 0;
+  for (std::size_t i = 0; i < F; ++i)
+    for (std::size_t m = 0; m < M; ++m) {
+      const std::uint64_t* st = &out.state[(i * M + m) * 2];
+      const std::uint64_t L = config.fibers[i].settings.tally.lobes, C = config.fibers[i].settings.fiber.sigma_a.size();
+      if (st[0] > L || st[1] > config.theta_i.size() * L * C)
+        r.fail(fmt::format("lobe_fit_state of fiber {}, model {} is out of range", i + 1, config.models[m]));
+      fits += st[0];
+      rows += st[1];
+      keys += st[0] * free_fit_keys(registered_model(config, config.models[m])).size();
+    }
+  out.lines = r.lines("lobe_fit_lines", fits, "per-lobe fit");
+  if (fits > 0) {
+    out.numbers = r.doubles("lobe_fit_numbers", {fits, kLobeFitNumbers}, "one row per per-lobe fit");
+    out.values = r.doubles("lobe_fit_values", {keys, kFitValues}, "one row per key of each per-lobe fit");
+  }
+  if (!r.f.has_attr("/", "lobe_fit_digests") || r.text("/", "lobe_fit_digest_order") != kLobeFitDigestOrder)
+    r.fail("its per-lobe fit digests are missing (written by another build?)");
+  if (r.f.attr_uint64s("/", "lobe_fit_digests", 64) != lobe_fit_digests(out.state, out.numbers, out.values))
+    r.fail("the per-lobe fit datasets do not hold the values written with them (their digests in "
+           "/lobe_fit_digests differ: datasets swapped, edited or damaged)");
+  return rows;
+}
 
 Stored read_stored(const Reader& r, std::size_t F, const AtlasConfig& config) {
   const std::size_t K = config.theta_i.size(), M = config.models.size(), columns = comparison_columns().size();
@@ -404,6 +507,7 @@ Stored read_stored(const Reader& r, std::size_t F, const AtlasConfig& config) {
       }
     }
   }
+  if (config.per_lobe) rows += read_lobe_fits(r, F, config, s.lobe_fits);
   s.sim_energy = r.doubles("sim_energy", {energies}, "theta_i x lobes x channels of every saved fiber");
   s.sim_error = r.doubles("sim_error", {energies}, "theta_i x lobes x channels of every saved fiber");
   s.model_seconds = r.doubles("model_seconds", {F, M}, "fibers_saved x models");
@@ -431,12 +535,31 @@ AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const 
   out.seconds = s.model_seconds[at_im];
   out.before = read_comparisons(r, s.comparisons, st[2], at, fiber, where + ", before");
   out.after = read_comparisons(r, s.comparisons, st[3], at, fiber, where + ", after");
+  std::uint64_t lobe_fit_count = 0;
   if (out.fitted && !out.applicable) r.fail(where + ": fitted but not applicable");
   const std::string& model = registered_model(config, out.model);
+  if (config.per_lobe) {
+    const std::uint64_t* lst = &s.lobe_fits.state[at_im * 2];
+    out.lobe_fit_status = s.lobe_fits.status[at_im];
+    out.after_lobe_fit = read_comparisons(r, s.comparisons, lst[1], at, fiber, where + ", after per-lobe fit");
+    lobe_fit_count = lst[0];
+  }
   if (out.fitted && !free_fit_keys(model).empty()) {
     out.fit = read_fit(r, s.fits, at, config, fiber.fiber, out.model, where);
     if (analytic::describe_params(model, out.fit.params) != out.params_after)
       r.fail(where + ": the fitted values do not give params_after");
+  }
+  if (lobe_fit_count > 0 && !out.fitted) r.fail(where + ": fitted lobe by lobe but not jointly");
+  for (std::uint64_t j = 0; j < lobe_fit_count; ++j, ++at.lobe_fit) {
+    const double* n = &s.lobe_fits.numbers[at.lobe_fit * kLobeFitNumbers];
+    LobeFit lf;
+    lf.lobe = from_cell<int>(r, n[0], where + ".lobe_fit.lobe");
+    if (lf.lobe < 0 || lf.lobe >= fiber.lobes) r.fail(fmt::format("{}: per-lobe fit of lobe {} is outside the fiber's {} lobes", where, lf.lobe, fiber.lobes));
+    const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, lobe_name(lf.lobe, fiber.lobes));
+    lf.fit = fit_from(r, n + 1, s.lobe_fits.values, at.lobe_fit_value, per_lobe_keys(model, out.fit.keys, lf.lobe),
+                      model, out.fit.params, lobe_where);
+    out.lobe_fits.push_back(std::move(lf));
+    out.lobe_fit_lines.push_back(s.lobe_fits.lines[at.lobe_fit]);
   }
   return out;
 }
@@ -479,7 +602,15 @@ std::string atlas_config_identity(const AtlasConfig& config) {
   for (const auto& [variant, model] : config.variant_of) s += fmt::format("variant {}: model {}\n", variant, model);
   for (const auto& [model, settings] : config.model_parameters)
     s += fmt::format("model_parameters.{}: {}\n", model, joined(settings, " "));
-  s += fmt::format("fit.max_iterations: {}\ntheta_i (rad):", config.max_iterations);
+  s += fmt::format("fit.max_iterations: {}\n", config.max_iterations);
+  // fit.lobes and fit.per_lobe change the results; absent, the identity is the same as without these keys.
+  if (!config.fit_lobes.empty()) {
+    s += "fit.lobes:";
+    for (int l : config.fit_lobes) s += fmt::format(" {}", l);
+    s += "\n";
+  }
+  if (config.per_lobe) s += "fit.per_lobe: true\n";
+  s += "theta_i (rad):";
   for (double t : config.theta_i) s += fmt::format(" {}", t);
   s += "\n";
   for (std::size_t i = 0; i < config.fibers.size(); ++i)
@@ -510,7 +641,9 @@ void write_atlas_checkpoint(const std::string& path, const AtlasRunSetup& setup,
     f.set_attr("/", "fibers_total", static_cast<std::uint64_t>(config.fibers.size()));
     f.set_attr("/", "fibers_saved", static_cast<std::uint64_t>(fibers.size()));
     write_atlas_axis_names(f, config);
-    if (!fibers.empty()) write_flat(f, flatten(fibers), fibers.size(), config.theta_i.size(), config.models.size());
+    if (!fibers.empty())
+      write_flat(f, flatten(fibers, config.per_lobe), fibers.size(), config.theta_i.size(), config.models.size(),
+                 config.per_lobe);
     f.close();
   }
   out.commit();
@@ -558,7 +691,8 @@ AtlasCheckpoint read_atlas_checkpoint(const std::string& path) {
   Cursor at;
   for (std::size_t i = 0; i < saved; ++i) c.fibers.push_back(read_fiber(r, stored, at, c.config, i));
   if (at.comparison * comparison_columns().size() != stored.comparisons.size() ||
-      at.fit_value * kFitValues != stored.fits.values.size())
+      at.fit_value * kFitValues != stored.fits.values.size() ||
+      at.lobe_fit_value * kFitValues != stored.lobe_fits.values.size())
     r.fail("it holds more comparisons or fitted values than its models");
   // Last, so that a value out of range is named first: values that pass
   // every check but are not those written (datasets swapped or edited).
@@ -602,7 +736,7 @@ std::vector<std::uint8_t> pack_atlas_fiber(const AtlasConfig& config, std::size_
   const ScratchFile file{scratch};
   {
     h5::File f = h5::File::create(scratch);
-    write_flat(f, flatten({result}), 1, one.theta_i.size(), one.models.size());
+    write_flat(f, flatten({result}, one.per_lobe), 1, one.theta_i.size(), one.models.size(), one.per_lobe);
     f.close();
   }
   std::ifstream in(scratch, std::ios::binary);

@@ -42,7 +42,8 @@ struct AtlasRunSetup {
 // The normalised config that decides the results: every fiber's label and
 // simulator settings as sim::to_yaml writes them (photons, seed, roughness,
 // absorption, tally... every key explicit, doubles exact), theta_i, the
-// models, their fixed parameters and the fit's iteration limit. Two configs
+// models, their fixed parameters, the fit's iteration limit and, when given,
+// fit.lobes and fit.per_lobe. Two configs
 // with the same identity give the same atlas (comments and key order do not
 // matter).
 std::string atlas_config_identity(const AtlasConfig& config);

@@ -13,7 +13,10 @@
 #include <set>
 
 #include "analytic/model_registry.h"
+#include "analytic/physical_defaults.h"
+#include "common/config_reader.h"
 #include "common/error.h"
+#include "common/fiber.h"
 #include "common/units.h"
 #include "compare/fit.h"
 #include "sim/run/yaml_keys.h"
@@ -91,37 +94,37 @@ std::vector<double> numbers(const Reader& r, const YAML::Node& n, const std::str
   return out;
 }
 
-// The size of a roughness entry for tables and figures: beta_long (degrees)
-// for gaussian / exit_blur, alpha for microfacet models, 0 for smooth.
-void roughness_size(const YAML::Node& entry, AtlasFiber& f) {
-  f.roughness_model = entry["model"] && entry["model"].IsScalar() ? entry["model"].Scalar() : "gaussian";
+// The size of a fiber's roughness for tables and figures: beta_long
+// (degrees, as the config wrote it) for gaussian / exit_blur (its first
+// entry), alpha (longitudinal) for microfacet models, 0 for smooth.
+void roughness_size(const Roughness& roughness, AtlasFiber& f) {
+  f.roughness_model = roughness::name(roughness);
   f.roughness = 0.0;
-  for (const char* key : {"alpha", "beta_long", "beta"}) {
-    const YAML::Node v = entry[key];
-    if (!v) continue;
-    const YAML::Node first = v.IsSequence() && v.size() > 0 ? v[0] : v;
-    double x = 0.0;
-    if (first.IsScalar() && YAML::convert<double>::decode(first, x)) f.roughness = x;
-    f.roughness_unit = std::string(key) == "alpha" ? "" : "deg";
-    break;
-  }
+  f.roughness_unit = "";
+  const auto degrees = [&](double radians) {
+    f.roughness = std::stod(config::degrees_text(radians));
+    f.roughness_unit = "deg";
+  };
+  if (const auto* g = std::get_if<roughness::Gaussian>(&roughness)) degrees(g->beta_long);
+  if (const auto* e = std::get_if<roughness::ExitBlur>(&roughness)) degrees(e->beta_long.front());
+  if (const auto* m = analytic::microfacet_alpha(roughness)) f.roughness = m->alpha_long;
 }
 
-std::string absorption_label(const Reader& r, const YAML::Node& entry, const std::string& path) {
+// An absorption entry gives sigma_a or melanin (its values are read and
+// checked with the fiber, by the run config's reader).
+void check_absorption_entry(const Reader& r, const YAML::Node& entry, const std::string& path) {
   only_keys(r, entry, path, {"sigma_a", "melanin"});
   if (entry["sigma_a"] && entry["melanin"]) r.fail(path + " gives both sigma_a and melanin (give one)");
-  if (entry["sigma_a"]) {
-    std::string s;
-    for (double x : numbers(r, entry["sigma_a"], path + ".sigma_a")) s += (s.empty() ? "" : ",") + fmt::format("{:g}", x);
-    return "sigma_a=" + s;
-  }
-  if (entry["melanin"]) {
-    const YAML::Node m = entry["melanin"];
-    only_keys(r, m, path + ".melanin", {"eumelanin", "pheomelanin"});
-    return fmt::format("melanin {:g}/{:g}", m["eumelanin"] ? number(r, m["eumelanin"], path + ".melanin.eumelanin") : 0.0,
-                       m["pheomelanin"] ? number(r, m["pheomelanin"], path + ".melanin.pheomelanin") : 0.0);
-  }
-  r.fail(path + " gives neither sigma_a nor melanin (give one)");
+  if (!entry["sigma_a"] && !entry["melanin"]) r.fail(path + " gives neither sigma_a nor melanin (give one)");
+}
+
+// "sigma_a=0.2,0.4" or "melanin 0.8/0.1".
+std::string absorption_label(const Fiber& fiber) {
+  if (fiber.eumelanin && fiber.pheomelanin)
+    return fmt::format("melanin {:g}/{:g}", *fiber.eumelanin, *fiber.pheomelanin);
+  std::string s;
+  for (double x : fiber.sigma_a) s += (s.empty() ? "" : ",") + fmt::format("{:g}", x);
+  return "sigma_a=" + s;
 }
 
 // The simulator config of one fiber, parsed by the simulator's own parser.
@@ -262,7 +265,7 @@ std::vector<std::string> read_fixed_settings(const Reader& r, const YAML::Node& 
                            "value (fixed keys of {}: {})",
                            path, spec->key, model, fmt::join(fixed, ", ")));
   only_keys(r, settings, path, fixed);
-  analytic::ModelParams p = analytic::default_params(model);
+  analytic::ModelParameters p = analytic::default_params(model);
   for (const auto& setting : settings) {
     const std::string key = setting.first.Scalar();
     const analytic::ParamSpec* spec = analytic::find_param(table, key);
@@ -358,9 +361,14 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   }
   c.model_parameters = read_model_parameters(r, top["model_parameters"], entries);
   if (const YAML::Node fit = top["fit"]) {
-    only_keys(r, fit, "fit", {"max_iterations", "lobes"});
+    only_keys(r, fit, "fit", {"max_iterations", "lobes", "per_lobe"});
     if (fit["max_iterations"])
       c.max_iterations = static_cast<int>(integer(r, fit["max_iterations"], "fit.max_iterations", 0, 1000));
+    if (const YAML::Node per_lobe = fit["per_lobe"]) {
+      if (!per_lobe.IsScalar() || (per_lobe.Scalar() != "true" && per_lobe.Scalar() != "false"))
+        r.fail(fmt::format("fit.per_lobe = {} must be true or false", show(per_lobe)));
+      c.per_lobe = per_lobe.Scalar() == "true";
+    }
   }
   const auto roughness = items(r, sweep["roughness"], "sweep.roughness");
   const auto absorption = sweep["absorption"] ? items(r, sweep["absorption"], "sweep.absorption")
@@ -378,9 +386,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   const YAML::Node theta_node = sweep["theta_i"];
   const auto theta = numbers(r, theta_node, "sweep.theta_i");
   for (double t : theta) c.theta_i.push_back(deg_to_rad(t));
-  std::vector<std::string> absorption_labels;
   for (std::size_t a = 0; a < absorption.size(); ++a)
-    absorption_labels.push_back(absorption_label(r, absorption[a], fmt::format("sweep.absorption[{}]", a)));
+    check_absorption_entry(r, absorption[a], fmt::format("sweep.absorption[{}]", a));
   for (std::size_t g = 0; g < roughness.size(); ++g)
     if (!roughness[g].IsMap()) r.fail(fmt::format("sweep.roughness[{}] = {} must be a roughness block such as "
                                                   "{{model: gaussian, beta_long: 5}}", g, show(roughness[g])));
@@ -393,7 +400,6 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
         for (std::size_t e = 0; e < eccs.size(); ++e)
         for (std::size_t m = 0; m < medullas.size(); ++m) {
           AtlasFiber f;
-          roughness_size(roughness[g], f);
           const std::string where =
               fmt::format("sweep.roughness[{}] x absorption[{}] x scale_tilt[{}] x eccentricity[{}]", g, a, t, e) +
               (sweep["medulla"] ? fmt::format(" x medulla[{}]", m) : "");
@@ -404,7 +410,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
           f.absorption_index = static_cast<int>(a);
           f.tilt_index = static_cast<int>(t);
           f.eccentricity_index = static_cast<int>(e);
-          f.absorption_label = absorption_labels[a];
+          roughness_size(f.settings.fiber.roughness, f);
+          f.absorption_label = absorption_label(f.settings.fiber);
           const std::string size = f.roughness_model == "smooth" ? ""
                                    : f.roughness_unit == "deg" ? fmt::format(" {:g} deg", f.roughness)
                                                                : fmt::format(" alpha {:g}", f.roughness);

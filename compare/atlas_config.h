@@ -22,6 +22,8 @@
 //   model_parameters:     # optional: fixed (not fitted) parameters per model
 //     huang2022: {quadrature_points: 262144}
 //   fit: {max_iterations: 20, lobes: [R, TT, TRT]}   # lobes: optional, default every lobe
+//   # per_lobe: optional (false): after the joint fit, each lobe of fit.lobes
+//   # fitted alone from the joint fit's values (compare/atlas.h)
 //
 // A variant is a registered model under its own name (letters, digits, _
 // and -; unique among the entries) with its own fixed parameters (the rules
@@ -78,6 +80,8 @@ struct AtlasConfig {
   int max_iterations = 20;
   // fit.lobes: the tally lobes the fit judges and fits (empty: every lobe).
   std::vector<int> fit_lobes;
+  // fit.per_lobe: after the joint fit, each of those lobes fitted alone.
+  bool per_lobe = false;
   std::vector<double> theta_i;  // radians
 };
 

@@ -12,6 +12,7 @@
 #include "common/h5_file.h"
 #include "common/result_layout.h"
 #include "common/units.h"
+#include "compare/fit.h"
 
 namespace fiberlab::compare {
 
@@ -86,8 +87,87 @@ void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResul
   f.set_attr("/fibers", "absorption", joined(absorption));
 }
 
-void write_model(h5::File& f, const Shape& s, const std::string& name, const std::vector<AtlasFiberResult>& fibers,
+// fit.per_lobe: each lobe's own fit (compare/atlas.h) beside the joint one,
+// in the model's group: per fiber and lobe its fitted values, chi-square and
+// outcome, and the comparison of that lobe at its own values.
+void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const std::string& model,
+                     const std::vector<std::string>& keys, const std::vector<AtlasFiberResult>& fibers,
+                     std::size_t m) {
+  const hsize_t P = keys.size(), FL = s.F * s.L;
+  const std::size_t n = s.F * s.K * s.L * s.C;
+  std::vector<double> energy(n, kNaN), chi2(n, kNaN), dof(n, kNaN);
+  std::vector<double> value(FL * P, kNaN), error(FL * P, kNaN), unscaled(FL * P, kNaN), start(FL * P, kNaN),
+      bound(FL * P, kNaN), fit_chi2_start(FL, kNaN), fit_chi2(FL, kNaN), fit_dof(FL, kNaN), iterations(FL, kNaN);
+  std::vector<std::uint64_t> fitted(FL, 0), converged(FL, 0);
+  std::vector<std::string> status, lines(FL), lobe_keys;
+  for (std::size_t i = 0; i < fibers.size(); ++i) {
+    const AtlasModelResult& r = fibers[i].models[m];
+    status.push_back(r.lobe_fit_status);
+    for (std::size_t j = 0; j < r.lobe_fits.size(); ++j) {
+      const LobeFit& lf = r.lobe_fits[j];
+      const std::size_t at = i * s.L + lf.lobe;
+      fitted[at] = 1;
+      converged[at] = lf.fit.converged;
+      lines[at] = r.lobe_fit_lines.at(j);
+      for (hsize_t k = 0; k < P && k < lf.fit.keys.size(); ++k) {
+        value[at * P + k] = lf.fit.value[k];
+        error[at * P + k] = lf.fit.error[k];
+        unscaled[at * P + k] = lf.fit.error_unscaled[k];
+        start[at * P + k] = lf.fit.start[k];
+        bound[at * P + k] = lf.fit.at_bound[k] ? 1.0 : 0.0;
+      }
+      fit_chi2_start[at] = lf.fit.chi2_start;
+      fit_chi2[at] = lf.fit.chi2;
+      fit_dof[at] = lf.fit.dof;
+      iterations[at] = lf.fit.iterations;
+    }
+    for (const LobeComparison& c : r.after_lobe_fit) {
+      const std::size_t at = s.at(i, c.k, c.lobe, c.channel);
+      energy[at] = c.model_energy;
+      chi2[at] = c.bins.chi2;
+      dof[at] = c.bins.dof;
+    }
+  }
+  const bool any = std::any_of(fibers.begin(), fibers.end(), [&](const AtlasFiberResult& r) {
+    return !r.models[m].lobe_fits.empty();
+  });
+  for (hsize_t l = 0; l < s.L; ++l) {
+    std::string k;
+    if (any)
+      for (const std::string& key : per_lobe_keys(model, keys, static_cast<int>(l))) k += (k.empty() ? "" : ",") + key;
+    lobe_keys.push_back(k);
+  }
+  f.set_attr("/" + g, "lobe_fit_status", joined(status));
+  f.set_attr("/" + g, "lobe_fit_keys", joined(lobe_keys));
+  f.set_attr("/" + g, "lobe_fit_lines", joined(lines));
+  const h5::Dims FLd{s.F, s.L}, FLP{s.F, s.L, P};
+  const std::string key_unit = "the key's unit (degrees for angles)";
+  put(f, g + "/lobe_fitted", FLd, fitted, "fiber,lobe", "0/1", "1: the lobe was fitted alone (fit.per_lobe)");
+  put(f, g + "/lobe_fit_converged", FLd, converged, "fiber,lobe", "0/1", "1: the lobe's own fit converged");
+  put(f, g + "/model_energy_lobe_fit", s.dims(), energy, kAtlasDims, "fraction of incident light",
+      "the model's lobe energy with that lobe's own fitted parameters (NaN: not fitted lobe by lobe)");
+  put(f, g + "/chi2_lobe_fit", s.dims(), chi2, kAtlasDims, "",
+      "chi-square of the bins with that lobe's own fitted parameters");
+  put(f, g + "/dof_lobe_fit", s.dims(), dof, kAtlasDims, "", "its degrees of freedom");
+  put(f, g + "/lobe_fit_start", FLP, start, "fiber,lobe,fit_key", key_unit,
+      "start of each key of the lobe's fit (attribute lobe_fit_keys, one line per lobe; empty when no lobe "
+      "was fitted): the joint fit's value");
+  put(f, g + "/lobe_fit_value", FLP, value, "fiber,lobe,fit_key", key_unit, "fitted value of the lobe's own fit");
+  put(f, g + "/lobe_fit_error", FLP, error, "fiber,lobe,fit_key", key_unit,
+      "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
+  put(f, g + "/lobe_fit_error_unscaled", FLP, unscaled, "fiber,lobe,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
+  put(f, g + "/lobe_fit_at_bound", FLP, bound, "fiber,lobe,fit_key", "0/1",
+      "1: the value sits on an end of the table's range");
+  put(f, g + "/lobe_fit_chi2_start", FLd, fit_chi2_start, "fiber,lobe", "",
+      "the lobe fit's chi-square at its start (the lobe's bins, every theta_i)");
+  put(f, g + "/lobe_fit_chi2", FLd, fit_chi2, "fiber,lobe", "", "the lobe fit's chi-square at the minimum");
+  put(f, g + "/lobe_fit_dof", FLd, fit_dof, "fiber,lobe", "", "residuals minus fitted parameters");
+  put(f, g + "/lobe_fit_iterations", FLd, iterations, "fiber,lobe", "", "Levenberg-Marquardt iterations");
+}
+
+void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers,
                  std::size_t m) {
+  const std::string& name = config.models[m];
   const std::string g = "models/" + name;
   f.create_group(g);
   std::vector<std::string> keys;
@@ -171,6 +251,7 @@ void write_model(h5::File& f, const Shape& s, const std::string& name, const std
   put(f, g + "/fit_chi2", F, chi2, "fiber", "", "the fit's chi-square at the minimum");
   put(f, g + "/fit_dof", F, dof, "fiber", "", "residuals minus fitted parameters");
   put(f, g + "/fit_iterations", F, iterations, "fiber", "", "Levenberg-Marquardt iterations");
+  if (config.per_lobe) write_lobe_fits(f, s, g, registered_model(config, name), keys, fibers, m);
 }
 
 }  // namespace
@@ -204,7 +285,7 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
     write_fibers(f, s, fibers);
     f.create_group("models");
     for (std::size_t m = 0; m < config.models.size(); ++m) {
-      write_model(f, s, config.models[m], fibers, m);
+      write_model(f, s, config, fibers, m);
       // A variant's group says which registered model it runs, with what.
       if (const auto v = config.variant_of.find(config.models[m]); v != config.variant_of.end()) {
         const auto fixed = config.model_parameters.find(v->first);
@@ -219,6 +300,74 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
   }
   out.commit();
 }
+
+namespace {
+
+// fit.per_lobe's line under a model: how many lobe fits converged, and per
+// lobe the median chi2/dof after the joint fit and after the lobe's own fit
+// (over the fibers fitted lobe by lobe, the judged entries as the report's
+// tables); or why none was made.
+std::string describe_lobe_fits(const h5::File& f, const std::string& g, hsize_t F) {
+  const h5::Dims dims = f.shape(g + "chi2_lobe_fit");
+  if (dims.size() != 4 || dims[0] != F) throw Error(fmt::format("{}chi2_lobe_fit must be F x K x L x C", g));
+  const hsize_t K = dims[1], L = dims[2], C = dims[3];
+  const auto fitted = f.read_uint64s(g + "lobe_fitted", {F, L}, "fibers x lobes");
+  const auto converged = f.read_uint64s(g + "lobe_fit_converged", {F, L}, "fibers x lobes");
+  std::size_t n = 0, ok = 0;
+  for (std::size_t i = 0; i < fitted.size(); ++i) {
+    n += fitted[i] != 0;
+    ok += fitted[i] != 0 && converged[i] != 0;
+  }
+  if (n == 0) {
+    std::string status = f.attr_string(g, "lobe_fit_status");
+    status = status.substr(0, status.find('\n'));
+    return fmt::format("  per-lobe fit: none; {}{}\n", F > 1 ? "fiber 1: " : "", status);
+  }
+  const auto ca = f.read_doubles(g + "chi2_after", dims, ""), da = f.read_doubles(g + "dof_after", dims, "");
+  const auto cl = f.read_doubles(g + "chi2_lobe_fit", dims, ""), dl = f.read_doubles(g + "dof_lobe_fit", dims, "");
+  const auto judged = f.read_doubles(g + "judged", dims, "");
+  const std::string names = f.attr_string("/", "lobe_names");
+  std::vector<std::string> lobe_names;
+  for (std::size_t a = 0; a <= names.size();) {
+    const std::size_t b = std::min(names.find(',', a), names.size());
+    lobe_names.push_back(names.substr(a, b - a));
+    a = b + 1;
+  }
+  std::string s = fmt::format("  per-lobe fit: {} lobe fits, {} converged; median chi2/dof after joint fit -> "
+                              "after per-lobe fit:", n, ok);
+  for (hsize_t l = 0; l < L; ++l) {
+    std::vector<double> joint, own;
+    for (hsize_t i = 0; i < F; ++i) {
+      if (!fitted[i * L + l]) continue;
+      double c1 = 0, d1 = 0, c2 = 0, d2 = 0;
+      for (hsize_t k = 0; k < K; ++k)
+        for (hsize_t c = 0; c < C; ++c) {
+          const std::size_t at = ((i * K + k) * L + l) * C + c;
+          if (judged[at] == 1.0 && std::isfinite(cl[at]) && std::isfinite(ca[at])) {
+            c1 += ca[at];
+            d1 += da[at];
+            c2 += cl[at];
+            d2 += dl[at];
+          }
+        }
+      if (d1 > 0 && d2 > 0) {
+        joint.push_back(c1 / d1);
+        own.push_back(c2 / d2);
+      }
+    }
+    if (joint.empty()) continue;
+    auto median = [](std::vector<double> v) {
+      std::sort(v.begin(), v.end());
+      return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+    };
+    s += fmt::format(" {} {:.3g} -> {:.3g};", l < lobe_names.size() ? lobe_names[l] : std::to_string(l),
+                     median(joint), median(own));
+  }
+  s.back() = '\n';
+  return s;
+}
+
+}  // namespace
 
 std::string describe_atlas_file(const std::string& path) {
   const h5::File f = h5::File::open_read(path);
@@ -246,6 +395,7 @@ std::string describe_atlas_file(const std::string& path) {
                                                        : "";
     s += fmt::format("model {}{}: applicable to {}, fitted to {}, converged on {} of {} fibers\n", m, variant,
                      count(g + "applicable"), count(g + "fitted"), count(g + "converged"), F[0]);
+    if (f.has_attr(g, "lobe_fit_status")) s += describe_lobe_fits(f, g, F[0]);
     start = comma + 1;
   }
   return s;

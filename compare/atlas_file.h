@@ -1,7 +1,8 @@
 #pragma once
 // The atlas's HDF5 file (format "fiber-atlas", docs/FILE_FORMAT.md): one
 // row per fiber, per model a group with the comparison before and after the
-// fit and the fitted parameters. Written atomically (common/atomic_output.h).
+// fit and the fitted parameters (with fit.per_lobe, also each lobe's own fit
+// and the comparison after it). Written atomically (common/atomic_output.h).
 #include <string>
 #include <vector>
 

@@ -67,9 +67,54 @@ void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
   out.commit();
 }
 
+// fit.per_lobe's headline: the joint fit's and the lobes' own fits' columns.
+std::string headline_with_lobe_fits(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+  const int L = lobe_count(fibers);
+  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after joint fit | after per-lobe fit | "
+                  "median χ²/dof before | after joint fit | after per-lobe fit |\n"
+                  "|---|---|---|---|---|---|---|---|---|\n";
+  for (std::size_t m = 0; m < config.models.size(); ++m)
+    for (int l = 0; l < L; ++l) {
+      std::vector<double> eb, ea, el, cb, ca, cl;
+      int applicable = 0;
+      for (const auto& f : fibers) {
+        const AtlasModelResult& r = f.models[m];
+        if (!r.applicable) continue;
+        ++applicable;
+        const AtlasLobeSummary sum = summarize_lobe(r, l);
+        eb.push_back(sum.max_abs_energy_error);
+        if (r.fitted) ea.push_back(sum.max_abs_energy_error_after);
+        if (sum.lobe_fitted) el.push_back(sum.max_abs_energy_error_lobe_fit);
+        if (sum.dof_before > 0) cb.push_back(per_dof(sum.chi2_before, sum.dof_before));
+        if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
+        if (sum.lobe_fitted && sum.dof_lobe_fit > 0) cl.push_back(per_dof(sum.chi2_lobe_fit, sum.dof_lobe_fit));
+      }
+      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable,
+                       lobe_name(l, L), num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"),
+                       num(median(el), "{:.4f}"), num(median(cb)), num(median(ca)), num(median(cl)));
+    }
+  return s;
+}
+
+// fit.per_lobe: each lobe's own fitted values, or why the model was not
+// fitted lobe by lobe.
+std::string lobe_fitted_params(const AtlasModelResult& m, int lobes) {
+  if (m.lobe_fits.empty()) return m.lobe_fit_status;
+  std::string s;
+  for (const LobeFit& lf : m.lobe_fits) {
+    s += fmt::format("{}{}:", s.empty() ? "" : "; ", lobe_name(lf.lobe, lobes));
+    for (std::size_t j = 0; j < lf.fit.keys.size(); ++j)
+      s += fmt::format(" {} = {:.4g} ± {:.2g}{}", lf.fit.keys[j], lf.fit.value[j], lf.fit.error[j],
+                       lf.fit.at_bound[j] ? " (at bound)" : "");
+    if (lf.fit.outcome == FitOutcome::NotConverged) s += " (not converged)";
+  }
+  return s;
+}
+
 }  // namespace
 
 std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+  if (config.per_lobe) return headline_with_lobe_fits(config, fibers);
   const int L = lobe_count(fibers);
   std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | after fit |\n"
                   "|---|---|---|---|---|---|---|\n";
@@ -97,6 +142,10 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
   const int L = lobe_count(fibers);
   std::string s = "| fiber | model | fitted parameters (or why not) |";
   std::string rule = "|---|---|---|";
+  if (config.per_lobe) {
+    s += " per-lobe fit (or why not) |";
+    rule += "---|";
+  }
   for (int l = 0; l < L; ++l) {
     s += fmt::format(" {}: max\\|ΔE\\| | {}: χ²/dof |", lobe_name(l, L), lobe_name(l, L));
     rule += "---|---|";
@@ -106,13 +155,19 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
     for (std::size_t m = 0; m < config.models.size(); ++m) {
       const AtlasModelResult& r = fibers[i].models[m];
       s += fmt::format("| {}. {} | {} | {} |", i + 1, fibers[i].fiber.label, r.model, fitted_params(r));
+      if (config.per_lobe) s += fmt::format(" {} |", r.applicable ? lobe_fitted_params(r, L) : "-");
       for (int l = 0; l < L; ++l) {
         if (!r.applicable) {
           s += " - | - |";
           continue;
         }
         const AtlasLobeSummary sum = summarize_lobe(r, l);
-        if (r.fitted)
+        if (sum.lobe_fitted)
+          s += fmt::format(" {} → {} → {} | {} → {} → {} |", num(sum.max_abs_energy_error, "{:.4f}"),
+                           num(sum.max_abs_energy_error_after, "{:.4f}"),
+                           num(sum.max_abs_energy_error_lobe_fit, "{:.4f}"), num(per_dof(sum.chi2_before, sum.dof_before)),
+                           num(per_dof(sum.chi2_after, sum.dof_after)), num(per_dof(sum.chi2_lobe_fit, sum.dof_lobe_fit)));
+        else if (r.fitted)
           s += fmt::format(" {} → {} | {} → {} |", num(sum.max_abs_energy_error, "{:.4f}"),
                            num(sum.max_abs_energy_error_after, "{:.4f}"), num(per_dof(sum.chi2_before, sum.dof_before)),
                            num(per_dof(sum.chi2_after, sum.dof_after)));
@@ -147,11 +202,16 @@ std::string write_staged(ReportFolder& folder, const std::string& dir, const std
       "ΔE: |E_model - E_sim| of a lobe (fraction of the incident light), the largest over theta_i and "
       "channels. χ²/dof: the bins' chi-square (compare/comparison.h) summed over theta_i and channels. "
       "\"before\": the model's physical defaults for the fiber; \"after\": its free parameters fitted jointly "
-      "over every theta_i (compare/fit.h).{}\n\n## Per model and lobe (median over fibers)\n\n{}\n"
+      "over every theta_i (compare/fit.h).{}{}\n\n## Per model and lobe (median over fibers)\n\n{}\n"
       "## Per fiber\n\n{}\n",
       config.path, command, atlas_path, fibers.size(), config.theta_i.size(),
       fibers.empty() ? 0 : fibers[0].photons, sim_s, fit_s,
-      fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(), fixed_parameters(config), headline, table);
+      fibers.empty() ? 0.0 : (sim_s + fit_s) / fibers.size(),
+      config.per_lobe ? " \"after per-lobe fit\": each lobe fitted alone from the joint fit's values, its own "
+                        "width and shift (fit.per_lobe; compare/atlas.h); per fiber, the lobe's cells read "
+                        "before → after joint fit → after per-lobe fit."
+                      : "",
+      fixed_parameters(config), headline, table);
   // The tables for the page (scripts/plot_atlas.py turns them into HTML).
   write_text(staged, "atlas_tables.md",
              "## Per model and lobe (median over fibers)\n\n" + headline + "\n## Per fiber\n\n" + table);

@@ -14,10 +14,12 @@ namespace fiberlab::compare {
 
 // The headline: per model and lobe, over the fibers the model applies to,
 // the median of each fiber's largest |E_model - E_sim| and of chi2/dof,
-// before and after the fit (Markdown).
+// before and after the fit (with fit.per_lobe: after the joint fit and
+// after each lobe's own fit) (Markdown).
 std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers);
 // Per fiber and model: status, fitted parameters +- errors, per lobe
-// |dE| and chi2/dof before -> after (Markdown).
+// |dE| and chi2/dof before -> after (with fit.per_lobe: each lobe's fitted
+// values, and before -> after joint fit -> after per-lobe fit) (Markdown).
 std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers);
 
 // Writes the folder (`atlas_path`: the atlas file already written, copied

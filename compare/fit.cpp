@@ -90,13 +90,13 @@ const analytic::ParamSpec& fit_spec(const std::string& model_name, const std::st
 
 }  // namespace
 
-double get_parameter(const std::string& model_name, const analytic::ModelParams& p, const std::string& key) {
+double get_parameter(const std::string& model_name, const analytic::ModelParameters& p, const std::string& key) {
   const analytic::ParamSpec& spec = fit_spec(model_name, key);
   const Key k = parse_key(key);
   return is_list(spec) ? spec.get_entry(p, k.index) : spec.get_number(p);
 }
 
-void set_parameter(const std::string& model_name, analytic::ModelParams& p, const std::string& key,
+void set_parameter(const std::string& model_name, analytic::ModelParameters& p, const std::string& key,
                    double value) {
   const analytic::ParamSpec& spec = fit_spec(model_name, key);
   const Key k = parse_key(key);
@@ -182,7 +182,7 @@ const char* outcome_name(FitOutcome o) {
 }
 
 FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
-                    const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                    const analytic::ModelParameters& start, const std::vector<std::string>& keys,
                     const Options& options, int max_iterations,
                     const std::function<void(const std::string&)>& progress) {
   if (keys.empty()) throw Error("--fit: no parameters given");
@@ -208,7 +208,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   const Selection sel = select_bins(result, options);
 
   auto params_at = [&](const Eigen::VectorXd& x) {
-    analytic::ModelParams p = start;
+    analytic::ModelParameters p = start;
     for (int j = 0; j < n; ++j) set_parameter(model_name, p, keys[j], x[j]);
     return p;
   };
@@ -418,7 +418,7 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
 }
 
 std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::string& model_name,
-                                   const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                                   const analytic::ModelParameters& start, const std::vector<std::string>& keys,
                                    const Options& options, int max_iterations,
                                    const std::function<void(const std::string&)>& progress) {
   std::vector<int> lobes = options.lobes;

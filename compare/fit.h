@@ -62,6 +62,7 @@
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "compare/comparison.h"
 #include "sim/store/result_file.h"
 
@@ -73,8 +74,8 @@ namespace fiberlab::compare {
 // NAME[p], or a list as one value (beta_long; alpha as scale_tilt). The value
 // is stored as given (make_model() checks the table's range). Throws
 // fiberlab::Error for a key the model cannot fit.
-double get_parameter(const std::string& model_name, const analytic::ModelParams& p, const std::string& key);
-void set_parameter(const std::string& model_name, analytic::ModelParams& p, const std::string& key,
+double get_parameter(const std::string& model_name, const analytic::ModelParameters& p, const std::string& key);
+void set_parameter(const std::string& model_name, analytic::ModelParameters& p, const std::string& key,
                    double value);
 // The closed range the fit keeps `key` in (the table's ParamSpec::fit_min,
 // fit_max; scale_tilt that of the tilt shifts `alpha`).
@@ -110,7 +111,7 @@ struct FitResult {
   bool converged = false;  // outcome != NotConverged
   FitOutcome outcome = FitOutcome::NotConverged;
   std::string stop_reason;  // one line: why the fit stopped (the test that ended it, with its numbers)
-  analytic::ModelParams params;  // at the minimum
+  analytic::ModelParameters params;  // at the minimum
   double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
 };
 
@@ -129,7 +130,7 @@ std::vector<std::string> per_lobe_keys(const std::string& model_name, const std:
 // `progress` (optional) receives one line per iteration (the CLI prints it
 // on stderr: fits take minutes).
 FitResult fit_model(const sim::ResultFile& result, const std::string& model_name,
-                    const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                    const analytic::ModelParameters& start, const std::vector<std::string>& keys,
                     const Options& options = {}, int max_iterations = 40,
                     const std::function<void(const std::string&)>& progress = {});
 
@@ -141,7 +142,7 @@ struct LobeFit {
   FitResult fit;
 };
 std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::string& model_name,
-                                   const analytic::ModelParams& start, const std::vector<std::string>& keys,
+                                   const analytic::ModelParameters& start, const std::vector<std::string>& keys,
                                    const Options& options = {}, int max_iterations = 40,
                                    const std::function<void(const std::string&)>& progress = {});
 

@@ -33,31 +33,18 @@ std::vector<std::string> split(const std::string& s, char sep) {
 }  // namespace
 
 std::unique_ptr<analytic::Model> make_model(const std::string& name,
-                                            const analytic::ModelParams& params) {
+                                            const analytic::ModelParameters& params) {
   return analytic::make_model(name, params);
+}
+
+std::vector<double> theta_r_shifts(const std::string& name, const analytic::ModelParameters& params) {
+  return analytic::theta_r_shifts(name, params);
 }
 
 analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
   analytic::PhysicalFiber f;
-  f.eta = s.fiber.eta;
-  f.eccentricity = s.fiber.eccentricity;
-  f.scale_tilt = s.fiber.scale_tilt;
-  f.sigma_a = s.fiber.sigma_a;
+  static_cast<Fiber&>(f) = s.fiber;
   f.lobes = s.tally.lobes;
-  switch (s.roughness.model) {
-    case sim::RoughnessModel::Smooth: f.roughness = analytic::PhysicalFiber::Roughness::Smooth; break;
-    case sim::RoughnessModel::Gaussian: f.roughness = analytic::PhysicalFiber::Roughness::Gaussian; break;
-    case sim::RoughnessModel::ExitBlur: f.roughness = analytic::PhysicalFiber::Roughness::ExitBlur; break;
-    case sim::RoughnessModel::Beckmann: f.roughness = analytic::PhysicalFiber::Roughness::Beckmann; break;
-    case sim::RoughnessModel::GGX: f.roughness = analytic::PhysicalFiber::Roughness::GGX; break;
-  }
-  if (f.microfacet()) {
-    f.alpha_long = s.roughness.alpha_long;
-    f.alpha_azim = s.roughness.alpha_azim;
-  } else {
-    f.beta_long = s.roughness.beta_long;
-    f.beta_azim = s.roughness.beta_azim;
-  }
   return f;
 }
 
@@ -71,7 +58,7 @@ ModelSpec parse_model_spec(const std::string& spec) {
   return m;
 }
 
-std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params,
+std::string model_header(const ModelSpec& spec, const analytic::ModelParameters& params,
                          const std::vector<std::string>& fiber_notes) {
   std::string s = fmt::format("model {}: {}\n", spec.label, analytic::describe_params(spec.name, params));
   if (!fiber_notes.empty()) s += "  from the simulated fiber:\n";
@@ -81,7 +68,7 @@ std::string model_header(const ModelSpec& spec, const analytic::ModelParams& par
   return s;
 }
 
-std::string params_json(const std::string& model_name, const analytic::ModelParams& params) {
+std::string params_json(const std::string& model_name, const analytic::ModelParameters& params) {
   std::string s;
   for (const analytic::ParamSpec& spec : analytic::model_info(model_name).params) {
     // "choice" and "integer" say what kind of value it is, not a unit: a reader
@@ -100,15 +87,15 @@ void add_keys(const std::vector<std::string>& key_values, std::vector<std::strin
 }
 }  // namespace
 
-analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
+analytic::ModelParameters params_for(const sim::Settings& s, const ModelSpec& spec,
                                  const std::vector<std::string>& settings,
                                  std::vector<std::string>* fiber_notes) {
   const analytic::ModelInfo& info = analytic::model_info(spec.name);
-  auto overrides = [&](analytic::ModelParams& p) {
+  auto overrides = [&](analytic::ModelParameters& p) {
     analytic::apply_settings(spec.name, p, settings);
     analytic::apply_settings(spec.name, p, spec.settings);
   };
-  analytic::ModelParams p = analytic::default_params(spec.name);
+  analytic::ModelParameters p = analytic::default_params(spec.name);
   overrides(p);
   analytic::FiberMapping mapping;
   add_keys(settings, mapping.user_keys);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "analytic/physical_defaults.h"
 #include "sim/store/result_file.h"
 
@@ -17,7 +18,11 @@ namespace fiberlab::compare {
 
 // A registered model by name (analytic::make_model). Throws fiberlab::Error otherwise.
 std::unique_ptr<analytic::Model> make_model(const std::string& name,
-                                            const analytic::ModelParams& params);
+                                            const analytic::ModelParameters& params);
+
+// The model's theta_r shift per lobe, radians (analytic::theta_r_shifts):
+// the `alpha` of compare().
+std::vector<double> theta_r_shifts(const std::string& name, const analytic::ModelParameters& params);
 
 // The simulator's settings as the models see a fiber (a copy, no physics).
 analytic::PhysicalFiber physical_fiber(const sim::Settings& s);
@@ -35,11 +40,11 @@ ModelSpec parse_model_spec(const std::string& spec);
 // The lines `predict` and `compare` print about a model before their
 // results: its parameters and the published approximations in effect.
 // `fiber_notes`: the approximate mappings from the simulated fiber (params_for).
-std::string model_header(const ModelSpec& spec, const analytic::ModelParams& params,
+std::string model_header(const ModelSpec& spec, const analytic::ModelParameters& params,
                          const std::vector<std::string>& fiber_notes = {});
 // The model's parameters as a JSON object {"key": {"value": "...", "unit": "..."}}
 // (command-line units: degrees for angles).
-std::string params_json(const std::string& model_name, const analytic::ModelParams& params);
+std::string params_json(const std::string& model_name, const analytic::ModelParameters& params);
 
 // Model parameters for a simulation's settings: the model's table defaults,
 // its physical defaults for the fiber (ModelInfo::from_fiber), then
@@ -49,7 +54,7 @@ std::string params_json(const std::string& model_name, const analytic::ModelPara
 // the model cannot represent is refused (fiberlab::Error) unless the
 // settings set the key concerned; `fiber_notes` (optional) receives one
 // line per approximate mapping applied (analytic::FiberMapping).
-analytic::ModelParams params_for(const sim::Settings& s, const ModelSpec& spec,
+analytic::ModelParameters params_for(const sim::Settings& s, const ModelSpec& spec,
                                  const std::vector<std::string>& settings,
                                  std::vector<std::string>* fiber_notes = nullptr);
 

@@ -50,7 +50,7 @@ std::string split_lines_joined(const std::vector<std::string>& lines) {
 }  // namespace
 
 void write_prediction(const std::string& path, const PredictionFile& p, const sim::Settings& settings,
-                      const analytic::ModelParams& params, const std::vector<std::string>& inputs) {
+                      const analytic::ModelParameters& params, const std::vector<std::string>& inputs) {
   AtomicOutput out(path, inputs);
   {
     h5::File f = h5::File::create(out.temp_path(), out.target());

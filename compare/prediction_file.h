@@ -46,7 +46,7 @@ struct PredictionFile {
 // `inputs`: files the output must not replace. Refuses a non-finite
 // probability with one line, writing nothing.
 void write_prediction(const std::string& path, const PredictionFile& pred, const sim::Settings& settings,
-                      const analytic::ModelParams& params, const std::vector<std::string>& inputs = {});
+                      const analytic::ModelParameters& params, const std::vector<std::string>& inputs = {});
 
 // Whether `path` is an HDF5 file whose root attribute format is
 // "fiber-prediction" (false for anything else, including missing files).

@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 
 #include "analytic/model.h"
+#include "analytic/model_parameters.h"
 #include "compare/comparison.h"
 #include "compare/verdict.h"
 
@@ -31,7 +32,7 @@ py::array_t<T> to_array(const std::vector<T>& data, const std::vector<py::ssize_
 }
 
 // A model's parameters as predict(**params) takes them (prediction_binding.cpp).
-py::dict params_dict(const std::string& model_name, const analytic::ModelParams& params);
+py::dict params_dict(const std::string& model_name, const analytic::ModelParameters& params);
 
 // The checks of `fiberlab compare`'s flags and the options they make; a
 // verdict as {"rows": [...], "judged", "rejected", "all_accepted",

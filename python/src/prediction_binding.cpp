@@ -20,7 +20,7 @@ namespace fiberlab::python {
 // degrees (the table's unit "deg"), integers as int, choices as text, a
 // scalar parameter as a number and a per-lobe or per-channel list as a list;
 // so that predict(result, model, **params) gives the same parameters.
-py::dict params_dict(const std::string& model_name, const analytic::ModelParams& params) {
+py::dict params_dict(const std::string& model_name, const analytic::ModelParameters& params) {
   const analytic::ParamTable& table = analytic::model_info(model_name).params;
   const std::vector<analytic::ParamAttribute> values = analytic::param_attributes(model_name, params);
   py::dict out;
@@ -58,7 +58,7 @@ py::dict predict(const sim::Settings& s, const std::string& model_name, const st
   py::dict d;
   d["probability"] = to_array(pred.probability, {K, pred.lobes, grid.n_theta(), grid.n_phi(), pred.channels});
   d["params"] = params_dict(model_name, chosen.params);
-  d["alpha"] = chosen.params.alpha;  // radians, for compare::compare
+  d["alpha"] = analytic::theta_r_shifts(chosen.spec.name, chosen.params);  // radians, for compare::compare
   d["theta_i"] = to_array(pred.theta_i, {K});
   d["phi_i"] = to_array(pred.phi_i, {K});
   d["theta_edges"] = to_array(grid.theta_edges, {grid.n_theta() + 1});

@@ -44,12 +44,12 @@ inline Vec3 blur_exit_direction(const Vec3& d, double v, double beta_azim, Photo
 // indexed by the lobe p (the last entry for every larger p).
 class ExitBlur {
  public:
-  explicit ExitBlur(const RoughnessSettings& r) : beta_azim_(r.beta_azim) {
+  explicit ExitBlur(const roughness::ExitBlur& r) : beta_azim_(r.beta_azim) {
     for (double b : r.beta_long) v_.push_back(b * b);
   }
   Vec3 apply(const Vec3& d, int p, PhotonRandom& rng) const {
-    return blur_exit_direction(d, RoughnessSettings::for_lobe(v_, p),
-                               RoughnessSettings::for_lobe(beta_azim_, p), rng);
+    return blur_exit_direction(d, roughness::ExitBlur::for_lobe(v_, p),
+                               roughness::ExitBlur::for_lobe(beta_azim_, p), rng);
   }
 
  private:
@@ -59,7 +59,7 @@ class ExitBlur {
 // Roughness model `exit_blur` (sim/roughness/roughness_model.h): smooth interfaces, the
 // exit direction blurred once.
 struct ExitBlurRoughness : life::SmoothRoughness {
-  explicit ExitBlurRoughness(const Settings& s) : blur(s.roughness) {}
+  explicit ExitBlurRoughness(const roughness::ExitBlur& r) : blur(r) {}
   Vec3 exit_direction(const Vec3& d, int segments, PhotonRandom& rng) const {
     return blur.apply(d, segments, rng);
   }

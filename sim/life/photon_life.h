@@ -62,7 +62,7 @@ struct LifeConfig {
 
   static MedullaConfig medulla_config(const Settings& s) {
     if (!s.fiber.medulla) return {};
-    const MedullaSettings& m = *s.fiber.medulla;
+    const Medulla& m = *s.fiber.medulla;
     const EllipseCrossSection e(s.fiber.eccentricity);
     return {e.r_v(), e.r_w(), m.radius, m.sigma_s, m.g, s.fiber.eta, m.eta, s.max_segments};
   }

@@ -8,16 +8,10 @@ namespace {
 
 using V = life::Vec3Of<double>;
 
-MicrofacetModel distribution_model(RoughnessModel m) {
-  if (m == RoughnessModel::Beckmann) return MicrofacetModel::Beckmann;
-  if (m == RoughnessModel::GGX) return MicrofacetModel::GGX;
-  throw Error("internal error: microfacet roughness for a model that is not beckmann or ggx");
-}
-
 }  // namespace
 
-MicrofacetRoughness::MicrofacetRoughness(const RoughnessSettings& r)
-    : distribution_(distribution_model(r.model), r.alpha_long, r.alpha_azim), masking_(r.masking) {}
+MicrofacetRoughness::MicrofacetRoughness(MicrofacetModel model, const roughness::MicrofacetAlpha& r)
+    : distribution_(model, r.alpha_long, r.alpha_azim), masking_(r.masking) {}
 
 Vec3 MicrofacetRoughness::mean_normal(const Vec3& d, const BoundaryNormals& n) {
   return mean_normal(V(d), V(n.facing), V(n.untilted_facing)).to_vec3();

@@ -38,8 +38,7 @@ namespace fiberlab::sim {
 
 class MicrofacetRoughness {
  public:
-  // r.model beckmann or ggx (throws fiberlab::Error otherwise).
-  explicit MicrofacetRoughness(const RoughnessSettings& r);
+  MicrofacetRoughness(MicrofacetModel model, const roughness::MicrofacetAlpha& r);
 
   bool masks() const { return masking_ == Masking::SmithG1; }
 

@@ -26,8 +26,6 @@ class GaussianRoughness {
  public:
   GaussianRoughness(double beta_long, double beta_azim)
       : widths_(beta_long, beta_azim) {}
-  explicit GaussianRoughness(const Settings& s)
-      : GaussianRoughness(s.roughness.beta_long.front(), s.roughness.beta_azim.front()) {}
 
   // Always inline: GCC 12 leaves it out of line, passing the photon state,
   // the frame and the stream through memory.

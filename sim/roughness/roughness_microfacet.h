@@ -9,7 +9,7 @@
 namespace fiberlab::sim {
 
 struct MicrofacetLifeModel {
-  explicit MicrofacetLifeModel(const Settings& s) : roughness(s.roughness) {}
+  MicrofacetLifeModel(MicrofacetModel model, const roughness::MicrofacetAlpha& r) : roughness(model, r) {}
 
   template <class T>
   life::FacetDraw<T> draw_normal(const life::Vec3Of<T>& d, const life::BoundaryFrame<T>& frame,

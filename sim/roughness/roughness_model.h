@@ -7,7 +7,8 @@
 // for both number types of the life (a scalar double, or an
 // xsimd::batch<double> of photons: sim/simd/lanes.h), with
 //
-//   explicit Model(const Settings&);
+//   (constructed from its roughness type, common/roughness/, by
+//   life_model in sim/roughness/roughness_models.h)
 //   template <class T>
 //   FacetDraw<T> draw_normal(const Vec3Of<T>& d, const BoundaryFrame<T>& frame,
 //                            const MaskOf<T>& live, LaneRandom<T>& rng, T& tries,
@@ -44,23 +45,25 @@
 // BatchTracer ask it (runs_batched in sim/roughness/roughness_models.h); a
 // model written for T = double only runs on the reference tracer.
 //
-// To add a model, the files it touches (counted for beckmann / ggx, which
-// touch 23; a model of one header and one test file touches 12):
-// 1. its sampler, one header sim/roughness/roughness_<name>.h (see
-//    roughness_gaussian.h for a rejection sampler, roughness_smooth.h for the
-//    simplest, roughness_microfacet.h for one with an event weight), more
-//    files if it has parts of its own (the microfacet models: seven);
-// 2. its registration and settings (six): sim/roughness/roughness_models.h
-//    (the variant and make_roughness), sim/run/settings.h and settings.cpp
-//    (its name, parameters, reading and validation),
-//    sim/store/result_file.cpp (its parameters as file attributes),
-//    cli/cmd_info.cpp (their description), compare/models.cpp (the analytic
-//    models' stand-in for its fibers);
-// 3. its tests: its own file(s) in tests/sim/ (an oracle for its normals;
-//    the microfacet models: six), listed in tests/CMakeLists.txt, and a case
-//    in tests/sim/test_batch_tracer.cpp (photon by photon against the
+// To add a model (counted with a model whose sampler is an existing one):
+// 1. its roughness type, one file common/roughness/<name>.h: its fields,
+//    config reading and checks, YAML text, file attributes, info line
+//    (common/roughness/roughness.h says what the type has), and its name in
+//    the variant there (one line and its #include);
+// 2. its sampler: one life_model overload in sim/roughness/roughness_models.h,
+//    and a header sim/roughness/roughness_<name>.h with its type in
+//    AnyRoughness when the sampler is new (see roughness_gaussian.h for a
+//    rejection sampler, roughness_smooth.h for the simplest,
+//    roughness_microfacet.h for one with an event weight);
+// 3. what the analytic models make of it: its rule in
+//    analytic/physical_defaults.cpp (apply_fiber_roughness) and in
+//    analytic/huang2022.cpp (huang_roughness), which do not compile without;
+// 4. its tests, in tests/sim/ (globbed: an oracle for its normals, and a case
+//    in tests/sim/test_batch_tracer.cpp, photon by photon against the
 //    reference tracer);
-// 4. docs/PHYSICS.md (the model) and docs/FILE_FORMAT.md (its attributes).
+// 5. docs/PHYSICS.md (the model) and docs/FILE_FORMAT.md (its attributes).
+// Settings, result files, checkpoints, `fiberlab info` and the comparison's
+// fiber then follow from the type.
 // Both tracers, the batched one's lane management, Fresnel, Stokes light,
 // tilt, the consistency rule, truncation and masking's losses then apply to
 // it unchanged.

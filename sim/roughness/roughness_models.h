@@ -15,23 +15,23 @@ namespace fiberlab::sim {
 using AnyRoughness = std::variant<life::SmoothRoughness, life::GaussianRoughness, ExitBlurRoughness,
                                   MicrofacetLifeModel>;
 
-// The roughness model the tracers apply: gaussian with beta_long = beta_azim
-// = 0 is the smooth model, fallback included (SPEC section 3).
+// The sampler of each roughness of the fiber (common/roughness/roughness.h).
+inline AnyRoughness life_model(const roughness::Smooth&) { return life::SmoothRoughness(); }
+// Gaussian with beta_long = beta_azim = 0 is the smooth model, fallback
+// included (SPEC section 3).
+inline AnyRoughness life_model(const roughness::Gaussian& g) {
+  if (g.beta_long == 0.0 && g.beta_azim == 0.0) return life::SmoothRoughness();
+  return life::GaussianRoughness(g.beta_long, g.beta_azim);
+}
+inline AnyRoughness life_model(const roughness::ExitBlur& e) { return ExitBlurRoughness(e); }
+inline AnyRoughness life_model(const roughness::Beckmann& b) {
+  return MicrofacetLifeModel(MicrofacetModel::Beckmann, b);
+}
+inline AnyRoughness life_model(const roughness::Ggx& g) { return MicrofacetLifeModel(MicrofacetModel::GGX, g); }
+
+// The roughness model the tracers apply to the fiber of `s`.
 inline AnyRoughness make_roughness(const Settings& s) {
-  const RoughnessSettings& r = s.roughness;
-  switch (r.model) {
-    case RoughnessModel::Beckmann:
-    case RoughnessModel::GGX:
-      return MicrofacetLifeModel(s);
-    case RoughnessModel::Smooth:
-      return life::SmoothRoughness(s);
-    case RoughnessModel::Gaussian:
-      if (r.beta_long.front() == 0.0 && r.beta_azim.front() == 0.0) return life::SmoothRoughness(s);
-      return life::GaussianRoughness(s);
-    case RoughnessModel::ExitBlur:
-      return ExitBlurRoughness(s);
-  }
-  return life::SmoothRoughness(s);
+  return std::visit([](const auto& r) { return life_model(r); }, s.fiber.roughness);
 }
 
 // Whether the batched tracer runs the model of `r`: its type says

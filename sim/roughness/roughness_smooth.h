@@ -9,7 +9,6 @@ namespace fiberlab::sim::life {
 
 struct SmoothRoughness {
   SmoothRoughness() = default;
-  explicit SmoothRoughness(const Settings&) {}
 
   template <class T>
   FacetDraw<T> draw_normal(const Vec3Of<T>& d, const BoundaryFrame<T>& frame,

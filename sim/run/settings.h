@@ -1,24 +1,16 @@
 #pragma once
 // What to run: the resolved simulation configuration (SPEC section 11).
 // All angles here are in radians; the YAML file has degrees.
-#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "common/bin_grid.h"
+#include "common/fiber.h"
 
 namespace fiberlab::sim {
 
-// Beckmann and GGX: microfacet distributions of normals about the tilted
-// normal, sampled as visible normals (sim/roughness/microfacet_roughness.h).
-enum class RoughnessModel { Smooth, Gaussian, ExitBlur, Beckmann, GGX };
-// `roughness.masking` of the microfacet models: `smith_g1` multiplies the
-// photon's weight by Smith's G1 of each scattered direction and kills paths
-// that leave on the wrong side of the mean surface (Huang et al. 2022's
-// ground truth); the removed weight is the ledger's `lost`.
-enum class Masking { None, SmithG1 };
 enum class Polarization { Scalar, Stokes };
 // How a photon's exits are scored (SPEC section 5; docs/PHYSICS.md
 // "Estimator"). `analog`: at every event the photon reflects with
@@ -28,54 +20,6 @@ enum class Polarization { Scalar, Stokes };
 // and the photon goes on along the other with the weight times one minus it
 // (Russian roulette once the weight is below life::kRouletteBelow).
 enum class Estimator { Analog, ExpectedValue };
-
-// `fiber.medulla` (docs/FUR.md): a scattering core, the cross-section scaled
-// by `radius` about the fiber's axis, filled with a medium of scattering
-// coefficient sigma_s and absorption sigma_a (1/R, as the fiber's), a
-// Henyey-Greenstein phase function of anisotropy g, and index eta (the
-// fiber's when not given: then its boundary is no interface).
-struct MedullaSettings {
-  double radius = 0.5;               // k in (0, 1), of the fiber's semi-axes
-  double sigma_s = 0.0;              // 1/R, finite, >= 0
-  std::vector<double> sigma_a;       // 1/R per channel (the fiber's channels)
-  double g = 0.0;                    // in (-1, 1)
-  double eta = 1.55;                 // relative to the outer medium, >= 1
-
-  friend bool operator==(const MedullaSettings&, const MedullaSettings&) = default;
-};
-
-struct FiberSettings {
-  double eta = 1.55;           // relative index, > 1
-  double eccentricity = 1.0;   // minor/major, (0, 1]
-  double scale_tilt = 0.0;     // alpha, radians, towards the root
-  std::vector<double> sigma_a{0.0, 0.0, 0.0};  // 1/R per channel
-  // Set when the config gave melanin instead of sigma_a (sigma_a is then derived).
-  std::optional<double> eumelanin, pheomelanin;
-  std::optional<MedullaSettings> medulla;  // none: a plain fiber
-
-  friend bool operator==(const FiberSettings&, const FiberSettings&) = default;
-};
-
-struct RoughnessSettings {
-  RoughnessModel model = RoughnessModel::Gaussian;
-  // Radians. gaussian: one entry. exit_blur: indexed by p, the last entry
-  // applying to every larger p. smooth: ignored (kept as given).
-  std::vector<double> beta_long{0.0};
-  std::vector<double> beta_azim{0.0};
-  // beckmann / ggx (0 for the other models): the microfacet roughness alpha
-  // along the fiber axis (longitudinal) and about it (azimuthal), each > 0.
-  double alpha_long = 0.0, alpha_azim = 0.0;
-  Masking masking = Masking::None;  // beckmann / ggx only
-
-  bool microfacet() const { return model == RoughnessModel::Beckmann || model == RoughnessModel::GGX; }
-
-  // beta for lobe p of a list indexed by p (last entry for larger p).
-  static double for_lobe(const std::vector<double>& betas, int p) {
-    return betas[std::min<std::size_t>(static_cast<std::size_t>(p), betas.size() - 1)];
-  }
-
-  friend bool operator==(const RoughnessSettings&, const RoughnessSettings&) = default;
-};
 
 struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
@@ -102,8 +46,7 @@ struct Settings {
   std::uint64_t photons = 1000000;  // per incident configuration
   std::uint64_t seed = 1;
   std::string output = "out.h5";
-  FiberSettings fiber;
-  RoughnessSettings roughness;
+  Fiber fiber;  // with its roughness (common/fiber.h)
   SourceSettings source;
   TallySettings tally;
   int max_segments = 1000;
@@ -150,11 +93,6 @@ std::uint64_t parse_integer_flag(const std::string& flag, const std::string& tex
 // result files as `config_yaml` and parseable again by parse_settings_yaml.
 std::string to_yaml(const Settings& s);
 
-// Derived sigma_a from melanin concentrations, d'Eon 2011 section 6.1.
-std::vector<double> sigma_a_from_melanin(double eumelanin, double pheomelanin);
-
-std::string to_string(RoughnessModel m);
-std::string to_string(Masking m);
 std::string to_string(Polarization p);
 std::string to_string(Estimator e);
 

@@ -73,9 +73,10 @@ void check_parameter_groups(const h5::File& f, const Settings& s, const std::str
   same("fiber", "eccentricity", {s.fiber.eccentricity});
   same("fiber", "scale_tilt", {s.fiber.scale_tilt});
   same("fiber", "sigma_a", s.fiber.sigma_a);
-  same("roughness", "beta_long", {s.roughness.beta_long});
-  same("roughness", "beta_azim", {s.roughness.beta_azim});
-  if (f.attr_string("/roughness", "model") != to_string(s.roughness.model))
+  for (const roughness::Attribute& a : roughness::attributes(s.fiber.roughness))
+    if (const auto* numbers = std::get_if<std::vector<double>>(&a.value))
+      same("roughness", a.name.c_str(), *numbers);
+  if (f.attr_string("/roughness", "model") != roughness::name(s.fiber.roughness))
     inconsistent(path, "/roughness@model does not match the stored config_yaml's roughness.model");
 }
 

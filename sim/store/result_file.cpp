@@ -23,27 +23,7 @@ void append(std::vector<T>& to, const std::vector<T>& from) {
 }
 
 void write_parameters(h5::File& f, const Settings& s) {
-  f.create_group("/fiber");
-  f.set_attr("/fiber", "eta", s.fiber.eta);
-  f.set_attr("/fiber", "eccentricity", s.fiber.eccentricity);
-  f.set_attr("/fiber", "scale_tilt", s.fiber.scale_tilt);
-  f.set_attr("/fiber", "sigma_a", s.fiber.sigma_a);
-  if (const auto& m = s.fiber.medulla) {  // docs/FUR.md
-    f.create_group("/fiber/medulla");
-    f.set_attr("/fiber/medulla", "radius", m->radius);
-    f.set_attr("/fiber/medulla", "sigma_s", m->sigma_s);
-    f.set_attr("/fiber/medulla", "sigma_a", m->sigma_a);
-    f.set_attr("/fiber/medulla", "g", m->g);
-    f.set_attr("/fiber/medulla", "eta", m->eta);
-  }
-  f.create_group("/roughness");
-  f.set_attr("/roughness", "model", to_string(s.roughness.model));
-  f.set_attr("/roughness", "beta_long", s.roughness.beta_long);
-  f.set_attr("/roughness", "beta_azim", s.roughness.beta_azim);
-  if (s.roughness.microfacet()) {  // beckmann / ggx
-    f.set_attr("/roughness", "alpha", std::vector<double>{s.roughness.alpha_long, s.roughness.alpha_azim});
-    f.set_attr("/roughness", "masking", to_string(s.roughness.masking));
-  }
+  write_fiber(f, s.fiber);
   f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
   f.set_attr("/source", "polarization", to_string(s.polarization));
   f.set_attr("/source", "estimator", to_string(s.estimator));

@@ -225,7 +225,7 @@ TEST(Chiang2016, AbsorbingLobeEnergiesAreTheSmoothCylinders) {
 // Mutation tried and caught: the residual off by one order (its total).
 TEST(Chiang2016, ZeroRoughnessIsTheSmoothCylinder) {
   const BinGrid grid = BinGrid::make(18, 72, ThetaBinning::Uniform);
-  ModelParams mp;
+  ExactParams mp;
   mp.sigma_a = {0.0, 0.6};
   mp.absorption = Absorption::Chord;
   const SmoothCylinder exact(mp);
@@ -256,7 +256,7 @@ TEST(Chiang2016, ZeroRoughnessIsTheSmoothCylinder) {
 // h -> -h mirror image, which the average over h makes identical.)
 TEST(Chiang2016, SmallRoughnessIsTheSmoothCylinder) {
   const BinGrid grid = BinGrid::make(6, 36, ThetaBinning::Uniform);  // centres +-15, 45, 75 deg
-  ModelParams mp;
+  ExactParams mp;
   mp.sigma_a = {0.3};
   mp.absorption = Absorption::Chord;
   Chiang2016Params p;

@@ -324,24 +324,25 @@ TEST(Huang2022, RDensityIsTheTextbookMicrofacetIntegral) {
 
 // The parameter table: defaults, --set parsing and refusals.
 TEST(Huang2022, ParameterTable) {
-  ModelParams p = default_params("huang2022");
-  EXPECT_DOUBLE_EQ(p.ggx_roughness, 0.3);
+  ModelParameters p = default_params("huang2022");
+  const Huang2022Params& h = p.as<Huang2022Params>();
+  EXPECT_DOUBLE_EQ(h.roughness, 0.3);
   apply_setting("huang2022", p, "roughness=0.1");
   apply_setting("huang2022", p, "tilt=3");
   apply_setting("huang2022", p, "masking=correlated");
   apply_setting("huang2022", p, "quadrature_points=4096");
-  EXPECT_EQ(p.huang_residual, 0);
+  EXPECT_EQ(h.residual, HuangResidual::Sampler);
   apply_setting("huang2022", p, "residual=cycles_eval");
-  EXPECT_EQ(p.huang_residual, 1);
+  EXPECT_EQ(h.residual, HuangResidual::CyclesEval);
   EXPECT_THROW(apply_setting("huang2022", p, "residual=eval"), Error);
-  EXPECT_DOUBLE_EQ(p.ggx_roughness, 0.1);
-  EXPECT_NEAR(p.scale_tilt, deg_to_rad(3.0), 1e-15);
-  EXPECT_EQ(p.huang_masking, 1);
+  EXPECT_DOUBLE_EQ(h.roughness, 0.1);
+  EXPECT_NEAR(h.tilt, deg_to_rad(3.0), 1e-15);
+  EXPECT_EQ(h.masking, HuangMasking::Correlated);
   EXPECT_THROW(apply_setting("huang2022", p, "roughness=1.5"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "eccentricity=0"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "quadrature_points=100"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "beta_m=0.3"), Error);
-  p.sigma_a = {0.1, 0.2, 0.3};
+  p.as<Huang2022Params>().sigma_a = {0.1, 0.2, 0.3};
   auto m = make_model("huang2022", p);
   EXPECT_EQ(m->name(), "huang2022");
   const BinGrid g = BinGrid::make(6, 8, ThetaBinning::Uniform);

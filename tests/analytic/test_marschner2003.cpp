@@ -23,8 +23,8 @@ namespace m3 = marschner2003;
 
 constexpr double kEta = 1.55;
 
-ModelParams params_one_channel(double beta_deg) {
-  ModelParams p;
+Marschner2003Params params_one_channel(double beta_deg) {
+  Marschner2003Params p;
   p.eta = kEta;
   p.sigma_a = {0.0};
   p.beta_long = {deg_to_rad(beta_deg)};
@@ -323,7 +323,7 @@ TEST(Marschner2003, ConvergesToExactSmoothCylinder) {
   // Exact roots, Gaussian in 2 theta_h, no caustic smoothing, small beta,
   // theta_i = 0 (where Marschner's Bravais Fresnel and the 3D one coincide in
   // any case; they coincide everywhere with our reading of Appendix B).
-  ModelParams params = params_one_channel(0.1);
+  Marschner2003Params params = params_one_channel(0.1);
   params.two_theta_h = true;
   params.exact_roots = true;
   const auto model = make_marschner2003(params);
@@ -355,7 +355,7 @@ TEST(Marschner2003, AbsorptionPublishedAndChord) {
   // TT energy at theta_i = 0 against the forward-mapped closed form, with the
   // published segment length 2 + 2 cos(2 gamma_t) and with the chord 2 cos gamma_t.
   for (bool chord : {false, true}) {
-    ModelParams params = params_one_channel(0.1);
+    Marschner2003Params params = params_one_channel(0.1);
     params.sigma_a = {0.4};
     params.two_theta_h = true;
     params.exact_roots = true;
@@ -383,7 +383,7 @@ TEST(Marschner2003, TotalReflectanceBehavesAsDeonFigure3) {
   // 0.989. Grazing, beta 20 deg, theta_i 85: theta_h 2.28, two_theta_h 1.07
   // (> 1 although 14% is missing). beta 30 deg, theta_i 0: 1.11 and 0.815.
   const auto total = [](double beta_deg, bool two, double theta_i_deg) {
-    ModelParams params = params_one_channel(beta_deg);
+    Marschner2003Params params = params_one_channel(beta_deg);
     params.two_theta_h = two;
     return total_reflectance(*make_marschner2003(params), deg_to_rad(theta_i_deg), 360, 360);
   };
@@ -412,11 +412,11 @@ TEST(Marschner2003, EccentricityOneEqualsCircle) {
   EXPECT_NEAR(m3::eta_star(kEta, a, 0.5 * kPi), e2, 1e-15);
   EXPECT_NEAR(m3::eta_star(kEta, a, 0.25 * kPi), 0.5 * (e1 + e2), 1e-15);
 
-  ModelParams circ = params_one_channel(8.0);
+  Marschner2003Params circ = params_one_channel(8.0);
   circ.w_c = deg_to_rad(15.0);
   circ.delta_h_m = 0.5;
   circ.delta_eta = 0.3;
-  ModelParams one = circ, ell = circ;
+  Marschner2003Params one = circ, ell = circ;
   one.eccentricity = 1.0 - 1e-14;  // takes the eta* path
   ell.eccentricity = 0.85;
   const auto m_circ = make_marschner2003(circ), m_one = make_marschner2003(one),
@@ -516,7 +516,7 @@ TEST(Marschner2003, EccentricityMatchesEllipseRayTrace) {
   EXPECT_NEAR(along_major, 0.23, 0.1);
   EXPECT_NEAR(along_minor, 39.2, 0.2);
 
-  ModelParams params = params_one_channel(0.5);
+  Marschner2003Params params = params_one_channel(0.5);
   params.two_theta_h = true;
   params.exact_roots = true;
   params.eccentricity = 0.85;
@@ -546,7 +546,7 @@ TEST(Marschner2003, EccentricityMatchesEllipseRayTrace) {
 TEST(Marschner2003, FiniteOnDenseGrid) {
   std::vector<double> out;
   for (int variant = 0; variant < 8; ++variant) {
-    ModelParams params = params_one_channel(variant % 2 ? 0.05 : 20.0);
+    Marschner2003Params params = params_one_channel(variant % 2 ? 0.05 : 20.0);
     params.sigma_a = {0.0, 5.0, 1e3};
     params.two_theta_h = variant & 2;
     params.exact_roots = variant & 4;
@@ -587,7 +587,7 @@ TEST(Marschner2003, FiniteOnDenseGrid) {
 }
 
 TEST(Marschner2003, LobeGrouping) {
-  ModelParams params = params_one_channel(6.0);
+  Marschner2003Params params = params_one_channel(6.0);
   params.lobes = 2;  // lobe 1 = TT + TRT
   const auto two = make_marschner2003(params);
   params.lobes = 4;
@@ -608,7 +608,7 @@ TEST(Marschner2003, LobeGrouping) {
 TEST(Marschner2003, BinProbabilitiesReachTheSmoothLimit) {
   // beta = 0.1 deg inside 2 deg theta bins: the override resolves M and the
   // 1/sqrt caustics. Oracle: the forward-mapped smooth-circle histogram.
-  ModelParams params = params_one_channel(0.1);
+  Marschner2003Params params = params_one_channel(0.1);
   params.two_theta_h = true;
   params.exact_roots = true;
   const auto model = make_marschner2003(params);
@@ -632,7 +632,7 @@ TEST(Marschner2003, BinProbabilitiesReachTheSmoothLimit) {
 TEST(Marschner2003, BinProbabilitiesAgreeWithDefaultWhenSmooth) {
   // Broad lobes and a smoothed caustic: the base class's per-bin 6 x 6
   // Gauss-Legendre rule is accurate there and must agree with the override.
-  ModelParams params = params_one_channel(12.0);
+  Marschner2003Params params = params_one_channel(12.0);
   params.sigma_a = {0.3, 1.0};
   params.w_c = deg_to_rad(20.0);
   params.k_g = 1.0;
@@ -672,7 +672,7 @@ TEST(Marschner2003, InterpolatedThetaMatchesPerNodeReference) {
   // reference's own theta_r quadrature error (4 vs 12 Gauss points per piece)
   // is 2e-3 of the largest TRT bin, 1e-11 for R and TT; a Monte Carlo
   // estimate reaches 1e-6 relative only with ~1e12 photons.
-  ModelParams params;
+  Marschner2003Params params;
   params.eta = kEta;
   params.sigma_a = {0.2, 0.4, 0.8};
   params.alpha = {deg_to_rad(-6.0), deg_to_rad(3.0), deg_to_rad(12.0), 0.0};
@@ -796,7 +796,7 @@ std::vector<double> direct_phi_bins(int p, double theta_d, const std::vector<dou
 // deviations either side of the lobe's centre -theta_i + alpha_p), of
 // M_p cos^2(theta_r) / cos^2(theta_d) (Eq. 9, SPEC s7) times direct_phi_bins
 // at theta_d. Published M (a Gaussian in theta_h) and cubic.
-std::vector<double> direct_bin_row(const ModelParams& params, const BinGrid& grid, double ti, int p, int i,
+std::vector<double> direct_bin_row(const Marschner2003Params& params, const BinGrid& grid, double ti, int p, int i,
                                    const m3::CausticParams* cp) {
   const GaussLegendre& gl = gauss_legendre(4);
   const double sd = 2.0 * params.beta_long[p], centre = -ti + params.alpha[p];  // in theta_r
@@ -819,9 +819,9 @@ std::vector<double> direct_bin_row(const ModelParams& params, const BinGrid& gri
   return want;
 }
 
-ModelParams bench_params() {
+Marschner2003Params bench_params() {
   // bench_analytic FullPredict's: published cubic and M, no caustic smoothing.
-  ModelParams params;
+  Marschner2003Params params;
   params.eta = kEta;
   params.sigma_a = {0.2, 0.4, 0.8};
   params.beta_long = {deg_to_rad(5.0), deg_to_rad(2.5), deg_to_rad(10.0)};
@@ -834,7 +834,7 @@ TEST(Marschner2003, BinsMatchADirectEvaluation) {
   // deg, 90 x 180 bins, 3 channels) against direct_bin_row: all 180 phi
   // bins of two theta bins per lobe. Also R and TT of an eccentric fiber
   // (a = 0.9): eccentricity changes N_TRT only (section 5.2.3).
-  ModelParams params = bench_params();
+  Marschner2003Params params = bench_params();
   const double ti = deg_to_rad(30.5);
   const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
   const std::size_t C = 3, row = 180 * C;
@@ -877,7 +877,7 @@ TEST(Marschner2003, GlintBinsMatchADirectEvaluation) {
   // change nothing else): theta bins at the lobe's centre (eta' 1.64), at
   // theta_r -62 deg (eta' 1.98, the caustics about to merge) and -74 deg
   // (eta' 2.18: merged, the glint fading).
-  ModelParams params = bench_params();
+  Marschner2003Params params = bench_params();
   params.w_c = deg_to_rad(15.0);
   params.k_g = 1.0;
   params.delta_eta = 0.3;
@@ -905,7 +905,7 @@ TEST(Marschner2003, GlintBinsMatchADirectEvaluation) {
 }
 
 TEST(Marschner2003, RejectsUnrepresentableParameters) {
-  ModelParams params = params_one_channel(0.0);
+  Marschner2003Params params = params_one_channel(0.0);
   EXPECT_THROW(make_marschner2003(params), Error);
   params = params_one_channel(5.0);
   params.eta = 1.0;

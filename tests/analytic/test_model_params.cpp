@@ -7,7 +7,10 @@
 #include <fstream>
 #include <map>
 
+#include "analytic/deon2011.h"
+#include "analytic/marschner2003.h"
 #include "analytic/model_registry.h"
+#include "analytic/smooth_cylinder.h"
 #include "common/error.h"
 #include "common/h5_file.h"
 #include "common/units.h"
@@ -32,7 +35,7 @@ TEST(ModelParams, EveryTableKeyParses) {
       {"huang2022 residual", "cycles_eval"},
       {"huang2022 quadrature_points", "65536"}};
   for (const ModelInfo& m : registered_models()) {
-    ModelParams p = default_params(m.name);
+    ModelParameters p = default_params(m.name);
     for (const ParamSpec& spec : m.params) {
       const auto o = own.find(m.name + " " + spec.key);
       ASSERT_TRUE(good.count(spec.key) || o != own.end()) << m.name << " " << spec.key;
@@ -42,17 +45,17 @@ TEST(ModelParams, EveryTableKeyParses) {
     }
     EXPECT_EQ(param_attributes(m.name, p).size(), m.params.size());
   }
-  ModelParams p = default_params("deon2011");
+  ModelParameters p = default_params("deon2011");
   apply_setting("deon2011", p, "beta_long=5,10");
-  EXPECT_NEAR(p.beta_long[1], deg_to_rad(10.0), 1e-15);
+  EXPECT_NEAR(p.as<Deon2011Params>().beta_long[1], deg_to_rad(10.0), 1e-15);
 }
 
 // The defaults that matter: the exact model is exact (chord absorption);
 // Marschner's caustic parameters are Table 1's.
 TEST(ModelParams, DefaultsAreTheModelsOwn) {
-  EXPECT_EQ(default_params("exact").absorption, Absorption::Chord);
-  EXPECT_EQ(default_params("deon2011").absorption, Absorption::Published);
-  const ModelParams m = default_params("marschner2003");
+  EXPECT_EQ(default_params("exact").as<ExactParams>().absorption, Absorption::Chord);
+  EXPECT_EQ(default_params("deon2011").as<Deon2011Params>().absorption, Absorption::Published);
+  const Marschner2003Params m = default_params("marschner2003").as<Marschner2003Params>();
   EXPECT_EQ(m.absorption, Absorption::Published);
   EXPECT_NEAR(m.w_c, deg_to_rad(10.0), 1e-15);
   EXPECT_EQ(m.k_g, 0.5);
@@ -63,7 +66,7 @@ TEST(ModelParams, DefaultsAreTheModelsOwn) {
 TEST(ModelParams, BadInputNamesTheKeyAndTheAllowedValues) {
   for (const char* bad : {"eta=1", "eta=abc", "sigma_a=0.1,,0.2", "beta_long=-1", "absorption=foo",
                           "lobes=0", "lobes=2.5", "nokey", "colour=red"}) {
-    ModelParams p = default_params("deon2011");
+    ModelParameters p = default_params("deon2011");
     try {
       apply_setting("deon2011", p, bad);
       ADD_FAILURE() << bad;
@@ -75,18 +78,20 @@ TEST(ModelParams, BadInputNamesTheKeyAndTheAllowedValues) {
       EXPECT_EQ(msg.find('\n'), std::string::npos);
     }
   }
-  ModelParams p;
+  ModelParameters p;
   EXPECT_THROW(make_model("phong", p), Error);
-  ModelParams q;
-  q.beta_long = {deg_to_rad(5.0)};
-  q.beta_azim = {deg_to_rad(5.0)};
-  for (const auto& n : model_names()) EXPECT_EQ(make_model(n, q)->lobes(), 4);
+  for (const auto& n : model_names()) {
+    ModelParameters q = default_params(n);
+    for (const char* width : {"beta_long=5", "beta_azim=5"})
+      if (find_param(model_info(n).params, std::string(width).substr(0, 9))) apply_setting(n, q, width);
+    EXPECT_EQ(make_model(n, q)->lobes(), 4);
+  }
 }
 
 // A key the model does not use is refused, naming the key and listing the
 // model's own keys.
 TEST(ModelParams, KeyOfAnotherModelIsRefused) {
-  ModelParams p = default_params("exact");
+  ModelParameters p = default_params("exact");
   try {
     apply_setting("exact", p, "k_g=5");
     ADD_FAILURE();

@@ -62,7 +62,7 @@ TEST(PbrtV4Mp, ChiangVariantLowersR) {
   p.beta_m = 0.3;
   p.alpha = 0.0;
   Chiang2016 exact(p);
-  p.pbrt_v4_mp = true;
+  p.mp = Chiang2016Mp::PbrtV4;
   Chiang2016 pbrt(p);
   const BinGrid grid = BinGrid::make(90, 36, ThetaBinning::Uniform);
   const std::vector<double> a = exact.bin_probabilities(grid, 0.0, 0.0), b = pbrt.bin_probabilities(grid, 0.0, 0.0);

@@ -104,7 +104,7 @@ TEST(SmoothCylinder, TrtFoldAtDescartesAngleAndMergeAtEtaPrime2) {
 TEST(SmoothCylinder, BinsAgreeWithRootSumDensity) {
   // density() sums A / |2 dPhi/dh| over the roots (a different algorithm):
   // integrate it over bins away from caustics and compare.
-  ModelParams p;
+  ExactParams p;
   p.sigma_a = {0.3};
   p.lobes = 4;
   const SmoothCylinder m(p);

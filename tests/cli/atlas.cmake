@@ -14,3 +14,9 @@ set_tests_properties(atlas_variants_cli PROPERTIES TIMEOUT 300)
 add_test(NAME atlas_mpi_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_mpi.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
 set_tests_properties(atlas_mpi_cli PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600)
+# `fiberlab atlas` with fit.per_lobe: each lobe's chi-square after its own
+# fit at most the joint fit's (the oracle), resume and mpirun -np 2 equal to
+# one process, bad per_lobe values refused in one line.
+add_test(NAME atlas_per_lobe_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_per_lobe.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
+set_tests_properties(atlas_per_lobe_cli PROPERTIES TIMEOUT 600)

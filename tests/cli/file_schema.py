@@ -123,8 +123,12 @@ def required(kind, documented, f):
                       "exact/lobe_weight_sq_sum"}
     if kind == "atlas":
         models = text(f.attrs["models"]).split(",")
+        # The per-lobe fits' datasets only with fit.per_lobe (its groups then carry lobe_fit_status).
         names = {n for n in names if not n.startswith("models/M/")} | {
-            n.replace("models/M/", "models/%s/" % m) for n in names if n.startswith("models/M/") for m in models}
+            n.replace("models/M/", "models/%s/" % m) for n in names if n.startswith("models/M/") for m in models
+            if "lobe_fit" not in n or "lobe_fit_status" in f["models/" + m].attrs}
+    if kind == "atlas_checkpoint" and "lobe_fit_status" not in f.attrs:
+        names = {n for n in names if "lobe_fit" not in n}
     return names
 
 

@@ -69,6 +69,9 @@ model_parameters: {deon2011: {quadrature_order: 8}}
 fit: {max_iterations: 1}
 YAML
 run_ok "atlas" "$fiberlab" atlas "$work/a.yaml" -o "$work/atlas.h5" --threads 1
+# The same with fit.per_lobe: the per-lobe fits' datasets too.
+sed 's/fit: {max_iterations: 1}/fit: {max_iterations: 1, per_lobe: true}/' "$work/a.yaml" >"$work/a_lobes.yaml"
+run_ok "atlas per_lobe" "$fiberlab" atlas "$work/a_lobes.yaml" -o "$work/atlas_lobes.h5" --threads 1
 set -m
 "$fiberlab" atlas "$work/a.yaml" -o "$work/atlas_long.h5" --photons 4000000 --threads 1 \
   >"$work/along.out" 2>"$work/along.err" &
@@ -87,7 +90,7 @@ got=$?
 # Python's Result.save (when the module is built).
 files=(result:"$work/run.h5" result:"$work/merged.h5" run_checkpoint:"$work/long.checkpoint.h5"
        prediction:"$work/prediction.h5" report_data:"$work/compare_report/report_data.h5"
-       atlas:"$work/atlas.h5" atlas:"$work/atlas_report/report_data.h5"
+       atlas:"$work/atlas.h5" atlas:"$work/atlas_report/report_data.h5" atlas:"$work/atlas_lobes.h5"
        atlas_checkpoint:"$work/atlas_long.checkpoint.h5")
 if [ -n "$python_dir" ]; then
   run_ok "Python Result.save" env PYTHONPATH="$python_dir" "$py" -c \

@@ -17,26 +17,26 @@ namespace fiberlab::compare::testing {
 
 // A white circular fiber without tilt (the simulator tests' smooth circle,
 // seed 4242); `model` picks roughness.
-inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, sim::RoughnessModel model) {
+inline sim::Settings circle(double theta_i_deg, std::uint64_t photons, const Roughness& model) {
   sim::Settings s = sim::testing::smooth_circle(theta_i_deg, photons);
   s.seed = 4242;
-  s.roughness.model = model;
+  s.fiber.roughness = model;
   return s;
 }
 
 using sim::testing::run;
 
 // Model params for a result (analytic/physical_defaults.h, via compare::params_for) plus --set overrides.
-inline analytic::ModelParams params(const sim::ResultFile& r, const std::string& model,
+inline analytic::ModelParameters params(const sim::ResultFile& r, const std::string& model,
                                     const std::vector<std::string>& settings = {}) {
   return params_for(r.settings, parse_model_spec(model), settings);
 }
 
 inline std::vector<LobeComparison> compare_with(const sim::ResultFile& r, const std::string& model,
                                                 const std::vector<std::string>& settings = {}) {
-  const analytic::ModelParams p = params(r, model, settings);
-  const auto m = make_model(parse_model_spec(model).name, p);
-  return compare(r, predict_result(*m, r), p.alpha);
+  const analytic::ModelParameters p = params(r, model, settings);
+  const auto m = compare::make_model(parse_model_spec(model).name, p);
+  return compare(r, predict_result(*m, r), compare::theta_r_shifts(parse_model_spec(model).name, p));
 }
 
 // The acceptance rule of `fiberlab compare` without --max-chi2: chi2/dof

@@ -2,8 +2,9 @@
 // the fiber written, every field bit for bit (the list of fields here is the
 // test's own, not the code's, so a field the writer forgets is caught), the
 // fit's parameters rebuilt as the fit made them; the config identity follows
-// what changes the results and nothing else. The end-to-end interrupt and
-// resume through the program: tests/cli/atlas_resume.sh.
+// what changes the results and nothing else; with fit.per_lobe, each lobe's
+// own fit is read back too. The end-to-end interrupt and resume through the
+// program: tests/cli/atlas_resume.sh (with per_lobe: atlas_per_lobe.sh).
 #include <gtest/gtest.h>
 
 #include <cstring>
@@ -66,6 +67,8 @@ void expect_same(const std::vector<LobeComparison>& a, const std::vector<LobeCom
   for (std::size_t i = 0; i < a.size(); ++i) expect_same(a[i], b[i], what + "[" + std::to_string(i) + "]");
 }
 
+void expect_same(const FitResult& x, const FitResult& y, const std::string& model, const std::string& what);
+
 void expect_same(const AtlasModelResult& a, const AtlasModelResult& b, const std::string& what) {
   EXPECT_EQ(a.model, b.model) << what;
   EXPECT_EQ(a.status, b.status) << what;
@@ -76,7 +79,18 @@ void expect_same(const AtlasModelResult& a, const AtlasModelResult& b, const std
   EXPECT_TRUE(same_bits(a.seconds, b.seconds)) << what;
   expect_same(a.before, b.before, what + ".before");
   expect_same(a.after, b.after, what + ".after");
-  const FitResult &x = a.fit, &y = b.fit;
+  expect_same(a.fit, b.fit, a.model, what + ".fit");
+  EXPECT_EQ(a.lobe_fit_status, b.lobe_fit_status) << what;
+  EXPECT_EQ(a.lobe_fit_lines, b.lobe_fit_lines) << what;
+  expect_same(a.after_lobe_fit, b.after_lobe_fit, what + ".after_lobe_fit");
+  ASSERT_EQ(a.lobe_fits.size(), b.lobe_fits.size()) << what;
+  for (std::size_t j = 0; j < a.lobe_fits.size(); ++j) {
+    EXPECT_EQ(a.lobe_fits[j].lobe, b.lobe_fits[j].lobe) << what;
+    expect_same(a.lobe_fits[j].fit, b.lobe_fits[j].fit, a.model, what + ".lobe_fits[" + std::to_string(j) + "]");
+  }
+}
+
+void expect_same(const FitResult& x, const FitResult& y, const std::string& model, const std::string& what) {
   EXPECT_EQ(x.keys, y.keys) << what;
   EXPECT_TRUE(same_bits(x.start, y.start)) << what;
   EXPECT_TRUE(same_bits(x.value, y.value)) << what;
@@ -91,7 +105,7 @@ void expect_same(const AtlasModelResult& a, const AtlasModelResult& b, const std
   EXPECT_EQ(x.evaluations, y.evaluations) << what;
   EXPECT_EQ(x.converged, y.converged) << what;
   // The parameters at the minimum: rebuilt, and the same model.
-  EXPECT_EQ(analytic::describe_params(a.model, x.params), analytic::describe_params(b.model, y.params)) << what;
+  EXPECT_EQ(analytic::describe_params(model, x.params), analytic::describe_params(model, y.params)) << what;
 }
 
 void expect_same(const AtlasFiberResult& a, const AtlasFiberResult& b, const std::string& what) {
@@ -148,6 +162,36 @@ TEST_F(AtlasCheckpointTest, AFiberReadBackIsTheFiberWrittenBitForBit) {
   EXPECT_EQ(std::distance(std::filesystem::directory_iterator(dir_), {}), 1);
 }
 
+// fit.per_lobe: each lobe's own fit (here R and p>=2 of fit.lobes) and its
+// comparison rows read back as written, from the checkpoint and from the
+// bytes one MPI rank sends another; the parameters of each lobe fit rebuilt
+// from the joint fit's.
+TEST_F(AtlasCheckpointTest, PerLobeFitsReadBackToo) {
+  std::string yaml = kConfig;
+  yaml.replace(yaml.find("max_iterations: 2"), 17, "max_iterations: 2, per_lobe: true, lobes: [R, p>=2]");
+  AtlasRunSetup setup{"p.yaml", yaml, "", "p.h5", "", "fiberlab atlas p.yaml -o p.h5"};
+  const AtlasConfig config = atlas_config_of(setup);
+  ASSERT_TRUE(config.per_lobe);
+  AtlasControl control;
+  control.threads = 1;
+  const std::vector<AtlasFiberResult> fibers{run_atlas_fiber(config, 0, control)};
+  const AtlasModelResult& deon = fibers[0].models[1];
+  ASSERT_EQ(deon.lobe_fits.size(), 2u) << deon.lobe_fit_status;
+  EXPECT_EQ(deon.lobe_fits[0].lobe, 0);
+  EXPECT_EQ(deon.lobe_fits[1].lobe, 2);
+  EXPECT_EQ(deon.lobe_fits[1].fit.keys, (std::vector<std::string>{"beta_long[2]", "beta_azim[2]", "alpha[2]"}));
+  EXPECT_FALSE(deon.after_lobe_fit.empty());
+  for (const LobeComparison& c : deon.after_lobe_fit) EXPECT_TRUE(c.lobe == 0 || c.lobe == 2) << c.lobe;
+  EXPECT_EQ(fibers[0].models[0].lobe_fit_status,
+            "not fitted lobe by lobe: its parameter table marks no parameter free");
+  write_atlas_checkpoint(path("p.checkpoint.h5"), setup, config, fibers);
+  const AtlasCheckpoint c = read_atlas_checkpoint(path("p.checkpoint.h5"));
+  ASSERT_EQ(c.fibers.size(), 1u);
+  expect_same(fibers[0], c.fibers[0], "fiber 1");
+  const auto bytes = pack_atlas_fiber(config, 0, fibers[0], path("pack.h5"));
+  expect_same(fibers[0], unpack_atlas_fiber(config, 0, bytes, path("unpack.h5")), "fiber 1 (packed)");
+}
+
 // No model fitted (fit.max_iterations 0) and a model not applicable (an
 // elliptical fiber for deon2011): nothing of either kind to store, and still
 // read back as written.
@@ -172,7 +216,11 @@ TEST_F(AtlasCheckpointTest, FibersWithoutFitsReadBackToo) {
 
 TEST(AtlasCheckpoint, IdentityFollowsWhatChangesTheResults) {
   const std::string base = atlas_config_identity(parse_atlas_config(kConfig, "a"));
-  // Comments, key order and the file's name change nothing.
+  // Comments, key order and the file's name change nothing, nor do the
+  // defaults written out.
+  std::string defaults = kConfig;
+  defaults.replace(defaults.find("max_iterations: 2"), 17, "max_iterations: 2, per_lobe: false");
+  EXPECT_EQ(atlas_config_identity(parse_atlas_config(defaults, "e")), base);
   std::string reordered = std::string("# a comment\nseed: 4\n") + kConfig;
   reordered.erase(reordered.find("seed: 4\ntally"), 8);
   EXPECT_EQ(atlas_config_identity(parse_atlas_config(reordered, "b")), base);
@@ -182,7 +230,9 @@ TEST(AtlasCheckpoint, IdentityFollowsWhatChangesTheResults) {
                           {"[0.1, 0.3]", "[0.1, 0.31]"}, {"[20, 50]", "[20, 51]"},
                           {"models: [exact, deon2011]", "models: [deon2011]"},
                           {"quadrature_order: 12", "quadrature_order: 13"},
-                          {"max_iterations: 2", "max_iterations: 3"}}) {
+                          {"max_iterations: 2", "max_iterations: 3"},
+                          {"max_iterations: 2", "max_iterations: 2, per_lobe: true"},
+                          {"max_iterations: 2", "max_iterations: 2, lobes: [TT]"}}) {
     std::string changed = kConfig;
     const auto at = changed.find(from);
     ASSERT_NE(at, std::string::npos) << from;

@@ -5,6 +5,7 @@
 
 #include <cstdio>
 
+#include "analytic/huang2022.h"
 #include "common/error.h"
 #include "common/units.h"
 #include "analytic/model_registry.h"
@@ -25,12 +26,12 @@ TEST(AtlasConfig, ShippedConfigsParse) {
   // Roughness slowest, eccentricity fastest.
   EXPECT_EQ(full.fibers[1].settings.fiber.eccentricity, 0.85);
   EXPECT_EQ(full.fibers[8].roughness, 10.0);
-  EXPECT_NEAR(full.fibers[8].settings.roughness.beta_long[0], deg_to_rad(10.0), 1e-15);
+  EXPECT_NEAR(std::get<fiberlab::roughness::Gaussian>(full.fibers[8].settings.fiber.roughness).beta_long, deg_to_rad(10.0), 1e-15);
   // Microfacet entries go through the simulator's parser as they are.
   EXPECT_EQ(full.fibers[16].roughness_model, "ggx");
   EXPECT_EQ(full.fibers[16].roughness, 0.1);
-  EXPECT_EQ(full.fibers[16].settings.roughness.model, sim::RoughnessModel::GGX);
-  EXPECT_EQ(full.fibers[24].settings.roughness.masking, sim::Masking::SmithG1);
+  EXPECT_TRUE(std::holds_alternative<fiberlab::roughness::Ggx>(full.fibers[16].settings.fiber.roughness));
+  EXPECT_EQ(fiberlab::roughness::masking(full.fibers[24].settings.fiber.roughness), Masking::SmithG1);
   // Melanin: three channels, sigma_a derived by the simulator.
   EXPECT_EQ(full.fibers[4].settings.fiber.sigma_a.size(), 3u);
   EXPECT_TRUE(full.fibers[4].settings.fiber.eumelanin.has_value());
@@ -147,10 +148,10 @@ TEST(AtlasConfig, ShippedHuangQuadratureIsBelowTheNoise) {
   ASSERT_EQ(fiber.roughness_model, "ggx");
   ASSERT_EQ(fiber.roughness, 0.3);
   ASSERT_EQ(fiber.settings.fiber.eccentricity, 0.85);
-  const analytic::ModelParams p =
+  const analytic::ModelParameters p =
       params_for(fiber.settings, ModelSpec{"huang2022", c.model_parameters.at("huang2022"), "huang2022"}, {});
-  analytic::ModelParams reference = p;
-  reference.quadrature_points = 4 * p.quadrature_points;
+  analytic::ModelParameters reference = p;
+  reference.as<analytic::Huang2022Params>().quadrature_points = 4 * p.as<analytic::Huang2022Params>().quadrature_points;
   const sim::TallySettings& t = fiber.settings.tally;
   const BinGrid grid = BinGrid::make(t.n_theta, t.n_phi, t.theta_bins);
   const double theta_i = deg_to_rad(45.0), photons = static_cast<double>(fiber.settings.photons);

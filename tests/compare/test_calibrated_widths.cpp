@@ -30,7 +30,7 @@ double theta_spread(const std::vector<double>& m, const BinGrid& g, int lobe, in
 }
 
 TEST(CalibratedWidths, DefaultLobeSpreadsWithin25PercentOnHeldOutFiber) {
-  sim::Settings s = testing::circle(-19.0, 200000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(-19.0, 200000, fiberlab::roughness::Gaussian{});
   sim::testing::make_rough(s, 6.0);
   s.fiber.sigma_a = {0.2};
   s.source.theta_i = {deg_to_rad(-19.0), deg_to_rad(43.0)};
@@ -39,7 +39,7 @@ TEST(CalibratedWidths, DefaultLobeSpreadsWithin25PercentOnHeldOutFiber) {
   const sim::ResultFile r = testing::run(s);
   const std::size_t cells = r.bin_cells();
   for (const char* model : {"deon2011", "marschner2003"}) {
-    const analytic::ModelParams p = testing::params(r, model);
+    const analytic::ModelParameters p = testing::params(r, model);
     const auto bins = predict_result(*make_model(model, p), r);
     for (std::size_t k = 0; k < r.configs(); ++k) {
       std::vector<double> sim(r.weight_sum.begin() + k * cells, r.weight_sum.begin() + (k + 1) * cells);

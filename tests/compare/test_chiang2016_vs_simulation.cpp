@@ -8,18 +8,19 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analytic/chiang2016.h"
 #include "compare_test_support.h"
 
 namespace fiberlab::compare {
 namespace {
 
 TEST(Chiang2016VsSimulation, SmoothCircleIsTheZeroRoughnessLimit) {
-  sim::Settings s = testing::circle(35.0, 1000000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 1000000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   const sim::ResultFile r = testing::run(s);
-  const analytic::ModelParams p = testing::params(r, "chiang2016");
-  EXPECT_EQ(p.beta_m, 0.0);  // smooth config -> the model's exact limit
-  EXPECT_EQ(p.beta_n, 0.0);
+  const analytic::ModelParameters p = testing::params(r, "chiang2016");
+  EXPECT_EQ(p.as<analytic::Chiang2016Params>().beta_m, 0.0);  // smooth config -> the model's exact limit
+  EXPECT_EQ(p.as<analytic::Chiang2016Params>().beta_n, 0.0);
   for (const auto& c : testing::compare_with(r, "chiang2016")) {
     std::printf("lobe %d: E_sim %.6f +- %.6f, E_model %.6f, chi2/dof %.3f (%d)\n", c.lobe, c.sim_energy,
                 c.sim_error, c.model_energy, c.bins.per_dof(), c.bins.dof);

@@ -37,10 +37,10 @@ void print(const LobeComparison& c) {
 // r_fresnel=per_h: the simulator's R lobe has f per h (Eq. 14), not
 // Eq. 12's half-angle Fresnel.
 TEST(CompareModels, ExitBlurAcceptedByDeon) {
-  sim::Settings s = testing::circle(3.0, 300000, sim::RoughnessModel::ExitBlur);
+  sim::Settings s = testing::circle(3.0, 300000, fiberlab::roughness::ExitBlur{});
   s.fiber.sigma_a = {0.2, 0.6};
-  s.roughness.beta_long = {deg_to_rad(5.0), deg_to_rad(7.0), deg_to_rad(10.0)};
-  s.roughness.beta_azim = {deg_to_rad(12.0), deg_to_rad(20.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(5.0), deg_to_rad(7.0), deg_to_rad(10.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(12.0), deg_to_rad(20.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 60;
   const sim::ResultFile r = testing::run(s);
@@ -60,7 +60,7 @@ TEST(CompareModels, ExitBlurAcceptedByDeon) {
 
 // A smooth circle against the exact model (SPEC s7-8), at two incidences.
 TEST(CompareModels, SmoothCircleAcceptedByExact) {
-  sim::Settings s = testing::circle(35.0, 1000000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 1000000, fiberlab::roughness::Smooth{});
   s.source.theta_i = {deg_to_rad(35.0), deg_to_rad(71.0)};
   s.tally.n_theta = 91;
   const sim::ResultFile r = testing::run(s);
@@ -75,7 +75,7 @@ TEST(CompareModels, SmoothCircleAcceptedByExact) {
 // The same data against a wrong index (1.45 instead of 1.55) is rejected
 // with a chi-square far beyond any statistical fluctuation.
 TEST(CompareModels, WrongEtaRejected) {
-  sim::Settings s = testing::circle(35.0, 1000000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 1000000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   const sim::ResultFile r = testing::run(s);
   for (const auto& c : testing::compare_with(r, "exact", {"eta=1.45"})) {
@@ -92,7 +92,7 @@ int run_binary(const std::string& args) {
 
 // The real program's exit status: 0 accepted, 1 rejected, 2 bad input.
 TEST(CompareModels, ExitStatus) {
-  sim::Settings s = testing::circle(35.0, 400000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 400000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   const fs::path dir = fs::temp_directory_path() / ("fiberlab_compare_exit_status_" + std::to_string(::getpid()));
   fs::create_directories(dir);

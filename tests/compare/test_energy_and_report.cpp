@@ -24,16 +24,16 @@ namespace fs = std::filesystem;
 // about 2 at small roughness (d'Eon 2011 s4.1, Fig. 3), the 2 theta_h fix
 // about 1 (minus the p >= 3 energy the three lobes miss).
 TEST(Energy, WhiteFiberFurnace) {
-  sim::Settings s = testing::circle(0.0, 100000, sim::RoughnessModel::ExitBlur);
+  sim::Settings s = testing::circle(0.0, 100000, fiberlab::roughness::ExitBlur{});
   s.source.theta_i = {deg_to_rad(1.0), deg_to_rad(41.0), deg_to_rad(81.0)};
-  s.roughness.beta_long = {deg_to_rad(2.0)};
-  s.roughness.beta_azim = {deg_to_rad(5.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(2.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(5.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 36;
   const sim::ResultFile r = testing::run(s);
   const EnergyCurve sim_e = simulation_energy(r);
   auto curve = [&](const std::string& spec, const std::vector<std::string>& set) {
-    const analytic::ModelParams p = testing::params(r, spec, set);
+    const analytic::ModelParameters p = testing::params(r, spec, set);
     return model_energy(*make_model(parse_model_spec(spec).name, p), spec, r.theta_i, 90, 45);
   };
   const EnergyCurve deon = curve("deon2011", {"r_fresnel=per_h"});
@@ -89,9 +89,9 @@ TEST(Report, CompareAndEnergyFolders) {
   const fs::path dir = fs::temp_directory_path() / ("fiberlab_report_test_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
-  sim::Settings s = testing::circle(31.0, 200000, sim::RoughnessModel::ExitBlur);
-  s.roughness.beta_long = {deg_to_rad(5.0)};
-  s.roughness.beta_azim = {deg_to_rad(10.0)};
+  sim::Settings s = testing::circle(31.0, 200000, fiberlab::roughness::ExitBlur{});
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(5.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(10.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 36;
   const std::string result = (dir / "r.h5").string();

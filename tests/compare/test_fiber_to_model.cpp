@@ -8,17 +8,18 @@
 #include <string>
 #include <vector>
 
+#include "analytic/chiang2016.h"
+#include "analytic/deon2011.h"
+#include "analytic/huang2022.h"
+#include "analytic/marschner2003.h"
 #include "common/error.h"
 #include "tests/compare/compare_test_support.h"
 
 namespace fiberlab::compare {
 namespace {
 
-sim::Settings microfacet_fiber(sim::RoughnessModel model, double alpha_long, double alpha_azim) {
-  sim::Settings s = testing::circle(30.0, 1000, model);
-  s.roughness.alpha_long = alpha_long;
-  s.roughness.alpha_azim = alpha_azim;
-  return s;
+sim::Settings microfacet_fiber(sim::MicrofacetModel model, double alpha_long, double alpha_azim) {
+  return testing::circle(30.0, 1000, sim::testing::microfacet(model, alpha_long, alpha_azim));
 }
 
 std::string refusal(const sim::Settings& s, const std::string& model) {
@@ -35,9 +36,9 @@ std::string refusal(const sim::Settings& s, const std::string& model) {
 TEST(FiberToModel, IsotropicGgxFiberIsHuangsRoughnessItself) {
   for (double alpha : {0.1, 0.3, 0.7}) {
     std::vector<std::string> notes;
-    const analytic::ModelParams p =
-        params_for(microfacet_fiber(sim::RoughnessModel::GGX, alpha, alpha), parse_model_spec("huang2022"), {}, &notes);
-    EXPECT_EQ(p.ggx_roughness, alpha);
+    const analytic::ModelParameters p =
+        params_for(microfacet_fiber(sim::MicrofacetModel::GGX, alpha, alpha), parse_model_spec("huang2022"), {}, &notes);
+    EXPECT_EQ(p.as<analytic::Huang2022Params>().roughness, alpha);
     EXPECT_TRUE(notes.empty()) << notes.front();  // the same distribution: nothing approximated
   }
 }
@@ -46,23 +47,25 @@ TEST(FiberToModel, IsotropicGgxFiberIsHuangsRoughnessItself) {
 // isotropic one: huang2022 refuses it, naming the field and what it allows;
 // with --set roughness the user's choice stands.
 TEST(FiberToModel, AnisotropicGgxFiberIsRefusedByHuang) {
-  const sim::Settings s = microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.1);
+  const sim::Settings s = microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.1);
   const std::string why = refusal(s, "huang2022");
   EXPECT_NE(why.find("roughness"), std::string::npos) << why;
   EXPECT_NE(why.find("anisotropic"), std::string::npos) << why;
   EXPECT_NE(why.find("--set roughness"), std::string::npos) << why;
   EXPECT_EQ(why.find('\n'), std::string::npos) << why;  // one line
-  EXPECT_EQ(params_for(s, parse_model_spec("huang2022"), {"roughness=0.2"}).ggx_roughness, 0.2);
-  EXPECT_EQ(params_for(s, parse_model_spec("huang2022:roughness=0.25"), {}).ggx_roughness, 0.25);
+  EXPECT_EQ(params_for(s, parse_model_spec("huang2022"), {"roughness=0.2"}).as<analytic::Huang2022Params>().roughness, 0.2);
+  EXPECT_EQ(params_for(s, parse_model_spec("huang2022:roughness=0.25"), {}).as<analytic::Huang2022Params>().roughness,
+            0.25);
   // The same for the other fibers it has no isotropic GGX for.
-  EXPECT_NE(refusal(microfacet_fiber(sim::RoughnessModel::Beckmann, 0.3, 0.1), "huang2022").find("anisotropic"),
+  EXPECT_NE(refusal(microfacet_fiber(sim::MicrofacetModel::Beckmann, 0.3, 0.1), "huang2022").find("anisotropic"),
             std::string::npos);
-  EXPECT_NE(refusal(microfacet_fiber(sim::RoughnessModel::GGX, 2.0, 2.0), "huang2022").find("outside [0, 1]"),
+  EXPECT_NE(refusal(microfacet_fiber(sim::MicrofacetModel::GGX, 2.0, 2.0), "huang2022").find("outside [0, 1]"),
             std::string::npos);
-  sim::Settings blur = testing::circle(30.0, 1000, sim::RoughnessModel::ExitBlur);
-  blur.roughness.beta_long = {deg_to_rad(5.0)};
+  sim::Settings blur = testing::circle(30.0, 1000, fiberlab::roughness::ExitBlur{});
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(blur).beta_long = {deg_to_rad(5.0)};
   EXPECT_NE(refusal(blur, "huang2022").find("exit_blur"), std::string::npos);
-  EXPECT_EQ(params_for(blur, parse_model_spec("huang2022"), {"roughness=0.1"}).ggx_roughness, 0.1);
+  EXPECT_EQ(params_for(blur, parse_model_spec("huang2022"), {"roughness=0.1"}).as<analytic::Huang2022Params>().roughness,
+            0.1);
 }
 
 // The Gaussian-width models read a microfacet fiber per axis (beta = atan(alpha
@@ -71,22 +74,28 @@ TEST(FiberToModel, AnisotropicGgxFiberIsRefusedByHuang) {
 TEST(FiberToModel, GaussianWidthModelsKeepTheAzimuthalAlphaAndStateTheMapping) {
   for (const std::string model : {"deon2011", "chiang2016", "marschner2003"}) {
     std::vector<std::string> notes;
-    const analytic::ModelParams aniso = params_for(microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.1),
+    const analytic::ModelParameters aniso = params_for(microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.1),
                                                    parse_model_spec(model), {}, &notes);
-    const analytic::ModelParams iso =
-        params_for(microfacet_fiber(sim::RoughnessModel::GGX, 0.3, 0.3), parse_model_spec(model), {});
+    const analytic::ModelParameters iso =
+        params_for(microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.3), parse_model_spec(model), {});
     ASSERT_EQ(notes.size(), 1u) << model;
     EXPECT_NE(notes.front().find("ggx alpha = [0.3, 0.1]"), std::string::npos) << notes.front();
     if (model == "chiang2016") {
-      EXPECT_EQ(aniso.beta_m, iso.beta_m);
-      EXPECT_LT(aniso.beta_n, iso.beta_n);
+      const auto &a = aniso.as<analytic::Chiang2016Params>(), &i = iso.as<analytic::Chiang2016Params>();
+      EXPECT_EQ(a.beta_m, i.beta_m);
+      EXPECT_LT(a.beta_n, i.beta_n);
+    } else if (model == "deon2011") {
+      const auto &a = aniso.as<analytic::Deon2011Params>(), &i = iso.as<analytic::Deon2011Params>();
+      EXPECT_EQ(a.beta_long, i.beta_long) << model;
+      EXPECT_LT(analytic::for_lobe(a.beta_azim, 0), analytic::for_lobe(i.beta_azim, 0)) << model;
+      // Per axis: beta_azim of R is the first-order spread 2 times atan(0.1 / sqrt 2).
+      EXPECT_DOUBLE_EQ(a.beta_azim.front(), 2.0 * std::atan(0.1 / std::sqrt(2.0)));
     } else {
-      EXPECT_EQ(aniso.beta_long, iso.beta_long) << model;
-      EXPECT_LT(analytic::for_lobe(aniso.beta_azim, 0), analytic::for_lobe(iso.beta_azim, 0)) << model;
-    }
-    // Per axis: beta_azim of R is the first-order spread 2 times atan(0.1 / sqrt 2).
-    if (model == "deon2011") {
-      EXPECT_DOUBLE_EQ(aniso.beta_azim.front(), 2.0 * std::atan(0.1 / std::sqrt(2.0)));
+      // marschner2003 has no azimuthal width (marschner2003.h): the
+      // longitudinal widths are the axis's own.
+      EXPECT_EQ(aniso.as<analytic::Marschner2003Params>().beta_long,
+                iso.as<analytic::Marschner2003Params>().beta_long)
+          << model;
     }
   }
 }

@@ -9,6 +9,8 @@
 
 #include <cstdio>
 
+#include "analytic/deon2011.h"
+#include "analytic/model_registry.h"
 #include "common/error.h"
 #include "compare/fit.h"
 #include "tests/compare/compare_test_support.h"
@@ -19,13 +21,13 @@ namespace {
 // exit_blur, no tilt, one beta_long for every lobe (8 deg): fit beta_long
 // of d'Eon (exact for this design, see test_compare_models.cpp) from 5 deg.
 TEST(Fit, RecoversExitBlurBetaLong) {
-  sim::Settings s = testing::circle(2.0, 300000, sim::RoughnessModel::ExitBlur);
-  s.roughness.beta_long = {deg_to_rad(8.0)};
-  s.roughness.beta_azim = {deg_to_rad(15.0)};
+  sim::Settings s = testing::circle(2.0, 300000, fiberlab::roughness::ExitBlur{});
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(8.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(15.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 36;
   const sim::ResultFile r = testing::run(s);
-  const analytic::ModelParams start =
+  const analytic::ModelParameters start =
       testing::params(r, "deon2011", {"r_fresnel=per_h", "absorption=chord", "beta_long=5"});
   const FitResult f = fit_model(r, "deon2011", start, {"beta_long"});
   std::printf("beta_long: 5 -> %.4f +- %.4f deg (unscaled %.4f), chi2/dof %.3f -> %.3f (%d dof), %d iterations\n",
@@ -39,11 +41,11 @@ TEST(Fit, RecoversExitBlurBetaLong) {
 
 // Smooth circle against the exact model: fit eta from 1.50.
 TEST(Fit, RecoversEtaOfSmoothCircle) {
-  sim::Settings s = testing::circle(35.0, 500000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(35.0, 500000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 91;
   s.tally.n_phi = 90;
   const sim::ResultFile r = testing::run(s);
-  const analytic::ModelParams start = testing::params(r, "exact", {"eta=1.5"});
+  const analytic::ModelParameters start = testing::params(r, "exact", {"eta=1.5"});
   const FitResult f = fit_model(r, "exact", start, {"eta"});
   std::printf("eta: 1.5 -> %.5f +- %.5f (unscaled %.5f), chi2/dof %.2f -> %.3f (%d dof), %d iterations\n",
               f.value[0], f.error[0], f.error_unscaled[0], f.chi2_start / f.dof, f.per_dof(), f.dof,
@@ -60,14 +62,14 @@ TEST(Fit, RecoversEtaOfSmoothCircle) {
 // (SPEC s7: about -1.2a for the mean). The test checks the fit lands
 // between -2.2a and -0.6a with a small error, and prints what it measured.
 TEST(Fit, MeasuresTiltShiftOfR) {
-  sim::Settings s = testing::circle(2.0, 300000, sim::RoughnessModel::ExitBlur);
+  sim::Settings s = testing::circle(2.0, 300000, fiberlab::roughness::ExitBlur{});
   s.fiber.scale_tilt = deg_to_rad(3.0);
-  s.roughness.beta_long = {deg_to_rad(4.0)};
-  s.roughness.beta_azim = {deg_to_rad(15.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_long = {deg_to_rad(4.0)};
+  sim::testing::roughness_of<fiberlab::roughness::ExitBlur>(s).beta_azim = {deg_to_rad(15.0)};
   s.tally.n_theta = 90;
   s.tally.n_phi = 36;
   const sim::ResultFile r = testing::run(s);
-  const analytic::ModelParams start =
+  const analytic::ModelParameters start =
       testing::params(r, "deon2011", {"r_fresnel=per_h", "absorption=chord"});
   const FitResult f = fit_model(r, "deon2011", start, {"alpha[0]"});
   std::printf("alpha[0]: %.3f -> %.4f +- %.4f deg (= %.3f a), chi2/dof %.3f -> %.3f (%d dof)\n", f.start[0],
@@ -105,16 +107,17 @@ TEST(Fit, KeysAreTheModelsOwn) {
 
 // scale_tilt moves every lobe by SPEC s7's shift rule.
 TEST(Fit, ScaleTiltIsTheShiftRule) {
-  analytic::ModelParams p;
+  analytic::ModelParameters p = analytic::default_params("deon2011");
+  const analytic::Deon2011Params& d = p.as<analytic::Deon2011Params>();
   set_parameter("deon2011", p, "scale_tilt", 3.0);
-  ASSERT_EQ(p.alpha.size(), 4u);
-  EXPECT_NEAR(rad_to_deg(p.alpha[0]), -6.0, 1e-12);
-  EXPECT_NEAR(rad_to_deg(p.alpha[1]), 3.0, 1e-12);
-  EXPECT_NEAR(rad_to_deg(p.alpha[2]), 12.0, 1e-12);
-  EXPECT_NEAR(rad_to_deg(p.alpha[3]), 0.0, 1e-12);
+  ASSERT_EQ(d.alpha.size(), 4u);
+  EXPECT_NEAR(rad_to_deg(d.alpha[0]), -6.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(d.alpha[1]), 3.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(d.alpha[2]), 12.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(d.alpha[3]), 0.0, 1e-12);
   EXPECT_NEAR(get_parameter("deon2011", p, "scale_tilt"), 3.0, 1e-12);
   set_parameter("deon2011", p, "beta_long[2]", 7.0);
-  EXPECT_NEAR(rad_to_deg(analytic::for_lobe(p.beta_long, 2)), 7.0, 1e-12);
+  EXPECT_NEAR(rad_to_deg(analytic::for_lobe(d.beta_long, 2)), 7.0, 1e-12);
 }
 
 // The fit's model evaluations run in parallel (compare/fit.cpp: the 2n x K
@@ -123,13 +126,13 @@ TEST(Fit, ScaleTiltIsTheShiftRule) {
 // threads give the same fit to the last bit. Three incident directions and
 // three keys: an odd number of tasks for two threads.
 TEST(Fit, SameForAnyThreadCount) {
-  sim::Settings s = testing::circle(20.0, 40000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(20.0, 40000, fiberlab::roughness::Gaussian{});
   s.source.theta_i = {deg_to_rad(20.0), deg_to_rad(45.0), deg_to_rad(70.0)};
-  s.roughness.beta_long = {deg_to_rad(10.0)};
+  sim::testing::roughness_of<fiberlab::roughness::Gaussian>(s).beta_long = {deg_to_rad(10.0)};
   s.tally.n_theta = 18;
   s.tally.n_phi = 24;
   const sim::ResultFile r = testing::run(s);
-  const analytic::ModelParams start = testing::params(r, "chiang2016");
+  const analytic::ModelParameters start = testing::params(r, "chiang2016");
   const std::vector<std::string> keys{"beta_m", "beta_n", "alpha"};
   const int threads = omp_get_max_threads();
   omp_set_num_threads(1);

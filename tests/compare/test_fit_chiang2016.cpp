@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <random>
 
+#include "analytic/chiang2016.h"
 #include "common/error.h"
 #include "compare/fit.h"
 #include "tests/compare/compare_test_support.h"
@@ -24,8 +25,8 @@ namespace {
 
 // A result with the layout of `s` whose tallies are a multinomial draw of
 // `photons` photons per incident direction from `model` (white fiber).
-sim::ResultFile synthetic_result(const analytic::ModelParams& truth, std::uint64_t photons, std::uint64_t seed) {
-  sim::Settings s = testing::circle(25.0, 4096, sim::RoughnessModel::Smooth);  // the layout only
+sim::ResultFile synthetic_result(const analytic::ModelParameters& truth, std::uint64_t photons, std::uint64_t seed) {
+  sim::Settings s = testing::circle(25.0, 4096, fiberlab::roughness::Smooth{});  // the layout only
   s.source.theta_i = {deg_to_rad(25.0), deg_to_rad(55.0)};
   s.tally.n_theta = 45;
   s.tally.n_phi = 72;
@@ -58,23 +59,23 @@ sim::ResultFile synthetic_result(const analytic::ModelParams& truth, std::uint64
 }
 
 // chiang2016's table defaults for a white fiber (one channel).
-analytic::ModelParams white_chiang() {
-  analytic::ModelParams p = params_for(sim::testing::smooth_circle(25.0, 1), parse_model_spec("chiang2016"), {});
-  p.sigma_a = {0.0};
+analytic::ModelParameters white_chiang() {
+  analytic::ModelParameters p = params_for(sim::testing::smooth_circle(25.0, 1), parse_model_spec("chiang2016"), {});
+  p.as<analytic::Chiang2016Params>().sigma_a = {0.0};
   return p;
 }
 
 TEST(FitChiang2016, RecoversBetaMBetaNAndAlphaFromItsOwnDraw) {
-  analytic::ModelParams truth = white_chiang();
-  truth.beta_m = 0.35;
-  truth.beta_n = 0.45;
-  truth.scale_tilt = deg_to_rad(2.0);
+  analytic::ModelParameters truth = white_chiang();
+  truth.as<analytic::Chiang2016Params>().beta_m = 0.35;
+  truth.as<analytic::Chiang2016Params>().beta_n = 0.45;
+  truth.as<analytic::Chiang2016Params>().alpha = deg_to_rad(2.0);
   const sim::ResultFile r = synthetic_result(truth, 2000000, 2016);
 
-  analytic::ModelParams start = truth;
-  start.beta_m = 0.2;
-  start.beta_n = 0.3;
-  start.scale_tilt = 0.0;
+  analytic::ModelParameters start = truth;
+  start.as<analytic::Chiang2016Params>().beta_m = 0.2;
+  start.as<analytic::Chiang2016Params>().beta_n = 0.3;
+  start.as<analytic::Chiang2016Params>().alpha = 0.0;
   const FitResult f = fit_model(r, "chiang2016", start, {"beta_m", "beta_n", "alpha"});
   const double want[3] = {0.35, 0.45, 2.0};
   for (int j = 0; j < 3; ++j) {
@@ -97,12 +98,12 @@ TEST(FitChiang2016, RecoversBetaMBetaNAndAlphaFromItsOwnDraw) {
 // The fit keeps to the table's ranges: a start outside is pulled in, a
 // truth at the edge is reached from inside and flagged.
 TEST(FitChiang2016, StaysInsideTheTablesRange) {
-  analytic::ModelParams truth = white_chiang();
-  truth.beta_m = 0.3;
-  truth.beta_n = 1.0;  // the upper end of [0, 1]
+  analytic::ModelParameters truth = white_chiang();
+  truth.as<analytic::Chiang2016Params>().beta_m = 0.3;
+  truth.as<analytic::Chiang2016Params>().beta_n = 1.0;  // the upper end of [0, 1]
   const sim::ResultFile r = synthetic_result(truth, 200000, 7);
-  analytic::ModelParams start = truth;
-  start.beta_n = 0.7;
+  analytic::ModelParameters start = truth;
+  start.as<analytic::Chiang2016Params>().beta_n = 0.7;
   const FitResult f = fit_model(r, "chiang2016", start, {"beta_n"});
   std::printf("beta_n: 0.7 -> %.5f +- %.5f, at bound %d\n", f.value[0], f.error[0], int(f.at_bound[0]));
   EXPECT_LE(f.value[0], 1.0);
@@ -119,9 +120,9 @@ TEST(FitChiang2016, FreeKeysAndRangesComeFromTheTables) {
   EXPECT_NO_THROW(check_fit_key("chiang2016", "alpha"));  // its scalar tilt
   EXPECT_THROW(check_fit_key("chiang2016", "scale_tilt"), Error);
   EXPECT_THROW(check_fit_key("chiang2016", "beta_m[1]"), Error);
-  analytic::ModelParams p = white_chiang();
+  analytic::ModelParameters p = white_chiang();
   set_parameter("chiang2016", p, "alpha", 3.0);
-  EXPECT_NEAR(p.scale_tilt, deg_to_rad(3.0), 1e-15);
+  EXPECT_NEAR(p.as<analytic::Chiang2016Params>().alpha, deg_to_rad(3.0), 1e-15);
   EXPECT_NEAR(get_parameter("chiang2016", p, "alpha"), 3.0, 1e-12);
 }
 

@@ -19,7 +19,7 @@ namespace {
 
 // A result with `r`'s settings and grid whose bins are N times the model's
 // probabilities at `truth` (weights 1: weight_sum = weight_sq_sum = count).
-sim::ResultFile synthetic(sim::ResultFile r, const std::string& model, const analytic::ModelParams& truth,
+sim::ResultFile synthetic(sim::ResultFile r, const std::string& model, const analytic::ModelParameters& truth,
                           std::uint64_t photons) {
   const auto m = make_model(model, truth);
   const std::vector<std::vector<double>> p = predict_result(*m, r);
@@ -40,7 +40,7 @@ sim::ResultFile synthetic(sim::ResultFile r, const std::string& model, const ana
 }
 
 sim::ResultFile template_result(double theta_i_deg, double tilt_deg) {
-  sim::Settings s = testing::circle(theta_i_deg, 2000, sim::RoughnessModel::Gaussian);
+  sim::Settings s = testing::circle(theta_i_deg, 2000, fiberlab::roughness::Gaussian{});
   s.fiber.scale_tilt = deg_to_rad(tilt_deg);
   s.tally.n_theta = 24;
   s.tally.n_phi = 36;
@@ -62,12 +62,12 @@ void print(const char* what, const FitResult& f) {
 // any of them).
 TEST(FitConvergence, RecoversDeonFromItsOwnBins) {
   const sim::ResultFile t = template_result(40.0, 3.0);
-  analytic::ModelParams truth = testing::params(t, "deon2011");
+  analytic::ModelParameters truth = testing::params(t, "deon2011");
   set_parameter("deon2011", truth, "beta_long", 6.0);
   set_parameter("deon2011", truth, "beta_azim", 20.0);
   set_parameter("deon2011", truth, "scale_tilt", 2.5);
   const sim::ResultFile r = synthetic(t, "deon2011", truth, 300000);
-  analytic::ModelParams start = truth;
+  analytic::ModelParameters start = truth;
   set_parameter("deon2011", start, "beta_long", 9.0);
   set_parameter("deon2011", start, "beta_azim", 12.0);
   set_parameter("deon2011", start, "scale_tilt", 1.0);
@@ -90,11 +90,11 @@ TEST(FitConvergence, RecoversDeonFromItsOwnBins) {
 // 0.5 error off in roughness, 0.2 in tilt).
 TEST(FitConvergence, RecoversHuangFromItsOwnBins) {
   const sim::ResultFile t = template_result(30.0, 3.0);
-  analytic::ModelParams truth = testing::params(t, "huang2022", {"quadrature_points=16384"});
+  analytic::ModelParameters truth = testing::params(t, "huang2022", {"quadrature_points=16384"});
   set_parameter("huang2022", truth, "roughness", 0.2);
   set_parameter("huang2022", truth, "tilt", 3.0);
   const sim::ResultFile r = synthetic(t, "huang2022", truth, 300000);
-  analytic::ModelParams start = truth;
+  analytic::ModelParameters start = truth;
   set_parameter("huang2022", start, "roughness", 0.3);
   set_parameter("huang2022", start, "tilt", 0.5);
   const FitResult f = fit_model(r, "huang2022", start, {"roughness", "tilt"}, Options{}, 20);
@@ -111,10 +111,10 @@ TEST(FitConvergence, RecoversHuangFromItsOwnBins) {
 // the outcome ignoring at_bound.
 TEST(FitConvergence, SaysWhyItStopped) {
   const sim::ResultFile t = template_result(40.0, 0.0);
-  analytic::ModelParams truth = testing::params(t, "deon2011");
+  analytic::ModelParameters truth = testing::params(t, "deon2011");
   set_parameter("deon2011", truth, "beta_long", 6.0);
   const sim::ResultFile r = synthetic(t, "deon2011", truth, 300000);
-  analytic::ModelParams start = truth;
+  analytic::ModelParameters start = truth;
   set_parameter("deon2011", start, "beta_long", 15.0);
   const FitResult capped = fit_model(r, "deon2011", start, {"beta_long"}, Options{}, 1);
   print("capped", capped);
@@ -122,7 +122,7 @@ TEST(FitConvergence, SaysWhyItStopped) {
   EXPECT_FALSE(capped.converged);
   EXPECT_NE(capped.stop_reason.find("iteration cap (1)"), std::string::npos) << capped.stop_reason;
 
-  analytic::ModelParams narrow = truth;
+  analytic::ModelParameters narrow = truth;
   set_parameter("deon2011", narrow, "beta_long", 0.6);
   const sim::ResultFile rn = synthetic(t, "deon2011", narrow, 300000);
   const FitResult bound = fit_model(rn, "deon2011", start, {"beta_long"}, Options{}, 40);

@@ -58,10 +58,10 @@ TEST(FurAtlas, ErrorsNameTheMedullaEntry) {
 // compared as for any fiber, and the `scattered` lobe holds the
 // simulation's scattered energy against the model's zero.
 TEST(FurComparison, ModelsPredictNothingInTheScatteredLobe) {
-  sim::Settings s = testing::circle(30.0, 20000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(30.0, 20000, fiberlab::roughness::Smooth{});
   s.tally.n_theta = 18;
   s.tally.n_phi = 36;
-  sim::MedullaSettings m;
+  Medulla m;
   m.radius = 0.5;
   m.sigma_s = 4.0;
   m.sigma_a = {0.0};

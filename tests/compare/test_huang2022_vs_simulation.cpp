@@ -13,13 +13,14 @@
 #include <cmath>
 #include <cstdio>
 
+#include "analytic/huang2022.h"
 #include "compare_test_support.h"
 
 namespace fiberlab::compare {
 namespace {
 
 sim::Settings ellipse(double theta_i_deg, double tilt_deg) {
-  sim::Settings s = testing::circle(theta_i_deg, 400000, sim::RoughnessModel::Smooth);
+  sim::Settings s = testing::circle(theta_i_deg, 400000, fiberlab::roughness::Smooth{});
   s.fiber.eccentricity = 0.7;
   s.fiber.scale_tilt = deg_to_rad(tilt_deg);
   s.fiber.sigma_a = {0.3};
@@ -42,8 +43,8 @@ void expect_accepted(const std::vector<LobeComparison>& cs) {
 
 TEST(Huang2022VsSimulation, SmoothEllipseIsTheZeroRoughnessLimit) {
   const sim::ResultFile r = testing::run(ellipse(40.0, 0.0));
-  const analytic::ModelParams p = testing::params(r, "huang2022", {"quadrature_points=262144"});
-  EXPECT_EQ(p.ggx_roughness, 0.0);  // smooth config -> the model's exact limit
+  const analytic::ModelParameters p = testing::params(r, "huang2022", {"quadrature_points=262144"});
+  EXPECT_EQ(p.as<analytic::Huang2022Params>().roughness, 0.0);  // smooth config -> the model's exact limit
   expect_accepted(testing::compare_with(r, "huang2022", {"quadrature_points=262144"}));
 }
 

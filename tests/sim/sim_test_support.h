@@ -7,6 +7,15 @@
 #include "sim/store/result_file.h"
 #include "sim/run/settings.h"
 #include "sim/run/simulation.h"
+#include "sim/roughness/microfacet_distribution.h"
+
+namespace fiberlab::sim {
+
+inline std::string to_string(MicrofacetModel m) {
+  return m == MicrofacetModel::Beckmann ? "beckmann" : "ggx";
+}
+
+}  // namespace fiberlab::sim
 
 namespace fiberlab::sim::testing {
 
@@ -17,9 +26,7 @@ inline Settings smooth_circle(double theta_i_deg, std::uint64_t photons) {
   s.seed = 12345;
   s.fiber.eta = 1.55;
   s.fiber.sigma_a = {0.0};
-  s.roughness.model = RoughnessModel::Smooth;
-  s.roughness.beta_long = {0.0};
-  s.roughness.beta_azim = {0.0};
+  s.fiber.roughness = roughness::Smooth{};
   s.source.theta_i = {deg_to_rad(theta_i_deg)};
   s.source.phi_i = {0.0};
   s.tally.n_theta = 90;
@@ -32,9 +39,21 @@ inline Settings smooth_circle(double theta_i_deg, std::uint64_t photons) {
 // tilt of `tilt_deg`.
 inline void make_rough(Settings& s, double beta_deg, double tilt_deg = 0.0) {
   s.fiber.scale_tilt = deg_to_rad(tilt_deg);
-  s.roughness.model = RoughnessModel::Gaussian;
-  s.roughness.beta_long = {deg_to_rad(beta_deg)};
-  s.roughness.beta_azim = {deg_to_rad(beta_deg)};
+  s.fiber.roughness = roughness::Gaussian{deg_to_rad(beta_deg), deg_to_rad(beta_deg)};
+}
+
+// The microfacet roughness `model` with alpha per axis (common/roughness/microfacet.h).
+inline Roughness microfacet(MicrofacetModel model, double alpha_long, double alpha_azim,
+                            Masking masking = Masking::None) {
+  const roughness::MicrofacetAlpha a{alpha_long, alpha_azim, masking};
+  if (model == MicrofacetModel::Beckmann) return roughness::Beckmann{a};
+  return roughness::Ggx{a};
+}
+
+// A roughness of `s` known to be of type Model.
+template <class Model>
+Model& roughness_of(Settings& s) {
+  return std::get<Model>(s.fiber.roughness);
 }
 
 inline ResultFile run(const Settings& s, int threads = 2) {

@@ -174,8 +174,7 @@ TEST(BatchTracer, RoughTiltedAbsorbingEllipseMatchesReference) {
   s.source.phi_i = {deg_to_rad(11.0)};
   expect_same_photons(s, "rough tilted ellipse");
   s.source.phi_i_uniform = true;
-  s.roughness.beta_long = {deg_to_rad(25.0)};
-  s.roughness.beta_azim = {deg_to_rad(4.0)};
+  s.fiber.roughness = roughness::Gaussian{deg_to_rad(25.0), deg_to_rad(4.0)};
   expect_same_photons(s, "rough ellipse, uniform phi_i, beta 25/4");
 }
 
@@ -211,9 +210,7 @@ TEST(BatchTracer, StokesLightMatchesReference) {
 TEST(BatchTracer, ExitBlurMatchesReference) {
   Settings s = testing::smooth_circle(-41.0, 1);
   s.fiber.scale_tilt = deg_to_rad(-2.0);
-  s.roughness.model = RoughnessModel::ExitBlur;
-  s.roughness.beta_long = {deg_to_rad(5.0), deg_to_rad(10.0)};
-  s.roughness.beta_azim = {deg_to_rad(8.0)};
+  s.fiber.roughness = roughness::ExitBlur{{{deg_to_rad(5.0), deg_to_rad(10.0)}, {deg_to_rad(8.0)}}};
   expect_same_photons(s, "exit blur");
 }
 
@@ -234,7 +231,7 @@ TEST(BatchTracer, MedullaMatchesReference) {
   s.fiber.eccentricity = 0.8;
   s.fiber.sigma_a = {0.2, 0.4};
   testing::make_rough(s, 5.0, 3.0);
-  MedullaSettings m;
+  Medulla m;
   m.radius = 0.55;
   m.sigma_s = 3.0;
   m.sigma_a = {0.1, 0.3};
@@ -251,16 +248,13 @@ TEST(BatchTracer, MedullaMatchesReference) {
 // ellipse, tilt, absorption, isotropic and anisotropic alpha, with and
 // without Smith G1 masking (weights, Lost photons and each loss compared),
 // scalar and Stokes light.
-Settings microfacet_case(RoughnessModel model, double ax, double ay, Masking masking) {
+Settings microfacet_case(MicrofacetModel model, double ax, double ay, Masking masking) {
   Settings s = testing::smooth_circle(17.0, 1);
   s.fiber.eccentricity = 0.8;
   s.fiber.scale_tilt = deg_to_rad(3.0);
   s.fiber.sigma_a = {0.2, 0.4, 0.8};
   s.source.phi_i = {deg_to_rad(11.0)};
-  s.roughness.model = model;
-  s.roughness.alpha_long = ax;
-  s.roughness.alpha_azim = ay;
-  s.roughness.masking = masking;
+  s.fiber.roughness = testing::microfacet(model, ax, ay, masking);
   return s;
 }
 
@@ -271,7 +265,7 @@ Settings microfacet_case(RoughnessModel model, double ax, double ay, Masking mas
 TEST(BatchTracer, GgxMatchesReference) {
   for (const Masking masking : {Masking::None, Masking::SmithG1}) {
     for (const auto& [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.15, 0.5}}) {
-      const Settings s = microfacet_case(RoughnessModel::GGX, ax, ay, masking);
+      const Settings s = microfacet_case(MicrofacetModel::GGX, ax, ay, masking);
       const std::string what = "ggx " + std::to_string(ax) + "/" + std::to_string(ay) +
                                (masking == Masking::SmithG1 ? " smith_g1" : "");
       expect_same_photons(s, what.c_str());
@@ -279,7 +273,7 @@ TEST(BatchTracer, GgxMatchesReference) {
   }
   // Photons launched one lane at a time (a random fiber rotation), each
   // given its list of losses there.
-  Settings s = microfacet_case(RoughnessModel::GGX, 0.3, 0.3, Masking::SmithG1);
+  Settings s = microfacet_case(MicrofacetModel::GGX, 0.3, 0.3, Masking::SmithG1);
   s.source.phi_i_uniform = true;
   expect_same_photons(s, "ggx 0.3 smith_g1, uniform phi_i");
 }
@@ -289,7 +283,7 @@ TEST(BatchTracer, GgxMatchesReference) {
 TEST(BatchTracer, BeckmannMatchesReference) {
   for (const Masking masking : {Masking::None, Masking::SmithG1}) {
     for (const auto& [ax, ay] : {std::pair{0.3, 0.3}, std::pair{0.5, 0.15}}) {
-      const Settings s = microfacet_case(RoughnessModel::Beckmann, ax, ay, masking);
+      const Settings s = microfacet_case(MicrofacetModel::Beckmann, ax, ay, masking);
       const std::string what = "beckmann " + std::to_string(ax) + "/" + std::to_string(ay) +
                                (masking == Masking::SmithG1 ? " smith_g1" : "");
       expect_same_photons(s, what.c_str());
@@ -298,10 +292,10 @@ TEST(BatchTracer, BeckmannMatchesReference) {
 }
 
 TEST(BatchTracer, MicrofacetStokesMatchesReference) {
-  for (const RoughnessModel model : {RoughnessModel::GGX, RoughnessModel::Beckmann}) {
+  for (const MicrofacetModel model : {MicrofacetModel::GGX, MicrofacetModel::Beckmann}) {
     Settings s = microfacet_case(model, 0.2, 0.35, Masking::SmithG1);
     s.polarization = Polarization::Stokes;
-    expect_same_photons(s, model == RoughnessModel::GGX ? "stokes ggx" : "stokes beckmann");
+    expect_same_photons(s, model == MicrofacetModel::GGX ? "stokes ggx" : "stokes beckmann");
   }
 }
 
@@ -320,14 +314,15 @@ static_assert(!life::RunsBatched<OnePhotonOnly>);
 static_assert(life::RunsBatched<life::GaussianRoughness>);
 static_assert(life::RunsBatched<MicrofacetLifeModel>);
 
-TEST(BatchTracer, EveryRoughnessModelRunsBatched) {
-  for (const RoughnessModel model : {RoughnessModel::Smooth, RoughnessModel::Gaussian,
-                                     RoughnessModel::ExitBlur, RoughnessModel::GGX,
-                                     RoughnessModel::Beckmann}) {
-    Settings s = microfacet_case(model, 0.3, 0.3, Masking::None);
-    s.roughness.beta_long = {deg_to_rad(5.0)};
-    s.roughness.beta_azim = {deg_to_rad(5.0)};
-    EXPECT_TRUE(runs_batched(make_roughness(s))) << to_string(model);
+TEST(BatchTracer, EveryMicrofacetModelRunsBatched) {
+  const double beta = deg_to_rad(5.0);
+  for (const Roughness& model : {Roughness(roughness::Smooth{{{beta}, {beta}}}), Roughness(roughness::Gaussian{beta, beta}),
+                                 Roughness(roughness::ExitBlur{{{beta}, {beta}}}),
+                                 testing::microfacet(MicrofacetModel::GGX, 0.3, 0.3),
+                                 testing::microfacet(MicrofacetModel::Beckmann, 0.3, 0.3)}) {
+    Settings s = microfacet_case(MicrofacetModel::GGX, 0.3, 0.3, Masking::None);
+    s.fiber.roughness = model;
+    EXPECT_TRUE(runs_batched(make_roughness(s))) << roughness::name(model);
   }
 }
 

@@ -62,9 +62,7 @@ TEST(Estimator, LedgerClosesPerPhoton) {
   s.polarization = Polarization::Stokes;
   expect_ledger_closes(s, "stokes");
   s.polarization = Polarization::Scalar;
-  s.roughness.model = RoughnessModel::GGX;
-  s.roughness.alpha_long = s.roughness.alpha_azim = 0.3;
-  s.roughness.masking = Masking::SmithG1;
+  s.fiber.roughness = testing::microfacet(MicrofacetModel::GGX, 0.3, 0.3, Masking::SmithG1);
   expect_ledger_closes(s, "ggx 0.3 smith_g1");
 }
 

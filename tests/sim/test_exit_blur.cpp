@@ -57,10 +57,11 @@ MarginalChi2 theta_marginal_vs_mp(const ResultFile& r, int lobe, double theta_i,
 
 Settings exit_blur_circle(std::vector<double> beta_long_deg) {
   Settings s = testing::smooth_circle(35.0, 1000000);
-  s.roughness.model = RoughnessModel::ExitBlur;
-  s.roughness.beta_long.clear();
-  for (double b : beta_long_deg) s.roughness.beta_long.push_back(deg_to_rad(b));
-  s.roughness.beta_azim = {deg_to_rad(10.0)};
+  roughness::ExitBlur blur;
+  blur.beta_long.clear();
+  for (double b : beta_long_deg) blur.beta_long.push_back(deg_to_rad(b));
+  blur.beta_azim = {deg_to_rad(10.0)};
+  s.fiber.roughness = blur;
   s.tally.n_theta = 180;
   s.tally.n_phi = 8;
   return s;
@@ -70,7 +71,7 @@ TEST(ExitBlur, ThetaMarginalIsDeonMp) {
   const Settings s = exit_blur_circle({6.0, 12.0, 20.0});
   const ResultFile r = testing::run(s);
   for (int lobe = 0; lobe < 3; ++lobe) {
-    const double beta = s.roughness.beta_long[lobe];
+    const double beta = std::get<roughness::ExitBlur>(s.fiber.roughness).beta_long[lobe];
     const MarginalChi2 c = theta_marginal_vs_mp(r, lobe, deg_to_rad(35.0), beta);
     std::printf("lobe %d, beta %.0f deg: chi2 %.1f over %d dof (threshold %.1f)\n", lobe,
                 rad_to_deg(beta), c.chi2, c.dof, testing::chi2_threshold(c.dof));

@@ -32,9 +32,8 @@
 namespace fiberlab::sim {
 namespace {
 
-MedullaSettings medulla(double k, double sigma_s, std::vector<double> sigma_a, double g,
-                        double eta) {
-  MedullaSettings m;
+Medulla medulla(double k, double sigma_s, std::vector<double> sigma_a, double g, double eta) {
+  Medulla m;
   m.radius = k;
   m.sigma_s = sigma_s;
   m.sigma_a = std::move(sigma_a);

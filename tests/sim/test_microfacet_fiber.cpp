@@ -46,13 +46,8 @@
 namespace fiberlab::sim {
 namespace {
 
-void make_microfacet(Settings& s, RoughnessModel model, double alpha, Masking masking) {
-  s.roughness.model = model;
-  s.roughness.beta_long = {0.0};
-  s.roughness.beta_azim = {0.0};
-  s.roughness.alpha_long = alpha;
-  s.roughness.alpha_azim = alpha;
-  s.roughness.masking = masking;
+void make_microfacet(Settings& s, MicrofacetModel model, double alpha, Masking masking) {
+  s.fiber.roughness = testing::microfacet(model, alpha, alpha, masking);
 }
 
 double sum_exited(const ResultFile& r, std::size_t k, int c) {
@@ -103,13 +98,13 @@ TEST(MicrofacetFiber, SmallAlphaIsTheSmoothCylinder) {
   const double theta_i_deg = 40.3;
   const auto exact = analytic::smooth_cylinder_prediction(1.55, deg_to_rad(theta_i_deg), {0.3, 1.0},
                                                           analytic::Absorption::Chord, 4, 180);
-  for (RoughnessModel model : {RoughnessModel::GGX, RoughnessModel::Beckmann}) {
+  for (MicrofacetModel model : {MicrofacetModel::GGX, MicrofacetModel::Beckmann}) {
     Settings s = testing::smooth_circle(theta_i_deg, 1000000);
     s.fiber.sigma_a = {0.3, 1.0};
-    const Masking masking = model == RoughnessModel::GGX ? Masking::None : Masking::SmithG1;
+    const Masking masking = model == MicrofacetModel::GGX ? Masking::None : Masking::SmithG1;
     make_microfacet(s, model, 1e-4, masking);
     const ResultFile r = testing::run(s);
-    const char* name = model == RoughnessModel::GGX ? "ggx" : "beckmann + smith_g1";
+    const char* name = model == MicrofacetModel::GGX ? "ggx" : "beckmann + smith_g1";
     for (int lobe = 0; lobe < 4; ++lobe)
       for (int c = 0; c < 2; ++c) {
         const Chi2 chi = phi_chi2(r, lobe, c, exact);
@@ -140,7 +135,7 @@ TEST(MicrofacetFiber, SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber) {
   smooth.tally.n_theta = 180;
   Settings rough = smooth;
   rough.seed = 777;
-  make_microfacet(rough, RoughnessModel::GGX, 1e-4, Masking::None);
+  make_microfacet(rough, MicrofacetModel::GGX, 1e-4, Masking::None);
   const ResultFile a = testing::run(smooth), b = testing::run(rough);
   for (int lobe = 0; lobe < 3; ++lobe) {
     std::vector<double> a2, b2;
@@ -160,7 +155,7 @@ TEST(MicrofacetFiber, SmallAlphaOnATiltedFiberIsTheTiltedSmoothFiber) {
   }
 }
 
-Settings rough_tilted_ellipse(RoughnessModel model, double alpha, Masking masking) {
+Settings rough_tilted_ellipse(MicrofacetModel model, double alpha, Masking masking) {
   Settings s = testing::smooth_circle(30.0, 100000);
   s.fiber.eccentricity = 0.85;
   s.fiber.scale_tilt = deg_to_rad(3.0);
@@ -174,7 +169,7 @@ Settings rough_tilted_ellipse(RoughnessModel model, double alpha, Masking maskin
 // White furnace, no masking: the consistency rule keeps every photon's
 // weight, so exited + truncated = N and nothing is lost or absorbed.
 TEST(MicrofacetFiber, WhiteFurnaceWithoutMaskingLosesNothing) {
-  for (RoughnessModel model : {RoughnessModel::GGX, RoughnessModel::Beckmann})
+  for (MicrofacetModel model : {MicrofacetModel::GGX, MicrofacetModel::Beckmann})
     for (double alpha : {0.1, 0.6}) {
       const ResultFile r = testing::run(rough_tilted_ellipse(model, alpha, Masking::None));
       const double N = static_cast<double>(r.photons[0]);
@@ -195,7 +190,7 @@ TEST(MicrofacetFiber, WhiteFurnaceWithoutMaskingLosesNothing) {
 // is a mean of per-photon losses x in [0, 1] over N photons, whose variance is
 // at most E[x^2] <= E[x], so its standard error is at most sqrt(lost / N).
 TEST(MicrofacetFiber, WhiteFurnaceWithMaskingLosesMoreWithAlpha) {
-  for (RoughnessModel model : {RoughnessModel::GGX, RoughnessModel::Beckmann}) {
+  for (MicrofacetModel model : {MicrofacetModel::GGX, MicrofacetModel::Beckmann}) {
     double previous = 0.0;
     for (double alpha : {0.1, 0.3, 0.6}) {
       const ResultFile r = testing::run(rough_tilted_ellipse(model, alpha, Masking::SmithG1));
@@ -215,7 +210,7 @@ TEST(MicrofacetFiber, WhiteFurnaceWithMaskingLosesMoreWithAlpha) {
 // masking after a stretch inside is absorbed along that stretch first, so a
 // darker channel loses less (sigma_a 0 loses the most).
 TEST(MicrofacetFiber, LedgerBalancesWithAbsorptionAndLost) {
-  Settings s = rough_tilted_ellipse(RoughnessModel::GGX, 0.3, Masking::SmithG1);
+  Settings s = rough_tilted_ellipse(MicrofacetModel::GGX, 0.3, Masking::SmithG1);
   s.fiber.sigma_a = {0.0, 0.5, 2.0};
   const ResultFile r = testing::run(s);
   const double N = static_cast<double>(r.photons[0]);

@@ -72,9 +72,7 @@ Settings masked_white_fiber(Masking masking) {
   s.fiber.sigma_a = {0.0, 0.7};
   s.tally.n_theta = 18;
   s.tally.n_phi = 36;
-  s.roughness.model = RoughnessModel::GGX;
-  s.roughness.alpha_long = s.roughness.alpha_azim = 0.3;
-  s.roughness.masking = masking;
+  s.fiber.roughness = testing::microfacet(MicrofacetModel::GGX, 0.3, 0.3, masking);
   return s;
 }
 

@@ -47,25 +47,26 @@
 #include "common/units.h"
 #include "sim/life/source.h"
 #include "sim/life/tracer.h"
+#include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {
 namespace {
 
 struct Definition {
-  RoughnessModel model;
+  MicrofacetModel model;
   double alpha;  // isotropic
 
   double D(const Vec3& m) const {  // local frame, z = mean normal
     if (m.z() <= 0.0) return 0.0;
     const double t2 = (m.x() * m.x() + m.y() * m.y()) / (m.z() * m.z());  // tan^2 theta_m
     const double a2 = alpha * alpha, c4 = std::pow(m.z(), 4);
-    if (model == RoughnessModel::GGX) return a2 / (kPi * c4 * std::pow(a2 + t2, 2));
+    if (model == MicrofacetModel::GGX) return a2 / (kPi * c4 * std::pow(a2 + t2, 2));
     return std::exp(-t2 / a2) / (kPi * a2 * c4);
   }
   double G1(const Vec3& w) const {
     if (w.z() <= 0.0) return 0.0;
     const double tan_t = std::sqrt(w.x() * w.x() + w.y() * w.y()) / w.z();
-    if (model == RoughnessModel::GGX) return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan_t * tan_t));
+    if (model == MicrofacetModel::GGX) return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * tan_t * tan_t));
     if (tan_t == 0.0) return 1.0;
     const double a = 1.0 / (alpha * tan_t);
     const double lambda = (std::erf(a) - 1.0) / 2.0 + std::exp(-a * a) / (2.0 * a * std::sqrt(kPi));
@@ -115,14 +116,12 @@ struct Measured {
   double mean, std_error;
   int unbalanced;  // photons whose kept + booked weight is not 1
 };
-Measured first_event_loss(RoughnessModel model, double alpha, double theta_i, double tilt, int n) {
+Measured first_event_loss(MicrofacetModel model, double alpha, double theta_i, double tilt, int n) {
   Settings s;
   s.fiber.eta = 1.55;
   s.fiber.sigma_a = {0.0};
   s.fiber.scale_tilt = tilt;
-  s.roughness.model = model;
-  s.roughness.alpha_long = s.roughness.alpha_azim = alpha;
-  s.roughness.masking = Masking::SmithG1;
+  s.fiber.roughness = testing::microfacet(model, alpha, alpha, Masking::SmithG1);
   const Tracer tracer(s);
   const Vec3 wi = direction_from_angles(theta_i, 0.0);
   double sum = 0.0, sum2 = 0.0;
@@ -147,16 +146,16 @@ Measured first_event_loss(RoughnessModel model, double alpha, double theta_i, do
 
 TEST(MicrofacetMasking, FirstEventLossIsOneMinusTheExpectedG1) {
   struct Case {
-    RoughnessModel model;
+    MicrofacetModel model;
     double alpha, theta_i_deg, tilt_deg;
   };
   // (Beckmann masks little but near grazing: its cases are rougher or more
   // oblique. The tilted case: the mean normal of the event is n_f, for the
   // normals and for G1 alike.)
-  for (const Case c : {Case{RoughnessModel::GGX, 0.3, 0.0, 0.0}, Case{RoughnessModel::GGX, 0.5, 50.0, 0.0},
-                       Case{RoughnessModel::Beckmann, 0.7, 20.0, 0.0},
-                       Case{RoughnessModel::Beckmann, 0.5, 50.0, 0.0},
-                       Case{RoughnessModel::GGX, 0.5, 35.0, 10.0}}) {
+  for (const Case c : {Case{MicrofacetModel::GGX, 0.3, 0.0, 0.0}, Case{MicrofacetModel::GGX, 0.5, 50.0, 0.0},
+                       Case{MicrofacetModel::Beckmann, 0.7, 20.0, 0.0},
+                       Case{MicrofacetModel::Beckmann, 0.5, 50.0, 0.0},
+                       Case{MicrofacetModel::GGX, 0.5, 35.0, 10.0}}) {
     const double theta_i = deg_to_rad(c.theta_i_deg), tilt = deg_to_rad(c.tilt_deg);
     const Definition def{c.model, c.alpha};
     // The entry point's normal is n0 = (0, 1, 0) and u = (1, 0, 0); the mean

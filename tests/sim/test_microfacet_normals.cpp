@@ -46,13 +46,13 @@ namespace {
 // The definitions (Heitz 2014, section 5.2), in the frame of the mean normal
 // n with the longitudinal axis t along u projected onto n's tangent plane.
 struct Reference {
-  RoughnessModel model;
+  MicrofacetModel model;
   double ax, ay;  // along t (longitudinal), along n x t (azimuthal)
 
   double D(double x, double y, double z) const {
     if (z <= 0.0) return 0.0;
     const double r2 = x * x / (ax * ax) + y * y / (ay * ay);
-    if (model == RoughnessModel::GGX) return 1.0 / (kPi * ax * ay * std::pow(r2 + z * z, 2));
+    if (model == MicrofacetModel::GGX) return 1.0 / (kPi * ax * ay * std::pow(r2 + z * z, 2));
     return std::exp(-r2 / (z * z)) / (kPi * ax * ay * std::pow(z, 4));
   }
 
@@ -78,13 +78,9 @@ BoundaryNormals boundary(const Vec3& n0, double tilt, bool inside) {
 }
 
 // chi2 of the simulator's normals against the reference's; returns chi2 / threshold.
-double compare(RoughnessModel model, double ax, double ay, const Vec3& d, const BoundaryNormals& bn,
+double compare(MicrofacetModel model, double ax, double ay, const Vec3& d, const BoundaryNormals& bn,
                const char* what, int n = 100000) {
-  RoughnessSettings r;
-  r.model = model;
-  r.alpha_long = ax;
-  r.alpha_azim = ay;
-  const MicrofacetRoughness sim(r);
+  const MicrofacetRoughness sim(model, roughness::MicrofacetAlpha{ax, ay, Masking::None});
   const Reference ref{model, ax, ay};
   const Vec3 nf = bn.facing;  // the definition: the tilted normal (d.n_f < 0 in every case here)
   PhotonRandom ra(11, 12), rb(13, 14);
@@ -112,15 +108,15 @@ TEST(MicrofacetNormals, VisibleNormalsAboutTheTiltedNormalFromOutside) {
   const BoundaryNormals bn = boundary(kN0, kTilt, false);
   // Oblique incidence onto the outside, with an inclination.
   const Vec3 d = (-0.8 * kN0 + 0.5 * Vec3::UnitX() + 0.3 * kN0.cross(Vec3::UnitX())).normalized();
-  for (RoughnessModel model : {RoughnessModel::GGX, RoughnessModel::Beckmann})
-    EXPECT_LT(compare(model, 0.3, 0.3, d, bn, model == RoughnessModel::GGX ? "ggx 0.3, outside" : "beckmann 0.3, outside"), 1.0);
+  for (MicrofacetModel model : {MicrofacetModel::GGX, MicrofacetModel::Beckmann})
+    EXPECT_LT(compare(model, 0.3, 0.3, d, bn, model == MicrofacetModel::GGX ? "ggx 0.3, outside" : "beckmann 0.3, outside"), 1.0);
 }
 
 TEST(MicrofacetNormals, AnisotropicAlphaIsLongitudinalThenAzimuthal) {
   const BoundaryNormals bn = boundary(kN0, kTilt, false);
   const Vec3 d = (-kN0 + 0.2 * Vec3::UnitX()).normalized();
-  EXPECT_LT(compare(RoughnessModel::GGX, 0.15, 0.5, d, bn, "ggx [0.15, 0.5]"), 1.0);
-  EXPECT_LT(compare(RoughnessModel::Beckmann, 0.5, 0.15, d, bn, "beckmann [0.5, 0.15]"), 1.0);
+  EXPECT_LT(compare(MicrofacetModel::GGX, 0.15, 0.5, d, bn, "ggx [0.15, 0.5]"), 1.0);
+  EXPECT_LT(compare(MicrofacetModel::Beckmann, 0.5, 0.15, d, bn, "beckmann [0.5, 0.15]"), 1.0);
 }
 
 TEST(MicrofacetNormals, InsideHitsAndGrazingIncidence) {
@@ -128,12 +124,12 @@ TEST(MicrofacetNormals, InsideHitsAndGrazingIncidence) {
   // From inside, towards the boundary (d.n0 > 0), steep along the axis.
   const Vec3 d = (0.4 * kN0 + 0.9 * Vec3::UnitX()).normalized();
   ASSERT_LT(d.dot(in.facing), 0.0);
-  EXPECT_LT(compare(RoughnessModel::GGX, 0.2, 0.2, d, in, "ggx 0.2, inside, steep"), 1.0);
+  EXPECT_LT(compare(MicrofacetModel::GGX, 0.2, 0.2, d, in, "ggx 0.2, inside, steep"), 1.0);
   // Grazing from outside: -d.n_f = 0.1.
   const BoundaryNormals out = boundary(kN0, kTilt, false);
   const Vec3 t = out.facing.cross(Vec3(0.3, 0.2, 0.9)).normalized();
   const Vec3 g = (-0.1 * out.facing + std::sqrt(0.99) * t).normalized();
-  EXPECT_LT(compare(RoughnessModel::Beckmann, 0.4, 0.4, g, out, "beckmann 0.4, grazing"), 1.0);
+  EXPECT_LT(compare(MicrofacetModel::Beckmann, 0.4, 0.4, g, out, "beckmann 0.4, grazing"), 1.0);
 }
 
 }  // namespace

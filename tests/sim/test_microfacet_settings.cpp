@@ -40,22 +40,21 @@ void expect_error(const std::string& yaml, const std::vector<std::string>& piece
 
 TEST(MicrofacetSettings, IsotropicAnisotropicAndMasking) {
   const Settings g = parse("roughness: {model: ggx, alpha: 0.3}\n");
-  EXPECT_EQ(g.roughness.model, RoughnessModel::GGX);
-  EXPECT_TRUE(g.roughness.microfacet());
-  EXPECT_EQ(g.roughness.alpha_long, 0.3);
-  EXPECT_EQ(g.roughness.alpha_azim, 0.3);
-  EXPECT_EQ(g.roughness.masking, Masking::None);  // the default
+  ASSERT_TRUE(std::holds_alternative<roughness::Ggx>(g.fiber.roughness));
+  EXPECT_EQ(std::get<roughness::Ggx>(g.fiber.roughness).alpha_long, 0.3);
+  EXPECT_EQ(std::get<roughness::Ggx>(g.fiber.roughness).alpha_azim, 0.3);
+  EXPECT_EQ(std::get<roughness::Ggx>(g.fiber.roughness).masking, Masking::None);  // the default
 
   const Settings b = parse("roughness: {model: beckmann, alpha: [0.1, 0.4], masking: smith_g1}\n");
-  EXPECT_EQ(b.roughness.model, RoughnessModel::Beckmann);
-  EXPECT_EQ(b.roughness.alpha_long, 0.1);
-  EXPECT_EQ(b.roughness.alpha_azim, 0.4);
-  EXPECT_EQ(b.roughness.masking, Masking::SmithG1);
+  ASSERT_TRUE(std::holds_alternative<roughness::Beckmann>(b.fiber.roughness));
+  EXPECT_EQ(std::get<roughness::Beckmann>(b.fiber.roughness).alpha_long, 0.1);
+  EXPECT_EQ(std::get<roughness::Beckmann>(b.fiber.roughness).alpha_azim, 0.4);
+  EXPECT_EQ(std::get<roughness::Beckmann>(b.fiber.roughness).masking, Masking::SmithG1);
 
   // A list of one is the isotropic alpha.
-  EXPECT_EQ(parse("roughness: {model: ggx, alpha: [0.2]}\n").roughness.alpha_azim, 0.2);
+  EXPECT_EQ(std::get<roughness::Ggx>(parse("roughness: {model: ggx, alpha: [0.2]}\n").fiber.roughness).alpha_azim, 0.2);
   // masking: none is accepted (and means nothing) for every model.
-  EXPECT_EQ(parse("roughness: {model: gaussian, beta_long: 5, masking: none}\n").roughness.masking,
+  EXPECT_EQ(roughness::masking(parse("roughness: {model: gaussian, beta_long: 5, masking: none}\n").fiber.roughness),
             Masking::None);
 }
 
@@ -67,7 +66,8 @@ TEST(MicrofacetSettings, RoundTripThroughToYaml) {
     const Settings s = parse(yaml);
     const std::string text = to_yaml(s);
     EXPECT_EQ(parse(text), s) << text;
-    const bool microfacet = s.roughness.microfacet();
+    const bool microfacet = std::holds_alternative<roughness::Ggx>(s.fiber.roughness) ||
+                            std::holds_alternative<roughness::Beckmann>(s.fiber.roughness);
     EXPECT_EQ(text.find("alpha:") != std::string::npos, microfacet) << text;
     EXPECT_EQ(text.find("masking:") != std::string::npos, microfacet) << text;
     EXPECT_EQ(text.find("beta_long:") != std::string::npos, !microfacet) << text;

@@ -99,11 +99,7 @@ TEST(PhotonFeed, SimulationTalliesOfScatteredRunsEqualOneRun) {
   EXPECT_TRUE(one.exact().words() == fed.exact().words());
   // A microfacet model (its own sampler, and with masking a list of losses
   // per photon in flight) takes the runs as well.
-  s.roughness.model = RoughnessModel::GGX;
-  s.roughness.beta_long = {0.0};
-  s.roughness.beta_azim = {0.0};
-  s.roughness.alpha_long = s.roughness.alpha_azim = 0.1;
-  s.roughness.masking = Masking::SmithG1;
+  s.fiber.roughness = testing::microfacet(MicrofacetModel::GGX, 0.1, 0.1, Masking::SmithG1);
   const Simulation reference(s);
   Tally ref_one(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);
   Tally ref_fed(shape.lobes, shape.n_theta, shape.n_phi, shape.channels);

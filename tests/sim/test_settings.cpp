@@ -71,7 +71,7 @@ TEST(Settings, ShippedConfigsHaveTheDocumentedContents) {
   EXPECT_EQ(quick.output, "quickstart.h5");
   EXPECT_EQ(quick.photons, 1000000u);
   EXPECT_DOUBLE_EQ(quick.source.theta_i.at(0), deg_to_rad(30.0));
-  EXPECT_EQ(quick.roughness.model, RoughnessModel::Gaussian);
+  EXPECT_TRUE(std::holds_alternative<roughness::Gaussian>(quick.fiber.roughness));
   EXPECT_TRUE(quick.fiber.eumelanin.has_value());
 
   const Settings sweep = load_settings((dir / "white_fiber_sweep.yaml").string());
@@ -83,7 +83,7 @@ TEST(Settings, ShippedConfigsHaveTheDocumentedContents) {
   EXPECT_EQ(glints.source.phi_i.size(), 4u);
 
   const Settings smooth = load_settings((dir / "smooth_circle.yaml").string());
-  EXPECT_EQ(smooth.roughness.model, RoughnessModel::Smooth);
+  EXPECT_TRUE(std::holds_alternative<roughness::Smooth>(smooth.fiber.roughness));
   EXPECT_EQ(smooth.fiber.scale_tilt, 0.0);
   EXPECT_EQ(smooth.incidences().size(), 3u);
 }
@@ -100,9 +100,8 @@ TEST(Settings, EmptyMappingGivesTheDefaults) {
   EXPECT_EQ(s.fiber.scale_tilt, 0.0);
   EXPECT_EQ(s.fiber.sigma_a, (std::vector<double>{0.0, 0.0, 0.0}));
   EXPECT_FALSE(s.fiber.eumelanin.has_value());
-  EXPECT_EQ(s.roughness.model, RoughnessModel::Gaussian);
-  EXPECT_EQ(s.roughness.beta_long, std::vector<double>{0.0});
-  EXPECT_EQ(s.roughness.beta_azim, std::vector<double>{0.0});
+  EXPECT_EQ(std::get<roughness::Gaussian>(s.fiber.roughness).beta_long, 0.0);
+  EXPECT_EQ(std::get<roughness::Gaussian>(s.fiber.roughness).beta_azim, 0.0);
   EXPECT_EQ(s.source.theta_i, std::vector<double>{0.0});
   EXPECT_FALSE(s.source.phi_i_uniform);
   EXPECT_EQ(s.source.phi_i, std::vector<double>{0.0});
@@ -122,8 +121,8 @@ TEST(Settings, AnglesAreDegreesInTheFileAndRadiansInSettings) {
       "roughness: {model: gaussian, beta_long: 5, beta_azim: 10}\n"
       "source: {theta_i: [30, -45], phi_i: 90}\n");
   EXPECT_DOUBLE_EQ(s.fiber.scale_tilt, 3.0 * kPi / 180.0);
-  EXPECT_DOUBLE_EQ(s.roughness.beta_long.at(0), 5.0 * kPi / 180.0);
-  EXPECT_DOUBLE_EQ(s.roughness.beta_azim.at(0), 10.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(std::get<roughness::Gaussian>(s.fiber.roughness).beta_long, 5.0 * kPi / 180.0);
+  EXPECT_DOUBLE_EQ(std::get<roughness::Gaussian>(s.fiber.roughness).beta_azim, 10.0 * kPi / 180.0);
   EXPECT_DOUBLE_EQ(s.source.theta_i.at(0), kPi / 6.0);
   EXPECT_DOUBLE_EQ(s.source.theta_i.at(1), -kPi / 4.0);
   EXPECT_DOUBLE_EQ(s.source.phi_i.at(0), kPi / 2.0);
@@ -142,10 +141,10 @@ TEST(Settings, EveryFieldIsRead) {
   EXPECT_EQ(s.fiber.eta, 1.6);
   EXPECT_EQ(s.fiber.eccentricity, 0.5);
   EXPECT_EQ(s.fiber.sigma_a, (std::vector<double>{0.1, 0.2}));
-  EXPECT_EQ(s.roughness.model, RoughnessModel::ExitBlur);
-  ASSERT_EQ(s.roughness.beta_long.size(), 3u);
-  EXPECT_EQ(s.roughness.beta_azim, s.roughness.beta_long);  // beta_azim defaults to beta_long
-  EXPECT_DOUBLE_EQ(RoughnessSettings::for_lobe(s.roughness.beta_long, 7), deg_to_rad(12.0));
+  const auto& blur = std::get<roughness::ExitBlur>(s.fiber.roughness);
+  ASSERT_EQ(blur.beta_long.size(), 3u);
+  EXPECT_EQ(blur.beta_azim, blur.beta_long);  // beta_azim defaults to beta_long
+  EXPECT_DOUBLE_EQ(roughness::ExitBlur::for_lobe(blur.beta_long, 7), deg_to_rad(12.0));
   EXPECT_EQ(s.tally.n_theta, 45);
   EXPECT_EQ(s.tally.n_phi, 90);
   EXPECT_EQ(s.tally.theta_bins, ThetaBinning::EqualArea);
@@ -219,9 +218,9 @@ TEST(Settings, MelaninFollowsDEon2011Section6_1) {
 }
 
 TEST(Settings, ToStrings) {
-  EXPECT_EQ(to_string(RoughnessModel::Smooth), "smooth");
-  EXPECT_EQ(to_string(RoughnessModel::Gaussian), "gaussian");
-  EXPECT_EQ(to_string(RoughnessModel::ExitBlur), "exit_blur");
+  EXPECT_EQ(roughness::name(roughness::Smooth{}), "smooth");
+  EXPECT_EQ(roughness::name(roughness::Gaussian{}), "gaussian");
+  EXPECT_EQ(roughness::name(roughness::ExitBlur{}), "exit_blur");
   EXPECT_EQ(to_string(Polarization::Scalar), "scalar");
   EXPECT_EQ(to_string(Polarization::Stokes), "stokes");
 }
@@ -237,9 +236,7 @@ TEST(Settings, ToYamlRoundTripsExactly) {
   s.fiber.eccentricity = 0.85;
   s.fiber.scale_tilt = 0.0523598775598;  // radians that are no "round" degree value
   s.fiber.sigma_a = {0.1, 1e-7, 3.0, 12345.678};
-  s.roughness.model = RoughnessModel::ExitBlur;
-  s.roughness.beta_long = {0.01, 0.2, 0.3};
-  s.roughness.beta_azim = {0.4};
+  s.fiber.roughness = roughness::ExitBlur{{{0.01, 0.2, 0.3}, {0.4}}};
   s.source.theta_i = {-1.2, 0.0, 0.123456789, 1.5};
   s.source.phi_i = {-3.0, 0.5, 2.0};
   s.tally = {45, 91, ThetaBinning::EqualArea, 5};
@@ -363,7 +360,7 @@ TEST(SettingsErrors, ListBetaForGaussian) {
                {"roughness.beta_long = [5, 10]", "list", "[0, 90]", "exit_blur"});
   expect_error("roughness: {beta_azim: [5]}\n", {"roughness.beta_azim", "list", "exit_blur"});
   // exit_blur takes a list indexed by p.
-  EXPECT_EQ(parse("roughness: {model: exit_blur, beta_long: [5, 10]}\n").roughness.beta_long.size(),
+  EXPECT_EQ(std::get<roughness::ExitBlur>(parse("roughness: {model: exit_blur, beta_long: [5, 10]}\n").fiber.roughness).beta_long.size(),
             2u);
 }
 
