@@ -882,7 +882,10 @@ std::vector<std::string> marschner_approximations(const Marschner2003Params& p) 
 // The rule from a simulated fiber (physical_defaults.h): the eccentricity
 // itself; the tilt as SPEC s7's shifts; the longitudinal widths by the
 // calibrated rule in the model's width variable, floored at
-// kMinMarschnerBeta (the Gaussian M needs beta > 0).
+// kMinMarschnerBeta (the Gaussian M needs beta > 0). The model has no
+// azimuthal roughness (its N_p is the smooth fiber's, section 4.2, with only
+// the caustic's w_c), so a fiber's azimuthal width is not represented: the
+// mapping says so rather than dropping it unseen.
 void marschner2003_from_fiber(const PhysicalFiber& f, Marschner2003Params& p, FiberMapping& mapping) {
   apply_fiber_basics(f, p);
   p.alpha = tilt_shifts(f.scale_tilt);
@@ -890,6 +893,11 @@ void marschner2003_from_fiber(const PhysicalFiber& f, Marschner2003Params& p, Fi
   LobeWidths w;
   apply_fiber_roughness(f, w, marschner2003_width_calibration(p.two_theta_h), mapping, kMinMarschnerBeta);
   p.beta_long = w.beta_long;
+  if (std::any_of(w.beta_azim.begin(), w.beta_azim.end(), [](double b) { return b > 0.0; }))
+    mapping.notes.push_back(fmt::format(
+        "roughness: marschner2003 has no azimuthal roughness width; the azimuthal part of the {} fiber is not "
+        "represented (only its longitudinal widths are used)",
+        f.roughness_text()));
 }
 
 }  // namespace

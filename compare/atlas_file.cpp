@@ -87,6 +87,34 @@ void write_fibers(h5::File& f, const Shape& s, const std::vector<AtlasFiberResul
   f.set_attr("/fibers", "absorption", joined(absorption));
 }
 
+// What the file keeps of fits, one row per fit (a fiber's joint fit, or a
+// fiber's fit of one lobe) and P keys a row; NaN (0) where no fit was made.
+struct FitColumns {
+  std::size_t P;
+  std::vector<double> value, error, unscaled, start, bound, chi2_start, chi2, dof, iterations;
+  std::vector<std::uint64_t> converged;
+
+  FitColumns(std::size_t rows, std::size_t keys)
+      : P(keys), value(rows * keys, kNaN), error(rows * keys, kNaN), unscaled(rows * keys, kNaN),
+        start(rows * keys, kNaN), bound(rows * keys, kNaN), chi2_start(rows, kNaN), chi2(rows, kNaN),
+        dof(rows, kNaN), iterations(rows, kNaN), converged(rows, 0) {}
+
+  void set(std::size_t row, const FitResult& fit) {
+    for (std::size_t k = 0; k < P && k < fit.keys.size(); ++k) {
+      value[row * P + k] = fit.value[k];
+      error[row * P + k] = fit.error[k];
+      unscaled[row * P + k] = fit.error_unscaled[k];
+      start[row * P + k] = fit.start[k];
+      bound[row * P + k] = fit.at_bound[k] ? 1.0 : 0.0;
+    }
+    chi2_start[row] = fit.chi2_start;
+    chi2[row] = fit.chi2;
+    dof[row] = fit.dof;
+    iterations[row] = fit.iterations;
+    converged[row] = fit.converged;
+  }
+};
+
 // fit.per_lobe: each lobe's own fit (compare/atlas.h) beside the joint one,
 // in the model's group: per fiber and lobe its fitted values, chi-square and
 // outcome, and the comparison of that lobe at its own values.
@@ -96,9 +124,8 @@ void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const st
   const hsize_t P = keys.size(), FL = s.F * s.L;
   const std::size_t n = s.F * s.K * s.L * s.C;
   std::vector<double> energy(n, kNaN), chi2(n, kNaN), dof(n, kNaN);
-  std::vector<double> value(FL * P, kNaN), error(FL * P, kNaN), unscaled(FL * P, kNaN), start(FL * P, kNaN),
-      bound(FL * P, kNaN), fit_chi2_start(FL, kNaN), fit_chi2(FL, kNaN), fit_dof(FL, kNaN), iterations(FL, kNaN);
-  std::vector<std::uint64_t> fitted(FL, 0), converged(FL, 0);
+  FitColumns fits(FL, P);
+  std::vector<std::uint64_t> fitted(FL, 0);
   std::vector<std::string> status, lines(FL), lobe_keys;
   for (std::size_t i = 0; i < fibers.size(); ++i) {
     const AtlasModelResult& r = fibers[i].models[m];
@@ -107,19 +134,8 @@ void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const st
       const LobeFit& lf = r.lobe_fits[j];
       const std::size_t at = i * s.L + lf.lobe;
       fitted[at] = 1;
-      converged[at] = lf.fit.converged;
       lines[at] = r.lobe_fit_lines.at(j);
-      for (hsize_t k = 0; k < P && k < lf.fit.keys.size(); ++k) {
-        value[at * P + k] = lf.fit.value[k];
-        error[at * P + k] = lf.fit.error[k];
-        unscaled[at * P + k] = lf.fit.error_unscaled[k];
-        start[at * P + k] = lf.fit.start[k];
-        bound[at * P + k] = lf.fit.at_bound[k] ? 1.0 : 0.0;
-      }
-      fit_chi2_start[at] = lf.fit.chi2_start;
-      fit_chi2[at] = lf.fit.chi2;
-      fit_dof[at] = lf.fit.dof;
-      iterations[at] = lf.fit.iterations;
+      fits.set(at, lf.fit);
     }
     for (const LobeComparison& c : r.after_lobe_fit) {
       const std::size_t at = s.at(i, c.k, c.lobe, c.channel);
@@ -143,26 +159,26 @@ void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const st
   const h5::Dims FLd{s.F, s.L}, FLP{s.F, s.L, P};
   const std::string key_unit = "the key's unit (degrees for angles)";
   put(f, g + "/lobe_fitted", FLd, fitted, "fiber,lobe", "0/1", "1: the lobe was fitted alone (fit.per_lobe)");
-  put(f, g + "/lobe_fit_converged", FLd, converged, "fiber,lobe", "0/1", "1: the lobe's own fit converged");
+  put(f, g + "/lobe_fit_converged", FLd, fits.converged, "fiber,lobe", "0/1", "1: the lobe's own fit converged");
   put(f, g + "/model_energy_lobe_fit", s.dims(), energy, kAtlasDims, "fraction of incident light",
       "the model's lobe energy with that lobe's own fitted parameters (NaN: not fitted lobe by lobe)");
   put(f, g + "/chi2_lobe_fit", s.dims(), chi2, kAtlasDims, "",
       "chi-square of the bins with that lobe's own fitted parameters");
   put(f, g + "/dof_lobe_fit", s.dims(), dof, kAtlasDims, "", "its degrees of freedom");
-  put(f, g + "/lobe_fit_start", FLP, start, "fiber,lobe,fit_key", key_unit,
+  put(f, g + "/lobe_fit_start", FLP, fits.start, "fiber,lobe,fit_key", key_unit,
       "start of each key of the lobe's fit (attribute lobe_fit_keys, one line per lobe; empty when no lobe "
       "was fitted): the joint fit's value");
-  put(f, g + "/lobe_fit_value", FLP, value, "fiber,lobe,fit_key", key_unit, "fitted value of the lobe's own fit");
-  put(f, g + "/lobe_fit_error", FLP, error, "fiber,lobe,fit_key", key_unit,
+  put(f, g + "/lobe_fit_value", FLP, fits.value, "fiber,lobe,fit_key", key_unit, "fitted value of the lobe's own fit");
+  put(f, g + "/lobe_fit_error", FLP, fits.error, "fiber,lobe,fit_key", key_unit,
       "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
-  put(f, g + "/lobe_fit_error_unscaled", FLP, unscaled, "fiber,lobe,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
-  put(f, g + "/lobe_fit_at_bound", FLP, bound, "fiber,lobe,fit_key", "0/1",
+  put(f, g + "/lobe_fit_error_unscaled", FLP, fits.unscaled, "fiber,lobe,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
+  put(f, g + "/lobe_fit_at_bound", FLP, fits.bound, "fiber,lobe,fit_key", "0/1",
       "1: the value sits on an end of the table's range");
-  put(f, g + "/lobe_fit_chi2_start", FLd, fit_chi2_start, "fiber,lobe", "",
+  put(f, g + "/lobe_fit_chi2_start", FLd, fits.chi2_start, "fiber,lobe", "",
       "the lobe fit's chi-square at its start (the lobe's bins, every theta_i)");
-  put(f, g + "/lobe_fit_chi2", FLd, fit_chi2, "fiber,lobe", "", "the lobe fit's chi-square at the minimum");
-  put(f, g + "/lobe_fit_dof", FLd, fit_dof, "fiber,lobe", "", "residuals minus fitted parameters");
-  put(f, g + "/lobe_fit_iterations", FLd, iterations, "fiber,lobe", "", "Levenberg-Marquardt iterations");
+  put(f, g + "/lobe_fit_chi2", FLd, fits.chi2, "fiber,lobe", "", "the lobe fit's chi-square at the minimum");
+  put(f, g + "/lobe_fit_dof", FLd, fits.dof, "fiber,lobe", "", "residuals minus fitted parameters");
+  put(f, g + "/lobe_fit_iterations", FLd, fits.iterations, "fiber,lobe", "", "Levenberg-Marquardt iterations");
 }
 
 void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers,
@@ -179,10 +195,9 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
   const hsize_t P = keys.size();
   const std::size_t n = s.F * s.K * s.L * s.C;
   std::vector<double> eb(n, kNaN), ea(n, kNaN), cb(n, kNaN), ca(n, kNaN), db(n, kNaN), da(n, kNaN), judged(n, kNaN);
-  std::vector<double> value(s.F * P, kNaN), error(s.F * P, kNaN), unscaled(s.F * P, kNaN), start(s.F * P, kNaN),
-      bound(s.F * P, kNaN), chi2_start(s.F, kNaN), chi2(s.F, kNaN), dof(s.F, kNaN), iterations(s.F, kNaN),
-      seconds(s.F, kNaN);
-  std::vector<std::uint64_t> applicable(s.F, 0), fitted(s.F, 0), converged(s.F, 0);
+  std::vector<double> seconds(s.F, kNaN);
+  FitColumns fits(s.F, P);
+  std::vector<std::uint64_t> applicable(s.F, 0), fitted(s.F, 0);
   std::vector<std::string> status, before, after;
   for (std::size_t i = 0; i < fibers.size(); ++i) {
     const AtlasModelResult& r = fibers[i].models[m];
@@ -204,20 +219,7 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
     };
     fill(r.before, eb, cb, db, true);
     fill(r.after, ea, ca, da, false);
-    if (r.fitted) {
-      for (hsize_t j = 0; j < P && j < r.fit.keys.size(); ++j) {
-        value[i * P + j] = r.fit.value[j];
-        error[i * P + j] = r.fit.error[j];
-        unscaled[i * P + j] = r.fit.error_unscaled[j];
-        start[i * P + j] = r.fit.start[j];
-        bound[i * P + j] = r.fit.at_bound[j] ? 1.0 : 0.0;
-      }
-      chi2_start[i] = r.fit.chi2_start;
-      chi2[i] = r.fit.chi2;
-      dof[i] = r.fit.dof;
-      iterations[i] = r.fit.iterations;
-      converged[i] = r.fit.converged;
-    }
+    if (r.fitted) fits.set(i, r.fit);
   }
   std::string key_text;
   for (const auto& k : keys) key_text += (key_text.empty() ? "" : ",") + k;
@@ -229,7 +231,7 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
   const std::string energy = "fraction of incident light", key_unit = "the key's unit (degrees for angles)";
   put(f, g + "/applicable", F, applicable, "fiber", "0/1", "1: the model accepted the fiber (status says why not)");
   put(f, g + "/fitted", F, fitted, "fiber", "0/1", "1: the free parameters were fitted");
-  put(f, g + "/converged", F, converged, "fiber", "0/1", "1: the fit converged");
+  put(f, g + "/converged", F, fits.converged, "fiber", "0/1", "1: the fit converged");
   put(f, g + "/seconds", F, seconds, "fiber", "seconds", "wall time of this model's comparison and fit");
   put(f, g + "/model_energy_before", s.dims(), eb, kAtlasDims, energy,
       "the model's lobe energy with its physical defaults (NaN: not applicable)");
@@ -241,37 +243,46 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
   put(f, g + "/chi2_after", s.dims(), ca, kAtlasDims, "", "chi-square of the bins with the fitted parameters");
   put(f, g + "/dof_after", s.dims(), da, kAtlasDims, "", "its degrees of freedom");
   put(f, g + "/judged", s.dims(), judged, kAtlasDims, "0/1", "1: the lobe has enough energy to be judged");
-  put(f, g + "/fit_start", FP, start, "fiber,fit_key", key_unit, "start value of each fit key (attribute fit_keys)");
-  put(f, g + "/fit_value", FP, value, "fiber,fit_key", key_unit, "fitted value");
-  put(f, g + "/fit_error", FP, error, "fiber,fit_key", key_unit,
+  put(f, g + "/fit_start", FP, fits.start, "fiber,fit_key", key_unit, "start value of each fit key (attribute fit_keys)");
+  put(f, g + "/fit_value", FP, fits.value, "fiber,fit_key", key_unit, "fitted value");
+  put(f, g + "/fit_error", FP, fits.error, "fiber,fit_key", key_unit,
       "standard error scaled by sqrt(max(1, chi2/dof)) (compare/fit.h)");
-  put(f, g + "/fit_error_unscaled", FP, unscaled, "fiber,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
-  put(f, g + "/fit_at_bound", FP, bound, "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
-  put(f, g + "/fit_chi2_start", F, chi2_start, "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
-  put(f, g + "/fit_chi2", F, chi2, "fiber", "", "the fit's chi-square at the minimum");
-  put(f, g + "/fit_dof", F, dof, "fiber", "", "residuals minus fitted parameters");
-  put(f, g + "/fit_iterations", F, iterations, "fiber", "", "Levenberg-Marquardt iterations");
+  put(f, g + "/fit_error_unscaled", FP, fits.unscaled, "fiber,fit_key", key_unit, "sqrt(diag((J^T W J)^-1))");
+  put(f, g + "/fit_at_bound", FP, fits.bound, "fiber,fit_key", "0/1", "1: the value sits on an end of the table's range");
+  put(f, g + "/fit_chi2_start", F, fits.chi2_start, "fiber", "", "the fit's chi-square at its start (all theta_i, lobes)");
+  put(f, g + "/fit_chi2", F, fits.chi2, "fiber", "", "the fit's chi-square at the minimum");
+  put(f, g + "/fit_dof", F, fits.dof, "fiber", "", "residuals minus fitted parameters");
+  put(f, g + "/fit_iterations", F, fits.iterations, "fiber", "", "Levenberg-Marquardt iterations");
   if (config.per_lobe) write_lobe_fits(f, s, g, registered_model(config, name), keys, fibers, m);
 }
 
 }  // namespace
 
 void write_atlas_axis_names(h5::File& f, const AtlasConfig& config) {
+  // A fiber with a medulla has one lobe more, `scattered` (docs/FUR.md): the
+  // file's lobe axis is the longest, NaN where a fiber has no such lobe.
   int lobes = 0, channels = 0;
-  bool from_melanin = true;
+  bool from_melanin = true, scattered = false;
   for (const AtlasFiber& fiber : config.fibers) {
-    lobes = std::max(lobes, fiber.settings.tally.lobes);
+    const bool medulla = fiber.settings.fiber.medulla.has_value();
+    lobes = std::max(lobes, fiber.settings.tally.lobes + (medulla ? 1 : 0));
+    scattered = scattered || medulla;
     channels = std::max(channels, static_cast<int>(fiber.settings.fiber.sigma_a.size()));
     from_melanin = from_melanin && fiber.settings.fiber.eumelanin.has_value();
   }
-  write_axis_names(f, lobes, channels, from_melanin);
+  write_axis_names(f, lobes, channels, from_melanin, scattered);
 }
 
 void write_atlas_file(const std::string& path, const AtlasConfig& config,
                       const std::vector<AtlasFiberResult>& fibers) {
   if (fibers.empty()) throw Error("atlas: no fiber was simulated");
-  Shape s{fibers.size(), config.theta_i.size(), static_cast<hsize_t>(fibers[0].lobes), 1};
-  for (const auto& r : fibers) s.C = std::max<hsize_t>(s.C, r.channels);
+  // The longest lobe axis and the most channels of any fiber (a medulla adds
+  // the lobe `scattered`; absorption entries may differ in channels).
+  Shape s{fibers.size(), config.theta_i.size(), 1, 1};
+  for (const auto& r : fibers) {
+    s.L = std::max<hsize_t>(s.L, r.lobes);
+    s.C = std::max<hsize_t>(s.C, r.channels);
+  }
   AtomicOutput out(path);
   {
     h5::File f = h5::File::create(out.temp_path());

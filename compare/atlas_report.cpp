@@ -39,7 +39,21 @@ std::string fitted_params(const AtlasModelResult& m) {
   return s;
 }
 
-int lobe_count(const std::vector<AtlasFiberResult>& fibers) { return fibers.empty() ? 0 : fibers[0].lobes; }
+// The longest lobe axis of any fiber (a medulla adds the lobe `scattered`).
+int lobe_count(const std::vector<AtlasFiberResult>& fibers) {
+  int L = 0;
+  for (const AtlasFiberResult& f : fibers) L = std::max(L, f.lobes);
+  return L;
+}
+
+// The name of lobe l on that axis: the last is `scattered` when a fiber has
+// a medulla (docs/FUR.md).
+std::string lobe_label(int l, const std::vector<AtlasFiberResult>& fibers) {
+  const bool scattered = std::any_of(fibers.begin(), fibers.end(), [](const AtlasFiberResult& f) {
+    return f.fiber.settings.fiber.medulla.has_value();
+  });
+  return lobe_names(lobe_count(fibers), scattered).at(static_cast<std::size_t>(l));
+}
 
 // The config's model_parameters, one sentence (empty when there are none).
 std::string fixed_parameters(const AtlasConfig& config) {
@@ -67,12 +81,34 @@ void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
   out.commit();
 }
 
-// fit.per_lobe's headline: the joint fit's and the lobes' own fits' columns.
-std::string headline_with_lobe_fits(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+// fit.per_lobe: each lobe's own fitted values, or why the model was not
+// fitted lobe by lobe.
+std::string lobe_fitted_params(const AtlasModelResult& m, const std::vector<AtlasFiberResult>& fibers) {
+  if (m.lobe_fits.empty()) return m.lobe_fit_status;
+  std::string s;
+  for (const LobeFit& lf : m.lobe_fits) {
+    s += fmt::format("{}{}:", s.empty() ? "" : "; ", lobe_label(lf.lobe, fibers));
+    for (std::size_t j = 0; j < lf.fit.keys.size(); ++j)
+      s += fmt::format(" {} = {:.4g} ± {:.2g}{}", lf.fit.keys[j], lf.fit.value[j], lf.fit.error[j],
+                       lf.fit.at_bound[j] ? " (at bound)" : "");
+    if (lf.fit.outcome == FitOutcome::NotConverged) s += " (not converged)";
+  }
+  return s;
+}
+
+}  // namespace
+
+// Per model and lobe, medians over the fibers; with fit.per_lobe also the
+// columns of the lobes' own fits beside the joint fit's.
+std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
+  const bool lobe_fits = config.per_lobe;
   const int L = lobe_count(fibers);
-  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after joint fit | after per-lobe fit | "
-                  "median χ²/dof before | after joint fit | after per-lobe fit |\n"
-                  "|---|---|---|---|---|---|---|---|---|\n";
+  std::string s = lobe_fits ? "| model | fibers | lobe | median max\\|ΔE\\| before | after joint fit | after per-lobe fit | "
+                              "median χ²/dof before | after joint fit | after per-lobe fit |\n"
+                              "|---|---|---|---|---|---|---|---|---|\n"
+                            : "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | "
+                              "after fit |\n"
+                              "|---|---|---|---|---|---|---|\n";
   for (std::size_t m = 0; m < config.models.size(); ++m)
     for (int l = 0; l < L; ++l) {
       std::vector<double> eb, ea, el, cb, ca, cl;
@@ -89,51 +125,12 @@ std::string headline_with_lobe_fits(const AtlasConfig& config, const std::vector
         if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
         if (sum.lobe_fitted && sum.dof_lobe_fit > 0) cl.push_back(per_dof(sum.chi2_lobe_fit, sum.dof_lobe_fit));
       }
-      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable,
-                       lobe_name(l, L), num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"),
-                       num(median(el), "{:.4f}"), num(median(cb)), num(median(ca)), num(median(cl)));
-    }
-  return s;
-}
-
-// fit.per_lobe: each lobe's own fitted values, or why the model was not
-// fitted lobe by lobe.
-std::string lobe_fitted_params(const AtlasModelResult& m, int lobes) {
-  if (m.lobe_fits.empty()) return m.lobe_fit_status;
-  std::string s;
-  for (const LobeFit& lf : m.lobe_fits) {
-    s += fmt::format("{}{}:", s.empty() ? "" : "; ", lobe_name(lf.lobe, lobes));
-    for (std::size_t j = 0; j < lf.fit.keys.size(); ++j)
-      s += fmt::format(" {} = {:.4g} ± {:.2g}{}", lf.fit.keys[j], lf.fit.value[j], lf.fit.error[j],
-                       lf.fit.at_bound[j] ? " (at bound)" : "");
-    if (lf.fit.outcome == FitOutcome::NotConverged) s += " (not converged)";
-  }
-  return s;
-}
-
-}  // namespace
-
-std::string atlas_headline_markdown(const AtlasConfig& config, const std::vector<AtlasFiberResult>& fibers) {
-  if (config.per_lobe) return headline_with_lobe_fits(config, fibers);
-  const int L = lobe_count(fibers);
-  std::string s = "| model | fibers | lobe | median max\\|ΔE\\| before | after fit | median χ²/dof before | after fit |\n"
-                  "|---|---|---|---|---|---|---|\n";
-  for (std::size_t m = 0; m < config.models.size(); ++m)
-    for (int l = 0; l < L; ++l) {
-      std::vector<double> eb, ea, cb, ca;
-      int applicable = 0;
-      for (const auto& f : fibers) {
-        const AtlasModelResult& r = f.models[m];
-        if (!r.applicable) continue;
-        ++applicable;
-        const AtlasLobeSummary sum = summarize_lobe(r, l);
-        eb.push_back(sum.max_abs_energy_error);
-        if (r.fitted) ea.push_back(sum.max_abs_energy_error_after);
-        if (sum.dof_before > 0) cb.push_back(per_dof(sum.chi2_before, sum.dof_before));
-        if (r.fitted && sum.dof_after > 0) ca.push_back(per_dof(sum.chi2_after, sum.dof_after));
-      }
-      s += fmt::format("| {} | {} | {} | {} | {} | {} | {} |\n", config.models[m], applicable, lobe_name(l, L),
-                       num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"), num(median(cb)), num(median(ca)));
+      s += fmt::format("| {} | {} | {} | {} | {} |", config.models[m], applicable, lobe_label(l, fibers),
+                       num(median(eb), "{:.4f}"), num(median(ea), "{:.4f}"));
+      if (lobe_fits) s += fmt::format(" {} |", num(median(el), "{:.4f}"));
+      s += fmt::format(" {} | {} |", num(median(cb)), num(median(ca)));
+      if (lobe_fits) s += fmt::format(" {} |", num(median(cl)));
+      s += "\n";
     }
   return s;
 }
@@ -147,7 +144,7 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
     rule += "---|";
   }
   for (int l = 0; l < L; ++l) {
-    s += fmt::format(" {}: max\\|ΔE\\| | {}: χ²/dof |", lobe_name(l, L), lobe_name(l, L));
+    s += fmt::format(" {}: max\\|ΔE\\| | {}: χ²/dof |", lobe_label(l, fibers), lobe_label(l, fibers));
     rule += "---|---|";
   }
   s += "\n" + rule + "\n";
@@ -155,7 +152,7 @@ std::string atlas_table_markdown(const AtlasConfig& config, const std::vector<At
     for (std::size_t m = 0; m < config.models.size(); ++m) {
       const AtlasModelResult& r = fibers[i].models[m];
       s += fmt::format("| {}. {} | {} | {} |", i + 1, fibers[i].fiber.label, r.model, fitted_params(r));
-      if (config.per_lobe) s += fmt::format(" {} |", r.applicable ? lobe_fitted_params(r, L) : "-");
+      if (config.per_lobe) s += fmt::format(" {} |", r.applicable ? lobe_fitted_params(r, fibers) : "-");
       for (int l = 0; l < L; ++l) {
         if (!r.applicable) {
           s += " - | - |";

@@ -85,7 +85,7 @@ std::string energy_csv(const EnergyReport& r, const std::vector<EnergyCurve>& cu
 
 std::string write_energy_report(const EnergyReport& r, const std::vector<EnergyCurve>& curves) {
   const bool white = r.white, simulated = r.simulated;
-  const int c = r.channel, L = curves.front().lobes;
+  const int c = r.channel;
   const std::vector<double>& theta_i = r.theta_i;
   ReportFolder folder(r.dir);
   try {

@@ -125,8 +125,11 @@ TEST(ParamTables, EveryEntryRoundTripsOnItsOwnField) {
       ASSERT_NE(value, spec.show(p)) << m.name << " " << spec.key << ": the test value is the default";
       apply_setting(m.name, p, spec.key + "=" + value);
       EXPECT_EQ(spec.show(p), value) << m.name << " " << spec.key;
-      for (const ParamSpec& s : m.params)
-        if (s.key != spec.key) EXPECT_EQ(s.show(p), before[s.key]) << m.name << ": " << spec.key << " moved " << s.key;
+      for (const ParamSpec& s : m.params) {
+        if (s.key != spec.key) {
+          EXPECT_EQ(s.show(p), before[s.key]) << m.name << ": " << spec.key << " moved " << s.key;
+        }
+      }
       const ParamAttribute a = spec.attribute(p);
       EXPECT_EQ(a.name, spec.key);
       if (spec.unit == "choice") {

@@ -20,3 +20,9 @@ set_tests_properties(atlas_mpi_cli PROPERTIES SKIP_RETURN_CODE 77 TIMEOUT 600)
 add_test(NAME atlas_per_lobe_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_per_lobe.sh $<TARGET_FILE:fiberlab> ${PROJECT_SOURCE_DIR})
 set_tests_properties(atlas_per_lobe_cli PROPERTIES TIMEOUT 600)
+# `fiberlab atlas` sweeping fibers with and without a medulla (two channels,
+# both orders): the lobe `scattered` in the file's lobe axis, NaN where a fiber
+# has none.
+add_test(NAME atlas_medulla_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_medulla.sh $<TARGET_FILE:fiberlab>)
+set_tests_properties(atlas_medulla_cli PROPERTIES TIMEOUT 300)

@@ -78,8 +78,12 @@ TEST(FiberToModel, GaussianWidthModelsKeepTheAzimuthalAlphaAndStateTheMapping) {
                                                    parse_model_spec(model), {}, &notes);
     const analytic::ModelParameters iso =
         params_for(microfacet_fiber(sim::MicrofacetModel::GGX, 0.3, 0.3), parse_model_spec(model), {});
-    ASSERT_EQ(notes.size(), 1u) << model;
+    // marschner2003 also says that the azimuthal width is not represented.
+    ASSERT_EQ(notes.size(), model == "marschner2003" ? 2u : 1u) << model;
     EXPECT_NE(notes.front().find("ggx alpha = [0.3, 0.1]"), std::string::npos) << notes.front();
+    if (model == "marschner2003") {
+      EXPECT_NE(notes.back().find("no azimuthal roughness"), std::string::npos) << notes.back();
+    }
     if (model == "chiang2016") {
       const auto &a = aniso.as<analytic::Chiang2016Params>(), &i = iso.as<analytic::Chiang2016Params>();
       EXPECT_EQ(a.beta_m, i.beta_m);
@@ -98,6 +102,20 @@ TEST(FiberToModel, GaussianWidthModelsKeepTheAzimuthalAlphaAndStateTheMapping) {
           << model;
     }
   }
+}
+
+// marschner2003 has no azimuthal width: a gaussian fiber's beta_azim is not
+// represented, and the mapping says so; a smooth fiber has none to drop.
+TEST(FiberToModel, MarschnerSaysTheAzimuthalWidthIsNotRepresented) {
+  std::vector<std::string> notes;
+  params_for(testing::circle(30.0, 1000, fiberlab::roughness::Gaussian{deg_to_rad(5.0), deg_to_rad(5.0)}),
+             parse_model_spec("marschner2003"), {}, &notes);
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes.front().find("no azimuthal roughness"), std::string::npos) << notes.front();
+  notes.clear();
+  params_for(testing::circle(30.0, 1000, fiberlab::roughness::Smooth{}), parse_model_spec("marschner2003"), {},
+             &notes);
+  EXPECT_TRUE(notes.empty()) << notes.front();
 }
 
 }  // namespace

@@ -57,7 +57,7 @@ TEST(FiberRoughness, FileAttributesAreEachModelsOwnFields) {
   EXPECT_EQ(attribute_text(blur), (Attributes{{"beta_long", both}, {"beta_azim", both}}));
 }
 
-// The `fiberlab info` line of each model (cli/cmd_info.cpp prints it after "roughness: ").
+// The `fiberlab info` line of each model (app/info.cpp prints it after "roughness: ").
 TEST(FiberRoughness, DescribeNamesTheModelAndItsFields) {
   EXPECT_EQ(roughness::describe(parse_roughness("{model: ggx, alpha: [0.3, 0.1], masking: smith_g1}")),
             "ggx, alpha_long 0.3, alpha_azim 0.1, masking smith_g1");
