@@ -134,8 +134,10 @@ void exit_angles(FinishedPhotons& f) {
 // The photons of a vector whose lanes `lanes` finished this step, appended
 // to the block f (which has room for W more past them: sim/simd/lane_packing.h).
 // Their fates and exit directions as finished_outcome (sim/life/tracer.h) gives
-// them; a model's exit_direction needs each photon's own stream.
-template <class Model, class Light>
+// them; a model's exit_direction needs each photon's own stream. Slots
+// (sim/life/finished_photons.h) are kept with expected-value scoring only
+// (kExpectedValue); analog rows carry slot 0.
+template <bool kExpectedValue, class Model, class Light>
 void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, const Lanes& phi_i,
                const life::BitsOf<Lanes>& photon, const life::BitsOf<Lanes>& slot,
                std::uint64_t lanes, FinishedPhotons& f) {
@@ -152,18 +154,18 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
       life::pack_bits(life::lane_bits(s.scatters > Lanes(0.0)), lanes);
   pack_store(phi_i, lanes, f.phi_i + n);
   pack_store(photon, lanes, f.photon + n);
-  alignas(64) std::uint64_t slots[W];
-  pack_store(slot, lanes, slots);
   // Fates as fate_of (sim/life/tracer.h) gives them, from the code's mask bits.
   const std::uint64_t exited =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
   const std::uint64_t truncated =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kTruncated))), lanes);
+  alignas(64) double segments[W];
+  pack_store(s.segments, lanes, segments);
   const std::uint64_t ended =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
   const std::uint64_t lost = ~(exited | truncated | ended);
-  alignas(64) double segments[W];
-  pack_store(s.segments, lanes, segments);
+  alignas(64) std::uint64_t slots[W] = {};
+  if constexpr (kExpectedValue) pack_store(slot, lanes, slots);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
@@ -278,15 +280,22 @@ void BatchTracer::trace(double theta_i, double phi_i, const PhotonFeed& feed, co
         using Model = std::decay_t<decltype(model)>;
         if constexpr (!life::RunsBatched<Model>) {
           throw Error("internal error: this roughness model runs on the reference tracer only");
-        } else if (settings_.polarization == Polarization::Stokes)
-          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
-        else
-          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
+        } else if (settings_.polarization == Polarization::Stokes) {
+          if (config_.expected_value)
+            trace_with<life::StokesLight<Lanes>, true>(model, theta_i, phi_i, feed, sink, counters);
+          else
+            trace_with<life::StokesLight<Lanes>, false>(model, theta_i, phi_i, feed, sink, counters);
+        } else {
+          if (config_.expected_value)
+            trace_with<life::ScalarLight<Lanes>, true>(model, theta_i, phi_i, feed, sink, counters);
+          else
+            trace_with<life::ScalarLight<Lanes>, false>(model, theta_i, phi_i, feed, sink, counters);
+        }
       },
       roughness_);
 }
 
-template <class Light, class Model>
+template <class Light, bool kExpectedValue, class Model>
 void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
                              const PhotonFeed& feed, const Sink& sink,
                              TracerCounters& counters) const {
@@ -304,9 +313,9 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const Lanes iota = lane_index();
   life::LifeCounts<Lanes> counts;
   // Free photon slots (expected-value scoring: sim/life/finished_photons.h).
-  const bool expected_value = config_.expected_value;
-  std::vector<std::uint32_t> free_slots(kPoolLanes);
-  for (int i = 0; i < kPoolLanes; ++i) free_slots[i] = static_cast<std::uint32_t>(kPoolLanes - 1 - i);
+  constexpr bool expected_value = kExpectedValue;
+  std::vector<std::uint32_t> free_slots(expected_value ? kPoolLanes : 0);
+  for (int i = 0; i < static_cast<int>(free_slots.size()); ++i) free_slots[i] = static_cast<std::uint32_t>(kPoolLanes - 1 - i);
   auto take_slot = [&](int lane) {
     pool.bits[Pool::kSlot][lane] = free_slots.back();
     free_slots.pop_back();
@@ -349,8 +358,11 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   // A pass over the pool appends at most every lane it holds, and a vector's
   // worth of scratch past them (sim/simd/lane_packing.h).
   // With expected-value scoring every lane may also hand over an exit it
-  // scored: twice that.
-  constexpr int kFlushAbove = FinishedPhotons::kCapacity - 2 * (kPoolLanes + W);
+  // scored: twice that. The analog estimator keeps blocks of at most half
+  // the capacity, whose columns stay in the caches as well as the scorer's.
+  constexpr int kFlushAbove = expected_value
+                                  ? FinishedPhotons::kCapacity - 2 * (kPoolLanes + W)
+                                  : FinishedPhotons::kCapacity / 2 - (kPoolLanes + W);
   static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
 
   // Photons [next, end) of the current run are still to launch.
@@ -372,7 +384,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         launch_vector(n_active, next);
         const int n = static_cast<int>(std::min<std::uint64_t>(
             std::min(W, kPoolLanes - n_active), end - next));
-        if (expected_value)
+        if constexpr (expected_value)
           for (int j = 0; j < n; ++j) take_slot(n_active + j);
         if constexpr (kLosses)
           for (int i = n_active; i < n_active + n; ++i) pool.give_list(i);
@@ -381,7 +393,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       }
     } else {
       while (n_active < kPoolLanes && more_to_launch()) {
-        if (expected_value) take_slot(n_active);
+        if constexpr (expected_value) take_slot(n_active);
         launch(n_active++, next++);
       }
     }
@@ -400,12 +412,13 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       // A fixed incident direction keeps phi_i out of the pool.
       const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
       const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
-      const life::BitsOf<Lanes> slot = load_bits<Lanes>(pool.bits[Pool::kSlot] + o);
-      life::step(config_, model, s, live, counts, kRoundsPerStep);
+      life::BitsOf<Lanes> slot;
+      if constexpr (expected_value) slot = load_bits<Lanes>(pool.bits[Pool::kSlot] + o);
+      life::step<expected_value>(config_, model, s, live, counts, kRoundsPerStep);
       const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
-      if (expected_value) {
+      if constexpr (expected_value) {
         // A photon's scored exit (or roulette) goes before its end, if it
         // ended this step.
         const std::uint64_t scored = life::lane_bits(
@@ -420,7 +433,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       }
       if (finished != 0) {
         const int n_before = done->n;
-        hand_over(model, s, phi_lanes, photon, slot, finished, *done);
+        hand_over<expected_value>(model, s, phi_lanes, photon, slot, finished, *done);
         if constexpr (kLosses) hand_over_losses(s.losses.slot, finished, n_before, pool, *done);
       }
       if constexpr (kLosses)
@@ -428,7 +441,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
       if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
       life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
-      if (expected_value) life::pack_store(slot, in_flight, pool.bits[Pool::kSlot] + kept);
+      if constexpr (expected_value) life::pack_store(slot, in_flight, pool.bits[Pool::kSlot] + kept);
       kept += std::popcount(in_flight);
     }
     n_active = kept;

@@ -93,7 +93,8 @@ ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lob
       medulla_sigma_a_(std::move(medulla_sigma_a)),
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()), expected_value_(expected_value),
-      bins_per_lobe_(static_cast<std::size_t>(grid.n_theta()) * grid.n_phi()),
+      absorption_(expected_value ? sigma_a_.size() * FinishedPhotons::kCapacity : 0),
+      fixed_(sigma_a_.size()), growth_(sigma_a_.size()), lobe_growth_(sigma_a_.size()),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -129,7 +130,20 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   for (int c = 0; c < channels; ++c) {
     const Batch minus_sigma(-sigma_a_[c]);
     double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
-    if (medulla_sigma_a_.empty()) {
+    if (expected_value_) {
+      // Beer-Lambert's factor kept apart: Russian roulette's rows need it
+      // without the row's weight.
+      double* a = absorption_.data() + static_cast<std::size_t>(c) * kCap;
+      const Batch minus_medulla(medulla_sigma_a_.empty() ? 0.0 : -medulla_sigma_a_[c]);
+      for (int i = 0; i < f.n; i += W) {
+        Batch exponent = minus_sigma * Batch::load_aligned(f.path + i);
+        if (!medulla_sigma_a_.empty())
+          exponent = exponent + minus_medulla * Batch::load_aligned(f.medulla_path + i);
+        const Batch factor = xsimd::exp(exponent);
+        factor.store_unaligned(a + i);
+        (Batch::load_aligned(f.weight + i) * factor).store_unaligned(w + i);
+      }
+    } else if (medulla_sigma_a_.empty()) {
       for (int i = 0; i < f.n; i += W)
         (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
             .store_unaligned(w + i);
@@ -152,6 +166,7 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     bin[i] = tally.bin_index(lobe, static_cast<int>(theta_bin[i]),
                              static_cast<int>(phi_bin[i]));
     tally.prefetch(bin[i]);
+    if (expected_value_) lobe_[i] = lobe;
   }
   if (expected_value_) {
     score_rows_expected_value(f, bin, tally);
@@ -182,24 +197,25 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
 }
 
 // A photon's rows in order (sim/life/finished_photons.h): its exits added up
-// per bin, each row's weight booked in fixed point within the room its
-// earlier rows left of its unit weight (plus what Russian roulette created
-// for it), the weight roulette created or destroyed booked in the ledger's
-// roulette term, and its masking losses (at its last row) booked against
-// all it kept.
+// per bin and per lobe, each row's weight booked in fixed point within the
+// room its earlier rows left of its unit weight (plus what Russian roulette
+// created for it), the weight roulette created or destroyed booked in the
+// ledger's roulette term, and its masking losses (at its last row) booked
+// against all it kept.
 void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin,
                                            Tally& tally) {
   constexpr int kCap = FinishedPhotons::kCapacity;
   const int channels = static_cast<int>(sigma_a_.size());
   double* weight = one_photon_.data();
+  reserve_slots(f);
   std::size_t j = 0;  // the next of f.losses (in row order)
   for (int i = 0; i < f.n; ++i) {
-    OpenPhoton& p = open_photon(f.slot[i]);
-    if (!f.last[i] && f.roulette[i] != 0.0) score_roulette(f, i, p, tally);
+    const std::uint32_t slot = f.slot[i];
+    if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
     if (f.exited[i]) {
-      score_scored_exit(bin[i], weights_.data() + i, kCap, p, tally);
+      score_scored_exit(f, i, bin[i], tally);
     } else if (f.last[i] && !f.lost[i] && !f.ended[i]) {
-      book(weights_.data() + i, kCap, p);
+      book(weights_.data() + i, kCap, slot);
       tally.score_truncated_fixed(fixed_.data());
     }
     if (!f.last[i]) continue;
@@ -210,30 +226,35 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
         for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
       }
       // Room for the losses: 1 + created - booked (Tally::score_lost's 1 - kept).
-      fixed_.resize(channels);
-      for (int c = 0; c < channels; ++c) fixed_[c] = p.booked[c] - p.created[c];
+      const std::size_t at = static_cast<std::size_t>(slot) * channels;
+      for (int c = 0; c < channels; ++c) fixed_[c] = booked_[at + c] - created_[at + c];
       tally.score_lost(weight, fixed_.data());
     }
-    for (std::size_t e = 0; e < p.lobes.size(); ++e)
-      tally.score_lobe_square(p.lobes[e], p.lobe_totals.data() + e * channels);
-    p.lobes.clear();
-    p.lobe_totals.clear();
-    p.bins.clear();
-    p.totals.clear();
-    std::fill(p.booked.begin(), p.booked.end(), Tally::Fixed{0});
-    std::fill(p.created.begin(), p.created.end(), Tally::Fixed{0});
+    end_photon(slot);
   }
 }
 
-ExitScorer::OpenPhoton& ExitScorer::open_photon(std::uint32_t slot) {
-  if (slot >= open_.size()) {
-    open_.resize(slot + 1);
-    for (OpenPhoton& p : open_) {
-      p.booked.resize(sigma_a_.size(), Tally::Fixed{0});
-      p.created.resize(sigma_a_.size(), Tally::Fixed{0});
-    }
-  }
-  return open_[slot];
+// Room for every slot the block uses (once: slots are the tracer's, a
+// pool's worth).
+void ExitScorer::reserve_slots(const FinishedPhotons& f) {
+  std::uint32_t top = 0;
+  for (int i = 0; i < f.n; ++i) top = std::max(top, f.slot[i]);
+  if (top < runs_.size()) return;
+  const std::size_t slots = top + 1, channels = sigma_a_.size();
+  booked_.resize(slots * channels, Tally::Fixed{0});
+  created_.resize(slots * channels, Tally::Fixed{0});
+  lobe_total_.resize(slots * channels, 0.0);
+  runs_.resize(slots);
+}
+
+void ExitScorer::end_photon(std::uint32_t slot) {
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  std::fill_n(booked_.begin() + at, channels, Tally::Fixed{0});
+  std::fill_n(created_.begin() + at, channels, Tally::Fixed{0});
+  Run& run = runs_[slot];
+  run.lobe = -1;
+  run.bins.clear();
+  run.totals.clear();
 }
 
 // One row's weight in fixed point, into fixed_: at most the room the
@@ -243,19 +264,18 @@ ExitScorer::OpenPhoton& ExitScorer::open_photon(std::uint32_t slot) {
 // leave the ledger's absorbed (the complement) a few units below 0. More
 // than rounding (Tally::kRoundingAllowance) is a booking error: an internal
 // error, never clamped.
-void ExitScorer::book(const double* weight, std::size_t stride, OpenPhoton& p) {
-  const std::size_t channels = sigma_a_.size();
-  fixed_.resize(channels);
+void ExitScorer::book(const double* weight, std::size_t stride, std::uint32_t slot) {
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
-    const Tally::Fixed room = Tally::kOne + p.created[c] - p.booked[c];
+    const Tally::Fixed room = Tally::kOne + created_[at + c] - booked_[at + c];
     if (w > room) {
       if (w - room > Tally::kRoundingAllowance)
         throw Error(fmt::format("internal error: a photon's exits and truncated weight exceed 1 "
                                 "(channel {}) by more than rounding", c));
       w = room;
     }
-    p.booked[c] += w;
+    booked_[at + c] += w;
     fixed_[c] = w;
   }
 }
@@ -264,61 +284,63 @@ void ExitScorer::book(const double* weight, std::size_t stride, OpenPhoton& p) {
 // the path to it: weight created widens the photon's room; weight destroyed
 // is booked like an exit (within the room), and the ledger's roulette term
 // gains the signed amount.
-void ExitScorer::score_roulette(const FinishedPhotons& f, int i, OpenPhoton& p, Tally& tally) {
-  const std::size_t channels = sigma_a_.size();
+void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const std::size_t channels = sigma_a_.size(), at = f.slot[i] * channels;
   const double r = f.roulette[i];
-  growth_.resize(channels);
-  for (std::size_t c = 0; c < channels; ++c) {
-    double exponent = -sigma_a_[c] * f.path[i];
-    if (!medulla_sigma_a_.empty()) exponent -= medulla_sigma_a_[c] * f.medulla_path[i];
-    growth_[c] = std::abs(r) * std::exp(exponent);
-  }
+  for (std::size_t c = 0; c < channels; ++c) growth_[c] = std::abs(r) * absorption_[c * kCap + i];
   if (r > 0.0) {
-    fixed_.resize(channels);
     for (std::size_t c = 0; c < channels; ++c) {
       fixed_[c] = Tally::to_fixed(growth_[c]);
-      p.created[c] += fixed_[c];
+      created_[at + c] += fixed_[c];
     }
   } else {
-    book(growth_.data(), 1, p);
+    book(growth_.data(), 1, f.slot[i]);
     for (std::size_t c = 0; c < channels; ++c) fixed_[c] = -fixed_[c];
   }
   tally.score_roulette_fixed(fixed_.data());
 }
 
-void ExitScorer::score_scored_exit(std::size_t bin, const double* weight, std::size_t stride,
-                                   OpenPhoton& p, Tally& tally) {
-  const std::size_t channels = sigma_a_.size();
-  book(weight, stride, p);
-  growth_.resize(channels);
-  // The photon's total in the bin's lobe (the lobe's S2 holds its square).
-  const int lobe = static_cast<int>(bin / bins_per_lobe_);
-  std::size_t entry = 0;
-  while (entry < p.lobes.size() && p.lobes[entry] != lobe) ++entry;
-  if (entry == p.lobes.size()) {
-    p.lobes.push_back(lobe);
-    p.lobe_totals.insert(p.lobe_totals.end(), channels, 0.0);
+// Row i's exit in `bin`: the bin's S2 grows by (t + w)^2 - t^2 = w (2 t + w)
+// with t the photon's total in the bin so far, so that it ends with the
+// square of the photon's total (SPEC section 6); the lobe's likewise.
+void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const std::uint32_t slot = f.slot[i];
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  const double* weight = weights_.data() + i;
+  book(weight, kCap, slot);
+  Run& run = runs_[slot];
+  double* lobe_total = lobe_total_.data() + at;
+  if (run.lobe != lobe_[i]) {
+    run.lobe = lobe_[i];
+    run.bins.clear();
+    run.totals.clear();
+    std::fill_n(lobe_total, channels, 0.0);
   }
-  for (std::size_t c = 0; c < channels; ++c) p.lobe_totals[entry * channels + c] += weight[c * stride];
-  for (std::size_t e = 0; e < p.bins.size(); ++e) {
-    if (p.bins[e] != bin) continue;
-    // (t + w)^2 - t^2 = w (2 t + w): S2 ends with the square of the photon's total.
-    double* total = p.totals.data() + e * channels;
+  for (std::size_t c = 0; c < channels; ++c) {
+    const double w = weight[c * kCap];
+    lobe_growth_[c] = w * (2.0 * lobe_total[c] + w);
+    lobe_total[c] += w;
+  }
+  for (std::size_t e = 0; e < run.bins.size(); ++e) {
+    if (run.bins[e] != bin) continue;
+    double* total = run.totals.data() + e * channels;
     for (std::size_t c = 0; c < channels; ++c) {
-      const double w = weight[c * stride];
+      const double w = weight[c * kCap];
       growth_[c] = w * (2.0 * total[c] + w);
       total[c] += w;
     }
-    tally.score_exit_fixed(bin, fixed_.data(), growth_.data(), false);
+    tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), false);
     return;
   }
+  run.bins.push_back(bin);
   for (std::size_t c = 0; c < channels; ++c) {
-    const double w = weight[c * stride];
+    const double w = weight[c * kCap];
     growth_[c] = w * w;
-    p.totals.push_back(w);
+    run.totals.push_back(w);
   }
-  p.bins.push_back(bin);
-  tally.score_exit_fixed(bin, fixed_.data(), growth_.data(), true);
+  tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), true);
 }
 
 }  // namespace fiberlab::sim

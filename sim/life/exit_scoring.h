@@ -40,26 +40,35 @@ class ExitScorer {
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
   bool expected_value_;
-  std::size_t bins_per_lobe_;  // a bin index / this = its lobe (Tally::bin_index)
-  // Per slot, the photon in it so far: the bins it left in with its total
-  // weight there ([entry][channel]), and its exited weight ([channel]).
-  // weight so far in fixed point ([channel]: what it booked in the tally).
-  struct OpenPhoton {
+  // Expected-value scoring: per row of a block, Beer-Lambert's factor
+  // ([channel][row]; weights_ is the row's weight times it) and lobe.
+  std::vector<double> absorption_;
+  int lobe_[FinishedPhotons::kCapacity];
+  // Per slot (sim/life/finished_photons.h), the photon in it so far, in flat
+  // arrays sized once per slot ([slot][channel]): the weight it booked in
+  // fixed point, and what Russian roulette created for it; the lobe of its
+  // latest exit and its total there. A photon's lobes never decrease along
+  // its rows (min(p, L - 1) with p growing; the medulla's `scattered` once
+  // scattered), so its exits in one lobe are consecutive: its Run holds the
+  // bins of the current lobe with its total in each, and is emptied when
+  // the lobe changes. A Run's vectors keep their capacity: no allocation per
+  // photon once the runs have met their longest.
+  struct Run {
+    int lobe = -1;
     std::vector<std::size_t> bins;
-    std::vector<double> totals;
-    std::vector<Tally::Fixed> booked;
-    std::vector<Tally::Fixed> created;  // [channel]: weight Russian roulette created for it
-    std::vector<int> lobes;             // the lobes it left in, with its total there
-    std::vector<double> lobe_totals;    // ([entry][channel]), for Tally::score_lobe_square
+    std::vector<double> totals;  // [entry][channel]
   };
-  std::vector<OpenPhoton> open_;
+  std::vector<Tally::Fixed> booked_, created_;
+  std::vector<double> lobe_total_;
+  std::vector<Run> runs_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
-  std::vector<double> growth_;        // [channel]: one row's S2 growth
-  OpenPhoton& open_photon(std::uint32_t slot);
-  void book(const double* weight, std::size_t stride, OpenPhoton& p);
-  void score_scored_exit(std::size_t bin, const double* weight, std::size_t stride, OpenPhoton& p,
-                         Tally& tally);
-  void score_roulette(const FinishedPhotons& f, int i, OpenPhoton& p, Tally& tally);
+  std::vector<double> growth_;        // [channel]: one row's bin S2 growth
+  std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
+  void reserve_slots(const FinishedPhotons& f);
+  void book(const double* weight, std::size_t stride, std::uint32_t slot);
+  void score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally);
+  void score_roulette(const FinishedPhotons& f, int i, Tally& tally);
+  void end_photon(std::uint32_t slot);
   void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within
   // a margin), so that most vectors of bins need no settling on the edges.

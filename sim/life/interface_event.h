@@ -37,21 +37,14 @@ struct EventResult {
 // Which lanes may score their leaving branch by its expected value at this
 // event (`eligible`, within the acting lanes), and what decides whether that
 // branch leaves: the photon's side and the untilted outward normal n0 (the
-// consistency rule of SPEC section 3). `on` false: every choice is analog,
-// with the same random numbers as without this argument.
+// consistency rule of SPEC section 3). interact() without it makes every
+// choice analog (the analog estimator; the medulla's interface events,
+// sim/life/medulla.h, none of whose branches leaves the fiber).
 template <class T>
 struct ExitScoring {
-  bool on;
   MaskOf<T> eligible, inside;
   Vec3Of<T> n0;
 };
-
-// Analog choices (the medulla's interface events, sim/life/medulla.h: none
-// of their branches leaves the fiber).
-template <class T>
-ExitScoring<T> analog_choices() {
-  return {false, MaskOf<T>(false), MaskOf<T>(false), {}};
-}
 
 // The branch that leaves the fiber at once, if it does: reflection for a
 // photon outside, refraction (none under total internal reflection) for one
@@ -85,20 +78,33 @@ struct ScalarLight {
   using Rebind = ScalarLight<U>;
   explicit ScalarLight(const Vec3Of<T>& /*d*/ = {}) {}
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
-                          const MaskOf<T>& act, LaneRandom<T>& rng,
-                          const ExitScoring<T>& e = analog_choices<T>()) {
+                          const MaskOf<T>& act, LaneRandom<T>& rng) {
+    return interact_as<false>(d, m, n, act, rng, {});
+  }
+  EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+    return interact_as<true>(d, m, n, act, rng, e);
+  }
+
+ private:
+  template <bool kScore>
+  EventResult<T> interact_as(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                             const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
     // F uses the true 3D angle between d and m (SPEC section 3).
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     const FresnelReflectanceOf<T> f = fresnel_reflectance(cos_i, n.eta_rel, n.ratio);
     EventResult<T> r{{}, {}, MaskOf<T>(false), {}, T(0.0)};
-    if (e.on) {
+    MaskOf<T> reflect;
+    if constexpr (kScore) {
       r.scored = leaving_branch(e, d, m, f.tir, cos_i, f.cos_t, n.ratio, r.leave_direction);
       r.p_leave = select(e.inside, T(1.0) - f.F, f.F);
+      // Where the leaving branch is scored, the photon takes the other one:
+      // it reflects when inside.
+      reflect = f.tir | (r.scored & e.inside) |
+                ((!r.scored) & (rng.uniform(act & !f.tir & !r.scored) < f.F));
+    } else {
+      reflect = f.tir | (rng.uniform(act & !f.tir) < f.F);
     }
-    // Where the leaving branch is scored, the photon takes the other one:
-    // it reflects when inside.
-    const MaskOf<T> reflect = f.tir | (r.scored & e.inside) |
-                              ((!r.scored) & (rng.uniform(act & !f.tir & !r.scored) < f.F));
     r.direction = scatter_direction(d, m, reflect, cos_i, f.cos_t, n.ratio);
     r.refracted = !reflect;
     return r;
@@ -129,8 +135,18 @@ struct StokesLight {
   }
 
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
-                          const MaskOf<T>& act, LaneRandom<T>& rng,
-                          const ExitScoring<T>& e = analog_choices<T>()) {
+                          const MaskOf<T>& act, LaneRandom<T>& rng) {
+    return interact_as<false>(d, m, n, act, rng, {});
+  }
+  EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+    return interact_as<true>(d, m, n, act, rng, e);
+  }
+
+ private:
+  template <bool kScore>
+  EventResult<T> interact_as(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                             const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     // Turn the reference axis about d to the event's s-axis s = d x m / |d x m|;
     // (Q, U) rotate by 2 psi, cos psi = e1.s, sin psi = (d x e1).s. At
@@ -157,14 +173,17 @@ struct StokesLight {
     const T c_t = sqrt(max(T(0.0), ts * tp));
     const T p_reflect = a_r + b_r * q1;
     EventResult<T> res{{}, {}, MaskOf<T>(false), {}, T(0.0)};
-    if (e.on) {
+    MaskOf<T> reflect;
+    if constexpr (kScore) {
       res.scored = leaving_branch(e, d, m, tir, cos_i, r.cos_t, n.ratio, res.leave_direction);
       // The first row of the transmission matrix times the Stokes vector:
       // A_T + B_T Q = 1 - (A_R + B_R Q).
       res.p_leave = select(e.inside, T(1.0) - p_reflect, p_reflect);
+      reflect = tir | (res.scored & e.inside) |
+                ((!res.scored) & (rng.uniform(act & !tir & !res.scored) < p_reflect));
+    } else {
+      reflect = tir | (rng.uniform(act & !tir) < p_reflect);
     }
-    const MaskOf<T> reflect = tir | (res.scored & e.inside) |
-                              ((!res.scored) & (rng.uniform(act & !tir & !res.scored) < p_reflect));
     const T A = select(reflect, a_r, a_t), B = select(reflect, b_r, b_t);
     const T C = select(reflect, c_r, c_t), S = select(reflect, s_r, T(0.0));
     const T inv_i = T(1.0) / (A + B * q1);

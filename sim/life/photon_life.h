@@ -153,8 +153,9 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
 // section 3): draw the normal, reflect or refract, apply the consistency
 // rule (the new direction must leave the boundary on the photon's new side,
 // judged with the untilted normal; otherwise another event at the same
-// point, at most max_events).
-template <class T, class Model, class Light>
+// point, at most max_events). kExpectedValue: c.expected_value, fixed at
+// compile time so that the analog life carries no code of the other.
+template <bool kExpectedValue, class T, class Model, class Light>
 void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
                      const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
   const MaskOf<T> inside = s.inside != T(0.0);
@@ -169,10 +170,14 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   const MaskOf<T> act = f.ready;  // never failed too (sim/roughness/roughness_model.h)
   const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
                                 select(inside, T(c.eta), T(1.0 / c.eta))};
-  const ExitScoring<T> scoring{c.expected_value, act, inside, n0};
-  const EventResult<T> r = s.light.interact(s.d, f.m, index, act, s.rng, scoring);
+  EventResult<T> r;
+  if constexpr (kExpectedValue) {
+    r = s.light.interact(s.d, f.m, index, act, s.rng, ExitScoring<T>{act, inside, n0});
+    score_leaving_branch(model, s, r, frame, f.m, inside);
+  } else {
+    r = s.light.interact(s.d, f.m, index, act, s.rng);
+  }
   const Vec3Of<T> d = select(act, r.direction, s.d);
-  if (c.expected_value) score_leaving_branch(model, s, r, frame, f.m, inside);
   MaskOf<T> lost(false);
   if constexpr (HasEventWeight<Model, T>) {
     const EventWeight<T> w =
@@ -251,12 +256,19 @@ MaskOf<T> russian_roulette(PhotonState<T, Light>& s, const MaskOf<T>& live) {
 
 // One step of the life for the photons in `live`, all at a boundary point:
 // an interface event, then the next segment for those that go on inside.
-template <class T, class Model, class Light>
+// kExpectedValue must be c.expected_value (the tracers choose the
+// instantiation once per run).
+template <bool kExpectedValue, class T, class Model, class Light>
 void step(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
           const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
-  const MaskOf<T> go = c.expected_value ? russian_roulette(s, live) : live;
-  interface_event(c, model, s, go, counts, rounds);
-  travel(c, s, go);
+  if constexpr (kExpectedValue) {
+    const MaskOf<T> go = russian_roulette(s, live);
+    interface_event<true>(c, model, s, go, counts, rounds);
+    travel(c, s, go);
+  } else {
+    interface_event<false>(c, model, s, live, counts, rounds);
+    travel(c, s, live);
+  }
 }
 
 }  // namespace fiberlab::sim::life

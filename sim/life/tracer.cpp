@@ -24,7 +24,10 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   life::LifeCounts<double> counts;
   std::vector<ScoredExitOutcome> scored;
   while (s.code == static_cast<double>(life::kAtBoundary)) {
-    step(config_, model, s, true, counts, kMaxNormalTries);
+    if (config_.expected_value)
+      step<true>(config_, model, s, true, counts, kMaxNormalTries);
+    else
+      step<false>(config_, model, s, true, counts, kMaxNormalTries);
     if (config_.expected_value && (s.scored.weight > 0.0 || s.scored.roulette != 0.0)) {
       const int p = static_cast<int>(s.scored.segments);
       Vec3 d = s.scored.d.to_vec3();

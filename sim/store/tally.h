@@ -63,14 +63,22 @@ class Tally {
   // exits, its S1 already in fixed point (s1[c], booked so that the photon's
   // parts never exceed its unit weight: see ExitScorer), S2 growing by
   // s2_growth[c] (the growth of the square of the photon's total in the bin),
-  // the count by one when this is the photon's first exit in the bin.
-  void score_exit_fixed(std::size_t bin, const Fixed* s1, const double* s2_growth, bool first) {
+  // the count by one when this is the photon's first exit in the bin, and
+  // the bin's lobe's sum of squares of photon totals by lobe_growth[c] (a
+  // photon may leave in several bins of a lobe, and the lobe's standard
+  // error needs the sum over photons of the square of its total there, not
+  // the sum of its bins' S2; the analog estimator books none: there each
+  // photon leaves once and the lobe's S2 is its bins' S2).
+  void score_exit_fixed(std::size_t bin, int lobe_of_bin, const Fixed* s1, const double* s2_growth,
+                        const double* lobe_growth, bool first) {
     touched_[bin / kPageBins] = 1;
     Fixed* cell = cells() + bin * block();
     cell[0] += first ? 1 : 0;
+    Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels_;
     for (int c = 0; c < channels_; ++c) {
       cell[1 + c] += s1[c];
       cell[1 + channels_ + c] += to_fixed(s2_growth[c]);
+      lobe[c] += to_fixed(lobe_growth[c]);
     }
   }
   // A photon's truncated weight, already in fixed point.
@@ -83,15 +91,6 @@ class Tally {
   // = launched (sim/life/photon_life.h kRouletteBelow).
   void score_roulette_fixed(const Fixed* delta) {
     for (int c = 0; c < channels_; ++c) roulette_[c] += delta[c];
-  }
-  // The square of one photon's total weight[c] in `lobe` (expected-value
-  // scoring: a photon may leave in several bins of a lobe, and the lobe's
-  // standard error needs the sum over photons of the square of its total
-  // there, not the sum of its bins' S2). The analog estimator books none:
-  // there each photon leaves once and the lobe's S2 is its bins' S2.
-  void score_lobe_square(int lobe, const double* total) {
-    Fixed* s = lobe_sq_.data() + static_cast<std::size_t>(lobe) * channels_;
-    for (int c = 0; c < channels_; ++c) s[c] += to_fixed(total[c] * total[c]);
   }
   static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static constexpr Fixed kOne = Fixed{1} << 60;
@@ -182,7 +181,7 @@ class Tally {
   std::vector<Fixed> truncated_;
   std::vector<Fixed> lost_;
   std::vector<Fixed> roulette_;  // signed
-  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_lobe_square
+  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_exit_fixed's lobe_growth
 };
 
 }  // namespace fiberlab::sim
