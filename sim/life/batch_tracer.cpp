@@ -199,8 +199,10 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
 
 // The exits that the lanes `lanes` scored by expected value this step, and
 // the weight Russian roulette created or destroyed there (PhotonState::scored),
-// appended to the block f as rows that are not the photon's last
-// (sim/life/finished_photons.h). A model's exit direction draws
+// appended to the block f (sim/life/finished_photons.h): rows on the
+// photon's way, except for a photon that Russian roulette ended this step
+// (fate Ended, nothing left to score), whose row is also its last. A model's
+// exit direction draws
 // from the stream scored_exit_stream derives (sim/life/tracer.h), as the
 // reference Tracer does.
 template <class Model, class Light>
@@ -227,12 +229,14 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
   pack_store(slot, lanes, slots);
   alignas(64) double segments[W];
   pack_store(s.scored.segments, lanes, segments);
+  const std::uint64_t ended =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = false;
-    f.ended[n + j] = false;
-    f.last[n + j] = false;
+    f.ended[n + j] = (ended >> j) & 1;
+    f.last[n + j] = (ended >> j) & 1;
     f.scattered[n + j] = (scattered >> j) & 1;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
   }
@@ -261,6 +265,23 @@ void hand_over_losses(const Lanes& list, std::uint64_t lanes, int n, Pool& pool,
   life::pack_store(list, lanes, index);
   const int k = std::popcount(lanes);
   for (int j = 0; j < k; ++j) {
+    const int i = static_cast<int>(index[j]);
+    for (const WeightLoss& l : pool.loss_lists[i]) f.losses.push_back({n + j, l});
+    pool.loss_lists[i].clear();
+    pool.free_lists[pool.n_free++] = i;
+  }
+}
+
+// The same for the lanes `ended` among the lanes `scored` whose rows are
+// slots [n, ...) in their order (hand_over_scored: a photon that Russian
+// roulette ended has its last row there).
+void hand_over_losses_of_ended(const Lanes& list, std::uint64_t scored, std::uint64_t ended, int n,
+                               Pool& pool, FinishedPhotons& f) {
+  alignas(64) double index[W];
+  life::pack_store(list, scored, index);
+  const std::uint64_t ended_rows = life::pack_bits(ended, scored);
+  for (std::uint64_t rest = ended_rows; rest != 0; rest &= rest - 1) {
+    const int j = std::countr_zero(rest);
     const int i = static_cast<int>(index[j]);
     for (const WeightLoss& l : pool.loss_lists[i]) f.losses.push_back({n + j, l});
     pool.loss_lists[i].clear();
@@ -418,12 +439,20 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
+      std::uint64_t end_rows = finished;  // photons whose last row is handed over below
       if constexpr (expected_value) {
         // A photon's scored exit (or roulette) goes before its end, if it
-        // ended this step.
+        // ended this step; one that roulette ended ends on that row.
         const std::uint64_t scored = life::lane_bits(
             live & ((s.scored.weight > Lanes(0.0)) | (s.scored.roulette != Lanes(0.0))));
-        if (scored != 0) hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
+        const std::uint64_t ended = life::lane_bits(live & (s.code == Lanes(double(life::kEnded))));
+        end_rows = finished & ~ended;
+        if (scored != 0) {
+          const int n_before = done->n;
+          hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
+          if constexpr (kLosses)
+            if (ended != 0) hand_over_losses_of_ended(s.losses.slot, scored, ended, n_before, pool, *done);
+        }
         if (finished != 0) {
           alignas(64) std::uint64_t freed[W];
           life::pack_store(slot, finished, freed);
@@ -431,10 +460,10 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
             free_slots.push_back(static_cast<std::uint32_t>(freed[j]));
         }
       }
-      if (finished != 0) {
+      if (end_rows != 0) {
         const int n_before = done->n;
-        hand_over<expected_value>(model, s, phi_lanes, photon, slot, finished, *done);
-        if constexpr (kLosses) hand_over_losses(s.losses.slot, finished, n_before, pool, *done);
+        hand_over<expected_value>(model, s, phi_lanes, photon, slot, end_rows, *done);
+        if constexpr (kLosses) hand_over_losses(s.losses.slot, end_rows, n_before, pool, *done);
       }
       if constexpr (kLosses)
         life::pack_store(s.losses.slot, in_flight, pool.col[Pool::kLossList] + kept);

@@ -312,16 +312,19 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
   book(weight, kCap, slot);
   Run& run = runs_[slot];
   double* lobe_total = lobe_total_.data() + at;
-  if (run.lobe != lobe_[i]) {
+  // (A new lobe's total starts from 0 without being stored first: a store
+  // then load of the same numbers on every row would stall.)
+  const bool new_lobe = run.lobe != lobe_[i];
+  if (new_lobe) {
     run.lobe = lobe_[i];
     run.bins.clear();
     run.totals.clear();
-    std::fill_n(lobe_total, channels, 0.0);
   }
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
-    lobe_growth_[c] = w * (2.0 * lobe_total[c] + w);
-    lobe_total[c] += w;
+    const double t = new_lobe ? 0.0 : lobe_total[c];
+    lobe_growth_[c] = w * (2.0 * t + w);
+    lobe_total[c] = t + w;
   }
   for (std::size_t e = 0; e < run.bins.size(); ++e) {
     if (run.bins[e] != bin) continue;

@@ -6,7 +6,10 @@
 // A row is a photon's end (exited, truncated, lost or ended; `last`), or,
 // with expected-value scoring (Settings::estimator), a point on its way
 // (not `last`) where it scored an exit (`exited`, weight > 0), or Russian
-// roulette created or destroyed weight (`roulette` != 0), or both. A photon's rows come in the order it made them,
+// roulette created or destroyed weight (`roulette` != 0), or both. A
+// photon that Russian roulette ended (`ended`) may end on such a row (the
+// batched tracer's) or on a row of its own (the reference tracer's, through
+// add). A photon's rows come in the order it made them,
 // its end last, and carry the tracer's `slot` for the photon: no other
 // photon uses that slot until the photon's last row, so the scorer can add
 // up a photon's exits per bin (SPEC section 6: S2 holds the square of a
@@ -105,14 +108,16 @@ struct FinishedPhotons {
   }
   PhotonOutcome outcome(int i) const {
     PhotonOutcome o;
-    o.fate = exited[i] ? PhotonFate::Exited
-             : lost[i] ? PhotonFate::Lost
-             : ended[i] ? PhotonFate::Ended
-                        : PhotonFate::Truncated;
-    o.weight = weight[i];
+    // (An ended photon's last row may also hold an exit it scored there:
+    // that is not its fate, and it ends with nothing.)
+    o.fate = ended[i]    ? PhotonFate::Ended
+             : exited[i] ? PhotonFate::Exited
+             : lost[i]   ? PhotonFate::Lost
+                         : PhotonFate::Truncated;
+    o.weight = ended[i] ? 0.0 : weight[i];
     for (const Loss& l : losses)
       if (l.slot == i) o.losses.push_back(l.loss);
-    o.direction = Vec3(dx[i], dy[i], dz[i]);
+    o.direction = ended[i] ? Vec3(0.0, 0.0, 0.0) : Vec3(dx[i], dy[i], dz[i]);
     o.segments = segments[i];
     o.path_length = path[i];
     o.medulla_path = medulla_path[i];

@@ -29,19 +29,31 @@
 namespace fiberlab::sim::life {
 
 // Russian roulette with expected-value scoring of exits (SPEC section 5;
-// docs/PHYSICS.md "Estimator"): a photon at a boundary point whose
-// throughput weight w has fallen below kRouletteBelow survives with
-// probability w / kRouletteWeight and then carries kRouletteWeight, else its
-// path ends (fate Ended). The expectation of its weight is w either way, so
-// every tally is unbiased; the weight created (kRouletteWeight - w) and
-// destroyed (w) is booked, absorbed along the path so far, in the signed
-// ledger term `roulette`, whose expectation is 0. At 0.03 most photons have
-// scored their R, TT and TRT exits first (w ~ F ~ 0.05 after TT on a smooth
-// fiber, ~F^2 after TRT). Of the pairs (below, weight) tried, (0.003, 0.05),
-// (0.01, 0.05 / 0.1 / 0.25 / 1) and (0.03, 0.3), this one gave the most error
-// per second on bench/configs cases b and c (docs/PHYSICS.md "Estimator").
+// docs/PHYSICS.md "Estimator"): right after an interface event, a photon
+// still in the fiber whose throughput weight w is below the threshold
+// survives with probability w / (the weight it then carries), else its path
+// ends (fate Ended). The expectation of its weight is w either way, so every
+// tally is unbiased; the weight created and destroyed is booked, absorbed
+// along the path so far, in the signed ledger term `roulette`, whose
+// expectation is 0. Two regimes, by the photon's segments p at the event:
+// - p <= 1 (the first event and the TT point): below kRouletteBelow, carrying
+//   kRouletteWeight. After TT a smooth fiber leaves w ~ F ~ 0.05 > 0.03, so
+//   nearly every photon goes on to score TRT: TRT's error is what these
+//   weights buy.
+// - p >= kRouletteLateFrom (from the TRT point on): below 1, carrying 1, that
+//   is a photon goes on with probability w and then weight 1, as often as an
+//   analog photon would; without it every photon whose F stays high (light-
+//   guided paths) would be followed at a small weight to max_segments.
+// Of the settings measured with bench/figure_of_merit.py on cases b, c and
+// ggx ((0.03, 0.3), (0.05, 0.05), (0.1, 0.1), (0.2, 0.2), (1, 1) at every p;
+// (0.03, 0.3), (0.05, 0.05), (0.1, 0.1) with the late regime), this one gave
+// the TRT lobe the most error per second on b and c (docs/PHYSICS.md
+// "Estimator").
 inline constexpr double kRouletteBelow = 0.03;
 inline constexpr double kRouletteWeight = 0.3;
+inline constexpr double kRouletteLateFrom = 2.0;  // segments
+static_assert(kRouletteWeight >= kRouletteBelow && kRouletteWeight <= 1.0,
+              "a survivor must not play again at once, nor carry more than a photon starts with");
 
 // What a photon does next.
 // kEnded: ended by Russian roulette (expected-value scoring only).
@@ -71,8 +83,8 @@ struct LifeConfig {
 
 // The exit a photon scored at its last interface event by expected value
 // (weight 0: none), before its next segment: where and how it left; and the
-// weight Russian roulette created (> 0) or destroyed (< 0) before that event
-// (0: none), at the same path length. Not part of the photon's lasting state
+// weight Russian roulette created (> 0) or destroyed (< 0) right after that
+// event (0: none), at the same path length. Not part of the photon's lasting state
 // (the batched tracer hands it over after each step and does not keep it).
 template <class T>
 struct ScoredExit {
@@ -156,7 +168,7 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
 // point, at most max_events). kExpectedValue: c.expected_value, fixed at
 // compile time so that the analog life carries no code of the other.
 template <bool kExpectedValue, class T, class Model, class Light>
-void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
+MaskOf<T> interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
                      const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
   const MaskOf<T> inside = s.inside != T(0.0);
   const Vec3Of<T> n0 = c.ellipse.normal_at(s.px, s.py);
@@ -203,6 +215,7 @@ void interface_event(const LifeConfig& c, const Model& model, PhotonState<T, Lig
   const MaskOf<T> stuck = act & !consistent & !lost & (s.events_here >= T(c.max_events));
   s.code = select(stuck, T(kTruncated), code);
   counts.events = counts.events + ones<T>(act);
+  return act;
 }
 
 // One internal segment for the photons about to cross the fiber (SPEC
@@ -235,21 +248,30 @@ template <class T, class Light>
   s.code = select(stuck, T(kTruncated), s.code);
 }
 
-// Russian roulette (kRouletteBelow) for the photons in `live` at a boundary
-// point, before their interface event; gives back the lanes that go on.
-// Draws from a lane's stream only where it plays, so the analog estimator's
-// streams are untouched.
+// Russian roulette (kRouletteBelow) for the photons in `live` whose
+// interface event acted this step (`acted`), just after it and before their
+// next segment (a photon that ends here travels no further); gives back the
+// lanes that go on. Only a photon still in the fiber's life plays (kTravel,
+// or kAtBoundary: another event at the same point). A lane whose normal is
+// still being drawn (the batched tracer draws over several steps; the
+// reference tracer in one) does not play, so both tracers play at the same
+// events. Draws from a lane's stream only where it plays, so the analog
+// estimator's streams are untouched.
 template <class T, class Light>
-MaskOf<T> russian_roulette(PhotonState<T, Light>& s, const MaskOf<T>& live) {
+MaskOf<T> russian_roulette(PhotonState<T, Light>& s, const MaskOf<T>& live, const MaskOf<T>& acted) {
   s.scored.roulette = T(0.0);
-  const MaskOf<T> play = live & (s.weight < T(kRouletteBelow)) & (s.weight > T(0.0));
+  const MaskOf<T> going_on = (s.code == T(kTravel)) | (s.code == T(kAtBoundary));
+  const MaskOf<T> late = s.segments >= T(kRouletteLateFrom);
+  const T carry = select(late, T(1.0), T(kRouletteWeight));
+  const T below = select(late, T(1.0), T(kRouletteBelow));
+  const MaskOf<T> play = acted & going_on & (s.weight < below) & (s.weight > T(0.0));
   if (!any(play)) return live;
   const T u = s.rng.uniform(play);
-  const MaskOf<T> survive = play & (u * T(kRouletteWeight) < s.weight);
+  const MaskOf<T> survive = play & (u * carry < s.weight);
   const MaskOf<T> ended = play & !survive;
   s.scored.roulette =
-      select(survive, T(kRouletteWeight) - s.weight, select(ended, -s.weight, T(0.0)));
-  s.weight = select(survive, T(kRouletteWeight), select(ended, T(0.0), s.weight));
+      select(survive, carry - s.weight, select(ended, -s.weight, T(0.0)));
+  s.weight = select(survive, carry, select(ended, T(0.0), s.weight));
   s.code = select(ended, T(kEnded), s.code);
   return live & !ended;
 }
@@ -262,9 +284,8 @@ template <bool kExpectedValue, class T, class Model, class Light>
 void step(const LifeConfig& c, const Model& model, PhotonState<T, Light>& s,
           const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
   if constexpr (kExpectedValue) {
-    const MaskOf<T> go = russian_roulette(s, live);
-    interface_event<true>(c, model, s, go, counts, rounds);
-    travel(c, s, go);
+    const MaskOf<T> acted = interface_event<true>(c, model, s, live, counts, rounds);
+    travel(c, s, russian_roulette(s, live, acted));
   } else {
     interface_event<false>(c, model, s, live, counts, rounds);
     travel(c, s, live);

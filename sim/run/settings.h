@@ -18,7 +18,8 @@ enum class Polarization { Scalar, Stokes };
 // finally leaves. `expected_value`: at an event where one branch leaves the
 // fiber at once, that branch is scored with the weight times its probability
 // and the photon goes on along the other with the weight times one minus it
-// (Russian roulette once the weight is below life::kRouletteBelow).
+// (Russian roulette after an event once the weight is low:
+// life::kRouletteBelow, sim/life/photon_life.h).
 enum class Estimator { Analog, ExpectedValue };
 
 struct SourceSettings {

@@ -81,12 +81,12 @@ void expect_same_photons_with(const Settings& s, const std::string& what_estimat
               [&](const FinishedPhotons& f) {
                 for (int j = 0; j < f.n; ++j) {
                   const std::uint64_t i = f.photon[j];
-                  if (!f.last[j]) {
+                  // A photon that roulette ended ends on its row of that step.
+                  if (!f.last[j] || (f.ended[j] && (f.weight[j] > 0.0 || f.roulette[j] != 0.0)))
                     scored[i].push_back({Vec3(f.dx[j], f.dy[j], f.dz[j]), f.segments[j], f.path[j],
                                          f.weight[j], f.medulla_path[j], f.scattered[j],
                                          f.roulette[j]});
-                    continue;
-                  }
+                  if (!f.last[j]) continue;
                   batched[i] = f.outcome(j);
                   batched_phi[i] = f.phi_i[j];
                   ++seen[i];

@@ -66,6 +66,35 @@ TEST(Estimator, LedgerClosesPerPhoton) {
   expect_ledger_closes(s, "ggx 0.3 smith_g1");
 }
 
+// Russian roulette plays right after an interface event, before the next
+// segment (sim/life/photon_life.h step): a photon it ends travels no
+// further, so its end is at the point of its last row (the one with the
+// roulette term), and no more than that. Mutation caught: roulette before the
+// event (as a step's first action) leaves each ended photon one segment past
+// its last row.
+TEST(Estimator, RouletteEndsPhotonWhereItPlays) {
+  Settings s = testing::smooth_circle(17.0, 1);
+  s.estimator = Estimator::ExpectedValue;
+  s.fiber.eccentricity = 0.8;
+  s.fiber.sigma_a = {0.2, 0.4, 0.8};
+  testing::make_rough(s, 7.5, 3.0);
+  const Tracer tracer(s);
+  const auto inc = s.incidences().front();
+  int ended = 0;
+  for (std::uint64_t i = 0; i < 20000; ++i) {
+    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, false);
+    const PhotonOutcome o = tracer.trace(p.wi, p.h, p.rng);
+    if (o.fate != PhotonFate::Ended) continue;
+    ++ended;
+    ASSERT_FALSE(o.scored.empty()) << "photon " << i;
+    const ScoredExitOutcome& last = o.scored.back();
+    ASSERT_LT(last.roulette, 0.0) << "photon " << i;
+    EXPECT_EQ(o.segments, last.segments) << "photon " << i;
+    EXPECT_EQ(o.path_length, last.path_length) << "photon " << i;
+  }
+  EXPECT_GT(ended, 10000);  // most photons end by roulette
+}
+
 // The file's ledger: exited + truncated + lost = launched on a white fiber,
 // to rounding (absorbed is its complement).
 TEST(Estimator, FileLedgerClosesOnWhiteFiber) {
