@@ -40,6 +40,11 @@ Marginal marginal(const sim::ResultFile& r, const std::string& axis) {
             const std::size_t from = r.cell(k, l, i, j, c);
             const std::size_t to = ((k * L + l) * n + (theta ? i : j)) * C + c;
             s1[to] += r.weight_sum[from];
+            // Approximation under estimator expected_value: a photon that
+            // leaves in several bins of one marginal cell adds cross terms
+            // this sum of bins' S2 lacks (all >= 0), so the marginal's
+            // standard error is then a lower bound (docs/PHYSICS.md
+            // "Estimator"); exact for the analog estimator.
             s2[to] += r.weight_sq_sum[from];
           }
   Marginal out;

@@ -48,6 +48,11 @@ void print_summary(std::FILE* out, const sim::ResultFile& r) {
       for (int c = 0; c < r.channels; ++c)
         fmt::print(out, " {:>24}", fmt::format("{:.6f}", r.lost[k * r.channels + c] / N));
     }
+    if (r.settings.estimator == sim::Estimator::ExpectedValue) {  // signed, expectation 0
+      fmt::print(out, "\n  {:<10}", "roulette");
+      for (int c = 0; c < r.channels; ++c)
+        fmt::print(out, " {:>24}", fmt::format("{:+.3e}", r.roulette[k * r.channels + c] / N));
+    }
     fmt::print(out, "\n");
   }
 }

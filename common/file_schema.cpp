@@ -72,6 +72,16 @@ void describe_result_datasets(h5::File& f) {
   describe(f, "/ledger/lost", "incidence,channel", "weight",
            "weight removed by masking (roughness.masking smith_g1: 1 - G1 at each event, and paths "
            "killed on the wrong side of the mean surface); 0 otherwise (divide by N)");
+  if (f.exists("/tally/lobe_weight_sq_sum"))
+    describe(f, "/tally/lobe_weight_sq_sum", "incidence,lobe,channel", "weight^2",
+             "per lobe, the sum over photons of the square of each photon's total in the lobe "
+             "(estimator expected_value: a photon may leave in several bins of a lobe); the "
+             "lobe energy's standard error sqrt((S2/N - E^2)/(N - 1)), E = exited/N");
+  if (f.exists("/ledger/roulette"))
+    describe(f, "/ledger/roulette", "incidence,channel", "weight",
+             "signed: weight Russian roulette created minus weight it destroyed (estimator "
+             "expected_value), absorbed along the path before it; expectation 0; exited + "
+             "absorbed + truncated + lost - roulette = N (divide by N)");
   describe(f, "/fiber", "", "eta: 1, eccentricity: 1, scale_tilt: radians, sigma_a: 1/R per channel",
            "the fiber's parameters (attributes)");
   describe(f, "/roughness", "", "beta_long, beta_azim: radians; alpha: 1 (slope)",
@@ -92,6 +102,13 @@ void describe_exact_datasets(h5::File& f) {
   for (const char* name : {"absorbed", "truncated", "lost"})
     describe(f, std::string("/exact/") + name, "incidence,channel,word", "weight x 2^60",
              fmt::format("exact /ledger/{}: {}", name, pairs));
+  if (f.exists("/exact/lobe_weight_sq_sum"))
+    describe(f, "/exact/lobe_weight_sq_sum", "incidence,lobe,channel,word", "weight^2 x 2^60",
+             std::string("exact /tally/lobe_weight_sq_sum: ") + pairs);
+  if (f.exists("/exact/roulette"))
+    describe(f, "/exact/roulette", "incidence,channel,word", "weight x 2^60",
+             "exact /ledger/roulette: (high, low) 64-bit words of the exact sum x 2^60, a signed "
+             "128-bit integer in two's complement");
 }
 
 }  // namespace fiberlab

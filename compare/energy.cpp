@@ -53,6 +53,7 @@ EnergyCurve simulation_energy(const sim::ResultFile& r) {
   e.absorbed.assign(K * C, 0.0);
   e.truncated.assign(K * C, 0.0);
   e.lost.assign(K * C, 0.0);
+  e.roulette.assign(K * C, 0.0);
   e.ledger.assign(K * C, 0.0);
   for (std::size_t k = 0; k < K; ++k) {
     const double n = static_cast<double>(r.photons[k]);
@@ -70,8 +71,10 @@ EnergyCurve simulation_energy(const sim::ResultFile& r) {
       e.absorbed[k * C + c] = r.absorbed[k * C + c] / n;
       e.truncated[k * C + c] = r.truncated[k * C + c] / n;
       e.lost[k * C + c] = r.lost[k * C + c] / n;
-      e.ledger[k * C + c] =
-          (exited + r.absorbed[k * C + c] + r.truncated[k * C + c] + r.lost[k * C + c]) / n;
+      // (a ResultFile assembled without the term has none: 0)
+      e.roulette[k * C + c] = r.roulette.empty() ? 0.0 : r.roulette[k * C + c] / n;
+      e.ledger[k * C + c] = (exited + r.absorbed[k * C + c] + r.truncated[k * C + c] +
+                             r.lost[k * C + c]) / n - e.roulette[k * C + c];
     }
   }
   return e;

@@ -22,6 +22,7 @@ struct EnergyCurve {
   std::vector<double> theta_i;          // K, radians
   std::vector<double> lobe, lobe_error; // K x L x C (errors: simulation only, else 0)
   std::vector<double> absorbed, truncated, lost, ledger;  // K x C (simulation only)
+  std::vector<double> roulette;  // K x C (simulation only; signed, 0 but with expected_value)
 
   double at(std::size_t k, int l, int c) const { return lobe[(k * lobes + l) * channels + c]; }
   double error(std::size_t k, int l, int c) const { return lobe_error[(k * lobes + l) * channels + c]; }
@@ -32,7 +33,9 @@ struct EnergyCurve {
 
 // The simulation's ledger: exited per lobe / N (with the standard errors of
 // sim::lobe_energy), absorbed / N, truncated / N, lost / N (masking), and the
-// ledger sum (exited + absorbed + truncated + lost) / N, which is 1 to rounding.
+// Russian roulette's signed term / N (expected-value scoring), and the
+// ledger sum (exited + absorbed + truncated + lost - roulette) / N, which is
+// 1 to rounding.
 EnergyCurve simulation_energy(const sim::ResultFile& result);
 
 // A model's curve against a fiber with a medulla (docs/FUR.md): the models

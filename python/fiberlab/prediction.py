@@ -105,13 +105,13 @@ class Prediction:
         """Lobe energies as Result.energy has them (a LobeEnergy): mean (K, L, C)
         is the sum of the lobe's bin probabilities; std_err is 0 (no Monte
         Carlo noise); absorbed = 1 - the lobes' sum (what the model absorbs,
-        or does not place in any lobe); truncated and lost are 0 (a model
-        traces no paths)."""
+        or does not place in any lobe); truncated, lost and roulette are 0 (a
+        model traces no paths)."""
         from .result import LobeEnergy
         mean = self.probability.sum(axis=(2, 3))
         absorbed = 1.0 - mean.sum(axis=1)
         zero = np.zeros_like(absorbed)
-        return LobeEnergy(mean, np.zeros_like(mean), absorbed, zero, zero.copy())
+        return LobeEnergy(mean, np.zeros_like(mean), absorbed, zero, zero.copy(), zero.copy())
 
     @property
     def marginals(self):

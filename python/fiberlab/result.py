@@ -22,12 +22,16 @@ class LobeEnergy:
     """Fraction of the launched photons' weight per lobe (the ledger), with
     standard errors: mean and std_err (K, L, C); absorbed, truncated and lost
     (K, C). lost is the weight removed by masking (roughness.masking:
-    smith_g1), 0 otherwise; mean.sum(axis=1) + absorbed + truncated + lost = 1."""
+    smith_g1), 0 otherwise; roulette (K, C) is Russian roulette's signed term
+    (estimator: expected_value; 0 otherwise); mean.sum(axis=1) + absorbed +
+    truncated + lost - roulette = 1. With expected_value, std_err comes from
+    the per-lobe S2 of photon totals (/tally/lobe_weight_sq_sum)."""
     mean: np.ndarray
     std_err: np.ndarray
     absorbed: np.ndarray
     truncated: np.ndarray
     lost: np.ndarray
+    roulette: np.ndarray
 
 
 @dataclasses.dataclass(frozen=True)

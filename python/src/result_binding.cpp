@@ -81,7 +81,8 @@ py::tuple marginal(const Result& r, const std::string& axis) {
 }
 
 // The energy ledger (compare::simulation_energy): lobe energies with their
-// standard errors (K, L, C), absorbed, truncated and lost fractions (K, C).
+// standard errors (K, L, C), absorbed, truncated and lost fractions and
+// Russian roulette's signed term (K, C).
 py::dict energy(const Result& r) {
   const compare::EnergyCurve e = compare::simulation_energy(r);
   const py::ssize_t K = static_cast<py::ssize_t>(r.configs());
@@ -91,6 +92,7 @@ py::dict energy(const Result& r) {
   d["absorbed"] = to_array(e.absorbed, {K, r.channels});
   d["truncated"] = to_array(e.truncated, {K, r.channels});
   d["lost"] = to_array(e.lost, {K, r.channels});
+  d["roulette"] = to_array(e.roulette, {K, r.channels});
   return d;
 }
 

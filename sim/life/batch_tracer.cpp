@@ -34,7 +34,9 @@ struct Pool {
     kPhiI, kMedullaPath, kScatters, kLossList, kScalarColumns,
     kQ = kScalarColumns, kU, kV, kE1x, kE1y, kE1z, kColumns
   };
-  enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kBitColumns };
+  // kSlot: the photon's slot, for the scorer (sim/life/finished_photons.h;
+  // used with expected-value scoring only).
+  enum BitColumn { kS0, kS1, kS2, kS3, kPhoton, kSlot, kBitColumns };
   // W spare lanes past the end: new photons, and the photons in flight
   // packed to the front, are written a whole vector at a time from any lane
   // (BatchTracer::trace_with).
@@ -132,10 +134,13 @@ void exit_angles(FinishedPhotons& f) {
 // The photons of a vector whose lanes `lanes` finished this step, appended
 // to the block f (which has room for W more past them: sim/simd/lane_packing.h).
 // Their fates and exit directions as finished_outcome (sim/life/tracer.h) gives
-// them; a model's exit_direction needs each photon's own stream.
-template <class Model, class Light>
+// them; a model's exit_direction needs each photon's own stream. Slots
+// (sim/life/finished_photons.h) are kept with expected-value scoring only
+// (kExpectedValue); analog rows carry slot 0.
+template <bool kExpectedValue, class Model, class Light>
 void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, const Lanes& phi_i,
-               const life::BitsOf<Lanes>& photon, std::uint64_t lanes, FinishedPhotons& f) {
+               const life::BitsOf<Lanes>& photon, const life::BitsOf<Lanes>& slot,
+               std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
   if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
   const int n = f.n, k = std::popcount(lanes);
@@ -154,13 +159,21 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kExited))), lanes);
   const std::uint64_t truncated =
       life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kTruncated))), lanes);
-  const std::uint64_t lost = ~(exited | truncated);
   alignas(64) double segments[W];
   pack_store(s.segments, lanes, segments);
+  const std::uint64_t ended =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
+  const std::uint64_t lost = ~(exited | truncated | ended);
+  alignas(64) std::uint64_t slots[W] = {};
+  if constexpr (kExpectedValue) pack_store(slot, lanes, slots);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
     f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = (lost >> j) & 1;
+    f.ended[n + j] = (ended >> j) & 1;
+    f.last[n + j] = true;
+    f.roulette[n + j] = 0.0;
+    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
     f.scattered[n + j] = (scattered >> j) & 1;
   }
   // No exit direction for a photon that did not exit.
@@ -174,6 +187,65 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     for (int j = 0; j < k; ++j) {
       if (!f.exited[n + j]) continue;
       PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
+      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                       f.segments[n + j], rng);
+      f.dx[n + j] = d.x();
+      f.dy[n + j] = d.y();
+      f.dz[n + j] = d.z();
+    }
+  }
+  f.n = n + k;
+}
+
+// The exits that the lanes `lanes` scored by expected value this step, and
+// the weight Russian roulette created or destroyed there (PhotonState::scored),
+// appended to the block f (sim/life/finished_photons.h): rows on the
+// photon's way, except for a photon that Russian roulette ended this step
+// (fate Ended, nothing left to score), whose row is also its last. A model's
+// exit direction draws
+// from the stream scored_exit_stream derives (sim/life/tracer.h), as the
+// reference Tracer does.
+template <class Model, class Light>
+void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>& s,
+                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
+                      const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+  using life::pack_store;
+  if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
+  const int n = f.n, k = std::popcount(lanes);
+  pack_store(s.scored.d.x, lanes, f.dx + n);
+  pack_store(s.scored.d.y, lanes, f.dy + n);
+  pack_store(s.scored.d.z, lanes, f.dz + n);
+  pack_store(s.scored.path, lanes, f.path + n);
+  pack_store(s.scored.weight, lanes, f.weight + n);
+  pack_store(s.scored.roulette, lanes, f.roulette + n);
+  const std::uint64_t exited =
+      life::pack_bits(life::lane_bits(s.scored.weight > Lanes(0.0)), lanes);
+  pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
+  const std::uint64_t scattered =
+      life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
+  pack_store(phi_i, lanes, f.phi_i + n);
+  pack_store(photon, lanes, f.photon + n);
+  alignas(64) std::uint64_t slots[W];
+  pack_store(slot, lanes, slots);
+  alignas(64) double segments[W];
+  pack_store(s.scored.segments, lanes, segments);
+  const std::uint64_t ended =
+      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
+  for (int j = 0; j < k; ++j) {
+    f.segments[n + j] = static_cast<int>(segments[j]);
+    f.exited[n + j] = (exited >> j) & 1;
+    f.lost[n + j] = false;
+    f.ended[n + j] = (ended >> j) & 1;
+    f.last[n + j] = (ended >> j) & 1;
+    f.scattered[n + j] = (scattered >> j) & 1;
+    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
+  }
+  if constexpr (HasExitHook<Model>) {
+    alignas(64) std::uint64_t w[4][W];
+    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
+    for (int j = 0; j < k; ++j) {
+      if (!f.exited[n + j]) continue;
+      PhotonRandom rng = scored_exit_stream(w[0][j], w[1][j], w[2][j], w[3][j]);
       const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
                                        f.segments[n + j], rng);
       f.dx[n + j] = d.x();
@@ -200,6 +272,23 @@ void hand_over_losses(const Lanes& list, std::uint64_t lanes, int n, Pool& pool,
   }
 }
 
+// The same for the lanes `ended` among the lanes `scored` whose rows are
+// slots [n, ...) in their order (hand_over_scored: a photon that Russian
+// roulette ended has its last row there).
+void hand_over_losses_of_ended(const Lanes& list, std::uint64_t scored, std::uint64_t ended, int n,
+                               Pool& pool, FinishedPhotons& f) {
+  alignas(64) double index[W];
+  life::pack_store(list, scored, index);
+  const std::uint64_t ended_rows = life::pack_bits(ended, scored);
+  for (std::uint64_t rest = ended_rows; rest != 0; rest &= rest - 1) {
+    const int j = std::countr_zero(rest);
+    const int i = static_cast<int>(index[j]);
+    for (const WeightLoss& l : pool.loss_lists[i]) f.losses.push_back({n + j, l});
+    pool.loss_lists[i].clear();
+    pool.free_lists[pool.n_free++] = i;
+  }
+}
+
 }  // namespace
 
 BatchTracer::BatchTracer(const Settings& s)
@@ -212,15 +301,22 @@ void BatchTracer::trace(double theta_i, double phi_i, const PhotonFeed& feed, co
         using Model = std::decay_t<decltype(model)>;
         if constexpr (!life::RunsBatched<Model>) {
           throw Error("internal error: this roughness model runs on the reference tracer only");
-        } else if (settings_.polarization == Polarization::Stokes)
-          trace_with<life::StokesLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
-        else
-          trace_with<life::ScalarLight<Lanes>>(model, theta_i, phi_i, feed, sink, counters);
+        } else if (settings_.polarization == Polarization::Stokes) {
+          if (config_.expected_value)
+            trace_with<life::StokesLight<Lanes>, true>(model, theta_i, phi_i, feed, sink, counters);
+          else
+            trace_with<life::StokesLight<Lanes>, false>(model, theta_i, phi_i, feed, sink, counters);
+        } else {
+          if (config_.expected_value)
+            trace_with<life::ScalarLight<Lanes>, true>(model, theta_i, phi_i, feed, sink, counters);
+          else
+            trace_with<life::ScalarLight<Lanes>, false>(model, theta_i, phi_i, feed, sink, counters);
+        }
       },
       roughness_);
 }
 
-template <class Light, class Model>
+template <class Light, bool kExpectedValue, class Model>
 void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
                              const PhotonFeed& feed, const Sink& sink,
                              TracerCounters& counters) const {
@@ -237,6 +333,14 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   const Eigen::Vector2d beam = ellipse.beam_direction(-direction_from_angles(theta_i, phi_i));
   const Lanes iota = lane_index();
   life::LifeCounts<Lanes> counts;
+  // Free photon slots (expected-value scoring: sim/life/finished_photons.h).
+  constexpr bool expected_value = kExpectedValue;
+  std::vector<std::uint32_t> free_slots(expected_value ? kPoolLanes : 0);
+  for (int i = 0; i < static_cast<int>(free_slots.size()); ++i) free_slots[i] = static_cast<std::uint32_t>(kPoolLanes - 1 - i);
+  auto take_slot = [&](int lane) {
+    pool.bits[Pool::kSlot][lane] = free_slots.back();
+    free_slots.pop_back();
+  };
 
   // New photons into lanes [o, o + W), photons first, first + 1, ...: the
   // Source's streams and impact parameters and the life's start, a vector at
@@ -274,7 +378,12 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
   };
   // A pass over the pool appends at most every lane it holds, and a vector's
   // worth of scratch past them (sim/simd/lane_packing.h).
-  constexpr int kFlushAbove = FinishedPhotons::kCapacity - (kPoolLanes + W);
+  // With expected-value scoring every lane may also hand over an exit it
+  // scored: twice that. The analog estimator keeps blocks of at most half
+  // the capacity, whose columns stay in the caches as well as the scorer's.
+  constexpr int kFlushAbove = expected_value
+                                  ? FinishedPhotons::kCapacity - 2 * (kPoolLanes + W)
+                                  : FinishedPhotons::kCapacity / 2 - (kPoolLanes + W);
   static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
 
   // Photons [next, end) of the current run are still to launch.
@@ -296,13 +405,18 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         launch_vector(n_active, next);
         const int n = static_cast<int>(std::min<std::uint64_t>(
             std::min(W, kPoolLanes - n_active), end - next));
+        if constexpr (expected_value)
+          for (int j = 0; j < n; ++j) take_slot(n_active + j);
         if constexpr (kLosses)
           for (int i = n_active; i < n_active + n; ++i) pool.give_list(i);
         n_active += n;
         next += n;
       }
     } else {
-      while (n_active < kPoolLanes && more_to_launch()) launch(n_active++, next++);
+      while (n_active < kPoolLanes && more_to_launch()) {
+        if constexpr (expected_value) take_slot(n_active);
+        launch(n_active++, next++);
+      }
     }
     if (n_active == 0) break;
     if (done->n > kFlushAbove) flush();
@@ -319,20 +433,44 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
       // A fixed incident direction keeps phi_i out of the pool.
       const Lanes phi_lanes = vector_launch ? Lanes(phi_i) : load<Lanes>(pool.col[Pool::kPhiI] + o);
       const life::BitsOf<Lanes> photon = load_bits<Lanes>(pool.bits[Pool::kPhoton] + o);
-      life::step(config_, model, s, live, counts, kRoundsPerStep);
+      life::BitsOf<Lanes> slot;
+      if constexpr (expected_value) slot = load_bits<Lanes>(pool.bits[Pool::kSlot] + o);
+      life::step<expected_value>(config_, model, s, live, counts, kRoundsPerStep);
       const MaskOf<Lanes> at_boundary = s.code == Lanes(life::kAtBoundary);
       const std::uint64_t finished = life::lane_bits(live & !at_boundary);
       const std::uint64_t in_flight = life::lane_bits(live & at_boundary);
-      if (finished != 0) {
+      std::uint64_t end_rows = finished;  // photons whose last row is handed over below
+      if constexpr (expected_value) {
+        // A photon's scored exit (or roulette) goes before its end, if it
+        // ended this step; one that roulette ended ends on that row.
+        const std::uint64_t scored = life::lane_bits(
+            live & ((s.scored.weight > Lanes(0.0)) | (s.scored.roulette != Lanes(0.0))));
+        const std::uint64_t ended = life::lane_bits(live & (s.code == Lanes(double(life::kEnded))));
+        end_rows = finished & ~ended;
+        if (scored != 0) {
+          const int n_before = done->n;
+          hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
+          if constexpr (kLosses)
+            if (ended != 0) hand_over_losses_of_ended(s.losses.slot, scored, ended, n_before, pool, *done);
+        }
+        if (finished != 0) {
+          alignas(64) std::uint64_t freed[W];
+          life::pack_store(slot, finished, freed);
+          for (int j = 0; j < std::popcount(finished); ++j)
+            free_slots.push_back(static_cast<std::uint32_t>(freed[j]));
+        }
+      }
+      if (end_rows != 0) {
         const int n_before = done->n;
-        hand_over(model, s, phi_lanes, photon, finished, *done);
-        if constexpr (kLosses) hand_over_losses(s.losses.slot, finished, n_before, pool, *done);
+        hand_over<expected_value>(model, s, phi_lanes, photon, slot, end_rows, *done);
+        if constexpr (kLosses) hand_over_losses(s.losses.slot, end_rows, n_before, pool, *done);
       }
       if constexpr (kLosses)
         life::pack_store(s.losses.slot, in_flight, pool.col[Pool::kLossList] + kept);
       pool.put_state(s, [&](const auto& x, auto* column) { life::pack_store(x, in_flight, column + kept); });
       if (!vector_launch) life::pack_store(phi_lanes, in_flight, pool.col[Pool::kPhiI] + kept);
       life::pack_store(photon, in_flight, pool.bits[Pool::kPhoton] + kept);
+      if constexpr (expected_value) life::pack_store(slot, in_flight, pool.bits[Pool::kSlot] + kept);
       kept += std::popcount(in_flight);
     }
     n_active = kept;

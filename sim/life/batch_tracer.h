@@ -43,7 +43,9 @@ class BatchTracer {
   }
 
  private:
-  template <class Light, class Model>
+  // kExpectedValue: config_.expected_value, fixed at compile time so that
+  // the analog loop carries no code of the other estimator.
+  template <class Light, bool kExpectedValue, class Model>
   void trace_with(const Model& model, double theta_i, double phi_i, const PhotonFeed& feed,
                   const Sink& sink, TracerCounters& counters) const;
 

@@ -1,10 +1,12 @@
 #include "sim/life/exit_scoring.h"
 
+#include <fmt/format.h>
 #include <xsimd/xsimd.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include "common/error.h"
 #include "common/units.h"
 #include "common/bin_grid.h"
 
@@ -86,11 +88,13 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
 }  // namespace
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
-                       std::vector<double> medulla_sigma_a)
+                       std::vector<double> medulla_sigma_a, bool expected_value)
     : grid_(grid), sigma_a_(std::move(sigma_a)), last_lobe_(lobes - 1),
       medulla_sigma_a_(std::move(medulla_sigma_a)),
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
-      kept_(sigma_a_.size()),
+      kept_(sigma_a_.size()), expected_value_(expected_value),
+      absorption_(expected_value ? sigma_a_.size() * FinishedPhotons::kCapacity : 0),
+      fixed_(sigma_a_.size()), growth_(sigma_a_.size()), lobe_growth_(sigma_a_.size()),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -126,7 +130,20 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
   for (int c = 0; c < channels; ++c) {
     const Batch minus_sigma(-sigma_a_[c]);
     double* w = weights_.data() + static_cast<std::size_t>(c) * kCap;
-    if (medulla_sigma_a_.empty()) {
+    if (expected_value_) {
+      // Beer-Lambert's factor kept apart: Russian roulette's rows need it
+      // without the row's weight.
+      double* a = absorption_.data() + static_cast<std::size_t>(c) * kCap;
+      const Batch minus_medulla(medulla_sigma_a_.empty() ? 0.0 : -medulla_sigma_a_[c]);
+      for (int i = 0; i < f.n; i += W) {
+        Batch exponent = minus_sigma * Batch::load_aligned(f.path + i);
+        if (!medulla_sigma_a_.empty())
+          exponent = exponent + minus_medulla * Batch::load_aligned(f.medulla_path + i);
+        const Batch factor = xsimd::exp(exponent);
+        factor.store_unaligned(a + i);
+        (Batch::load_aligned(f.weight + i) * factor).store_unaligned(w + i);
+      }
+    } else if (medulla_sigma_a_.empty()) {
       for (int i = 0; i < f.n; i += W)
         (Batch::load_aligned(f.weight + i) * xsimd::exp(minus_sigma * Batch::load_aligned(f.path + i)))
             .store_unaligned(w + i);
@@ -149,6 +166,11 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     bin[i] = tally.bin_index(lobe, static_cast<int>(theta_bin[i]),
                              static_cast<int>(phi_bin[i]));
     tally.prefetch(bin[i]);
+    if (expected_value_) lobe_[i] = lobe;
+  }
+  if (expected_value_) {
+    score_rows_expected_value(f, bin, tally);
+    return;
   }
   double* weight = one_photon_.data();
   for (int i = 0; i < f.n; ++i) {
@@ -172,6 +194,156 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     for (int c = 0; c < channels; ++c) kept[c] = weights_[static_cast<std::size_t>(c) * kCap + slot];
     tally.score_lost(weight, kept);
   }
+}
+
+// A photon's rows in order (sim/life/finished_photons.h): its exits added up
+// per bin and per lobe, each row's weight booked in fixed point within the
+// room its earlier rows left of its unit weight (plus what Russian roulette
+// created for it), the weight roulette created or destroyed booked in the
+// ledger's roulette term, and its masking losses (at its last row) booked
+// against all it kept.
+void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin,
+                                           Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const int channels = static_cast<int>(sigma_a_.size());
+  double* weight = one_photon_.data();
+  reserve_slots(f);
+  std::size_t j = 0;  // the next of f.losses (in row order)
+  for (int i = 0; i < f.n; ++i) {
+    const std::uint32_t slot = f.slot[i];
+    if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
+    if (f.exited[i]) {
+      score_scored_exit(f, i, bin[i], tally);
+    } else if (f.last[i] && !f.lost[i] && !f.ended[i]) {
+      book(weights_.data() + i, kCap, slot);
+      tally.score_truncated_fixed(fixed_.data());
+    }
+    if (!f.last[i]) continue;
+    if (j < f.losses.size() && f.losses[j].slot == i) {
+      std::fill(weight, weight + channels, 0.0);
+      for (; j < f.losses.size() && f.losses[j].slot == i; ++j) {
+        const WeightLoss& l = f.losses[j].loss;
+        for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
+      }
+      // Room for the losses: 1 + created - booked (Tally::score_lost's 1 - kept).
+      const std::size_t at = static_cast<std::size_t>(slot) * channels;
+      for (int c = 0; c < channels; ++c) fixed_[c] = booked_[at + c] - created_[at + c];
+      tally.score_lost(weight, fixed_.data());
+    }
+    end_photon(slot);
+  }
+}
+
+// Room for every slot the block uses (once: slots are the tracer's, a
+// pool's worth).
+void ExitScorer::reserve_slots(const FinishedPhotons& f) {
+  std::uint32_t top = 0;
+  for (int i = 0; i < f.n; ++i) top = std::max(top, f.slot[i]);
+  if (top < runs_.size()) return;
+  const std::size_t slots = top + 1, channels = sigma_a_.size();
+  booked_.resize(slots * channels, Tally::Fixed{0});
+  created_.resize(slots * channels, Tally::Fixed{0});
+  lobe_total_.resize(slots * channels, 0.0);
+  runs_.resize(slots);
+}
+
+void ExitScorer::end_photon(std::uint32_t slot) {
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  std::fill_n(booked_.begin() + at, channels, Tally::Fixed{0});
+  std::fill_n(created_.begin() + at, channels, Tally::Fixed{0});
+  Run& run = runs_[slot];
+  run.lobe = -1;
+  run.bins.clear();
+  run.totals.clear();
+}
+
+// One row's weight in fixed point, into fixed_: at most the room the
+// photon's earlier rows left of its unit weight. The parts of a split weight
+// (w P and w (1 - P)) are rounded products whose sum can exceed w by a few
+// 2^-53, and each part rounds to fixed point: on a white fiber that would
+// leave the ledger's absorbed (the complement) a few units below 0. More
+// than rounding (Tally::kRoundingAllowance) is a booking error: an internal
+// error, never clamped.
+void ExitScorer::book(const double* weight, std::size_t stride, std::uint32_t slot) {
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  for (std::size_t c = 0; c < channels; ++c) {
+    Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
+    const Tally::Fixed room = Tally::kOne + created_[at + c] - booked_[at + c];
+    if (w > room) {
+      if (w - room > Tally::kRoundingAllowance)
+        throw Error(fmt::format("internal error: a photon's exits and truncated weight exceed 1 "
+                                "(channel {}) by more than rounding", c));
+      w = room;
+    }
+    booked_[at + c] += w;
+    fixed_[c] = w;
+  }
+}
+
+// Row i's Russian roulette (f.roulette[i], before absorption), absorbed along
+// the path to it: weight created widens the photon's room; weight destroyed
+// is booked like an exit (within the room), and the ledger's roulette term
+// gains the signed amount.
+void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const std::size_t channels = sigma_a_.size(), at = f.slot[i] * channels;
+  const double r = f.roulette[i];
+  for (std::size_t c = 0; c < channels; ++c) growth_[c] = std::abs(r) * absorption_[c * kCap + i];
+  if (r > 0.0) {
+    for (std::size_t c = 0; c < channels; ++c) {
+      fixed_[c] = Tally::to_fixed(growth_[c]);
+      created_[at + c] += fixed_[c];
+    }
+  } else {
+    book(growth_.data(), 1, f.slot[i]);
+    for (std::size_t c = 0; c < channels; ++c) fixed_[c] = -fixed_[c];
+  }
+  tally.score_roulette_fixed(fixed_.data());
+}
+
+// Row i's exit in `bin`: the bin's S2 grows by (t + w)^2 - t^2 = w (2 t + w)
+// with t the photon's total in the bin so far, so that it ends with the
+// square of the photon's total (SPEC section 6); the lobe's likewise.
+void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally) {
+  constexpr int kCap = FinishedPhotons::kCapacity;
+  const std::uint32_t slot = f.slot[i];
+  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  const double* weight = weights_.data() + i;
+  book(weight, kCap, slot);
+  Run& run = runs_[slot];
+  double* lobe_total = lobe_total_.data() + at;
+  // (A new lobe's total starts from 0 without being stored first: a store
+  // then load of the same numbers on every row would stall.)
+  const bool new_lobe = run.lobe != lobe_[i];
+  if (new_lobe) {
+    run.lobe = lobe_[i];
+    run.bins.clear();
+    run.totals.clear();
+  }
+  for (std::size_t c = 0; c < channels; ++c) {
+    const double w = weight[c * kCap];
+    const double t = new_lobe ? 0.0 : lobe_total[c];
+    lobe_growth_[c] = w * (2.0 * t + w);
+    lobe_total[c] = t + w;
+  }
+  for (std::size_t e = 0; e < run.bins.size(); ++e) {
+    if (run.bins[e] != bin) continue;
+    double* total = run.totals.data() + e * channels;
+    for (std::size_t c = 0; c < channels; ++c) {
+      const double w = weight[c * kCap];
+      growth_[c] = w * (2.0 * total[c] + w);
+      total[c] += w;
+    }
+    tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), false);
+    return;
+  }
+  run.bins.push_back(bin);
+  for (std::size_t c = 0; c < channels; ++c) {
+    const double w = weight[c * kCap];
+    growth_[c] = w * w;
+    run.totals.push_back(w);
+  }
+  tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), true);
 }
 
 }  // namespace fiberlab::sim

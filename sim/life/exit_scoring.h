@@ -3,6 +3,10 @@
 // Beer-Lambert weight exp(-sigma_a[c] l) per channel along the whole internal
 // path (times the photon's masking throughput), the lobe min(p, L - 1) and the
 // (theta_r, phi_r - phi_i) bin; weight removed by masking as the ledger's lost.
+// With expected-value scoring a photon may leave in one bin more than once
+// (the last lobe collects every p >= L - 1, and a rough point may score
+// twice): its exits are added up per bin as they come (per slot,
+// sim/life/finished_photons.h), so that S2 gains the square of its total.
 #include <cstdint>
 #include <vector>
 
@@ -17,9 +21,9 @@ class ExitScorer {
   // lobes: tally.lobes, by p. medulla_sigma_a: the medulla's sigma_a (empty
   // without a medulla); with one, photons that scattered in it go to lobe
   // `lobes` (`scattered`, docs/FUR.md) and every photon's weight carries
-  // exp(-medulla_sigma_a[c] medulla_path).
+  // exp(-medulla_sigma_a[c] medulla_path). expected_value: Settings::estimator.
   ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
-             std::vector<double> medulla_sigma_a = {});
+             std::vector<double> medulla_sigma_a = {}, bool expected_value = false);
   // Weights are computed for a whole block at once (vectorised), the tally
   // cells of the exits are located and prefetched, then added.
   void score(const FinishedPhotons& f, Tally& tally);
@@ -35,6 +39,37 @@ class ExitScorer {
   std::vector<double> weights_;     // [channel][photon]
   std::vector<double> one_photon_;  // [channel]
   std::vector<double> kept_;        // [channel]: a photon's exited or truncated weight
+  bool expected_value_;
+  // Expected-value scoring: per row of a block, Beer-Lambert's factor
+  // ([channel][row]; weights_ is the row's weight times it) and lobe.
+  std::vector<double> absorption_;
+  int lobe_[FinishedPhotons::kCapacity];
+  // Per slot (sim/life/finished_photons.h), the photon in it so far, in flat
+  // arrays sized once per slot ([slot][channel]): the weight it booked in
+  // fixed point, and what Russian roulette created for it; the lobe of its
+  // latest exit and its total there. A photon's lobes never decrease along
+  // its rows (min(p, L - 1) with p growing; the medulla's `scattered` once
+  // scattered), so its exits in one lobe are consecutive: its Run holds the
+  // bins of the current lobe with its total in each, and is emptied when
+  // the lobe changes. A Run's vectors keep their capacity: no allocation per
+  // photon once the runs have met their longest.
+  struct Run {
+    int lobe = -1;
+    std::vector<std::size_t> bins;
+    std::vector<double> totals;  // [entry][channel]
+  };
+  std::vector<Tally::Fixed> booked_, created_;
+  std::vector<double> lobe_total_;
+  std::vector<Run> runs_;
+  std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
+  std::vector<double> growth_;        // [channel]: one row's bin S2 growth
+  std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
+  void reserve_slots(const FinishedPhotons& f);
+  void book(const double* weight, std::size_t stride, std::uint32_t slot);
+  void score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally);
+  void score_roulette(const FinishedPhotons& f, int i, Tally& tally);
+  void end_photon(std::uint32_t slot);
+  void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within
   // a margin), so that most vectors of bins need no settling on the edges.
   bool theta_closed_form_, phi_closed_form_;

@@ -26,7 +26,38 @@ template <class T>
 struct EventResult {
   Vec3Of<T> direction;  // the new direction, for the lanes that acted
   MaskOf<T> refracted;  // the photon changed side
+  // Expected-value scoring (SPEC section 5), in the lanes of `scored`: the
+  // branch that leaves the fiber (its direction and probability) was not
+  // chosen; `direction` is the other branch.
+  MaskOf<T> scored;
+  Vec3Of<T> leave_direction;
+  T p_leave;
 };
+
+// Which lanes may score their leaving branch by its expected value at this
+// event (`eligible`, within the acting lanes), and what decides whether that
+// branch leaves: the photon's side and the untilted outward normal n0 (the
+// consistency rule of SPEC section 3). interact() without it makes every
+// choice analog (the analog estimator; the medulla's interface events,
+// sim/life/medulla.h, none of whose branches leaves the fiber).
+template <class T>
+struct ExitScoring {
+  MaskOf<T> eligible, inside;
+  Vec3Of<T> n0;
+};
+
+// The branch that leaves the fiber at once, if it does: reflection for a
+// photon outside, refraction (none under total internal reflection) for one
+// inside, kept only where its direction leaves on the outside of n0
+// (d'.n0 > 0). Where it does not leave, the choice stays analog (SPEC
+// section 5: a branch the consistency rule sends back is not terminal).
+template <class T>
+MaskOf<T> leaving_branch(const ExitScoring<T>& e, const Vec3Of<T>& d, const Vec3Of<T>& m,
+                         const MaskOf<T>& tir, const T& cos_i, const T& cos_t, const T& ratio,
+                         Vec3Of<T>& leave) {
+  leave = scatter_direction(d, m, !e.inside, cos_i, cos_t, ratio);
+  return e.eligible & !(e.inside & tir) & (leave.dot(e.n0) > T(0.0));
+}
 
 // Mirror reflection or vector Snell refraction of d about m (cos_i = -d.m),
 // only the chosen one computed: d' = a d + b m with (a, b) = (1, 2 cos_i)
@@ -48,11 +79,35 @@ struct ScalarLight {
   explicit ScalarLight(const Vec3Of<T>& /*d*/ = {}) {}
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
                           const MaskOf<T>& act, LaneRandom<T>& rng) {
+    return interact_as<false>(d, m, n, act, rng, {});
+  }
+  EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+    return interact_as<true>(d, m, n, act, rng, e);
+  }
+
+ private:
+  template <bool kScore>
+  EventResult<T> interact_as(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                             const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
     // F uses the true 3D angle between d and m (SPEC section 3).
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     const FresnelReflectanceOf<T> f = fresnel_reflectance(cos_i, n.eta_rel, n.ratio);
-    const MaskOf<T> reflect = f.tir | (rng.uniform(act & !f.tir) < f.F);
-    return {scatter_direction(d, m, reflect, cos_i, f.cos_t, n.ratio), !reflect};
+    EventResult<T> r{{}, {}, MaskOf<T>(false), {}, T(0.0)};
+    MaskOf<T> reflect;
+    if constexpr (kScore) {
+      r.scored = leaving_branch(e, d, m, f.tir, cos_i, f.cos_t, n.ratio, r.leave_direction);
+      r.p_leave = select(e.inside, T(1.0) - f.F, f.F);
+      // Where the leaving branch is scored, the photon takes the other one:
+      // it reflects when inside.
+      reflect = f.tir | (r.scored & e.inside) |
+                ((!r.scored) & (rng.uniform(act & !f.tir & !r.scored) < f.F));
+    } else {
+      reflect = f.tir | (rng.uniform(act & !f.tir) < f.F);
+    }
+    r.direction = scatter_direction(d, m, reflect, cos_i, f.cos_t, n.ratio);
+    r.refracted = !reflect;
+    return r;
   }
 };
 
@@ -81,6 +136,17 @@ struct StokesLight {
 
   EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
                           const MaskOf<T>& act, LaneRandom<T>& rng) {
+    return interact_as<false>(d, m, n, act, rng, {});
+  }
+  EventResult<T> interact(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                          const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
+    return interact_as<true>(d, m, n, act, rng, e);
+  }
+
+ private:
+  template <bool kScore>
+  EventResult<T> interact_as(const Vec3Of<T>& d, const Vec3Of<T>& m, const InterfaceIndex<T>& n,
+                             const MaskOf<T>& act, LaneRandom<T>& rng, const ExitScoring<T>& e) {
     const T cos_i = min(T(1.0), max(T(0.0), -d.dot(m)));
     // Turn the reference axis about d to the event's s-axis s = d x m / |d x m|;
     // (Q, U) rotate by 2 psi, cos psi = e1.s, sin psi = (d x e1).s. At
@@ -106,7 +172,18 @@ struct StokesLight {
     const T a_t = T(0.5) * (ts + tp), b_t = T(0.5) * (ts - tp);
     const T c_t = sqrt(max(T(0.0), ts * tp));
     const T p_reflect = a_r + b_r * q1;
-    const MaskOf<T> reflect = tir | (rng.uniform(act & !tir) < p_reflect);
+    EventResult<T> res{{}, {}, MaskOf<T>(false), {}, T(0.0)};
+    MaskOf<T> reflect;
+    if constexpr (kScore) {
+      res.scored = leaving_branch(e, d, m, tir, cos_i, r.cos_t, n.ratio, res.leave_direction);
+      // The first row of the transmission matrix times the Stokes vector:
+      // A_T + B_T Q = 1 - (A_R + B_R Q).
+      res.p_leave = select(e.inside, T(1.0) - p_reflect, p_reflect);
+      reflect = tir | (res.scored & e.inside) |
+                ((!res.scored) & (rng.uniform(act & !tir & !res.scored) < p_reflect));
+    } else {
+      reflect = tir | (rng.uniform(act & !tir) < p_reflect);
+    }
     const T A = select(reflect, a_r, a_t), B = select(reflect, b_r, b_t);
     const T C = select(reflect, c_r, c_t), S = select(reflect, s_r, T(0.0));
     const T inv_i = T(1.0) / (A + B * q1);
@@ -119,7 +196,9 @@ struct StokesLight {
     u = select(act, u2, u);
     v = select(act, v2, v);
     e1 = select(act, e1_new, e1);
-    return {out, !reflect};
+    res.direction = out;
+    res.refracted = !reflect;
+    return res;
   }
 };
 

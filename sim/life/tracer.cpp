@@ -22,12 +22,29 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
   const Vec3 d = -wi;
   auto s = life::start_photon<Light>(config_.ellipse.entry_point(d, h), d, rng.core());
   life::LifeCounts<double> counts;
-  while (s.code == static_cast<double>(life::kAtBoundary)) step(config_, model, s, true, counts, kMaxNormalTries);
+  std::vector<ScoredExitOutcome> scored;
+  while (s.code == static_cast<double>(life::kAtBoundary)) {
+    if (config_.expected_value)
+      step<true>(config_, model, s, true, counts, kMaxNormalTries);
+    else
+      step<false>(config_, model, s, true, counts, kMaxNormalTries);
+    if (config_.expected_value && (s.scored.weight > 0.0 || s.scored.roulette != 0.0)) {
+      const int p = static_cast<int>(s.scored.segments);
+      Vec3 d = s.scored.d.to_vec3();
+      if (s.scored.weight > 0.0) {
+        PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
+        d = exit_direction_of(model, d, p, blur);
+      }
+      scored.push_back({d, p, s.scored.path, s.scored.weight, s.scored.medulla_path,
+                        s.scored.scatters > 0.0, s.scored.roulette});
+    }
+  }
   rng.core() = s.rng;
   if (counters) counters->add(counts);
   PhotonOutcome out = finished_outcome(model, static_cast<int>(s.code), s.d.to_vec3(),
                                        static_cast<int>(s.segments), s.path, s.weight, rng);
   out.losses = std::move(s.losses.list);
+  out.scored = std::move(scored);
   out.medulla_path = s.medulla_path;
   out.scattered = s.scatters > 0.0;
   if (out.fate == PhotonFate::Exited) {

@@ -14,7 +14,23 @@
 namespace fiberlab::sim {
 
 // Lost: a roughness model ended the path (its weight is booked as lost).
-enum class PhotonFate { Exited, Truncated, Lost };
+// Ended: Russian roulette ended the path (expected-value scoring; the
+// weight it had is booked in the ledger's roulette term).
+enum class PhotonFate { Exited, Truncated, Lost, Ended };
+
+// An exit scored by expected value (Settings::estimator) before the
+// photon's life ended: it left along `direction` after `segments` segments
+// and `path_length` inside, with throughput `weight` (before absorption).
+struct ScoredExitOutcome {
+  Vec3 direction;
+  int segments;
+  double path_length, weight;
+  double medulla_path = 0.0;  // with a medulla: the length inside it so far
+  bool scattered = false;     // scattered in the medulla so far (lobe `scattered`)
+  // Weight Russian roulette created (> 0) or destroyed (< 0) at this point,
+  // before absorption; a row with weight 0 carries only this.
+  double roulette = 0.0;
+};
 
 struct PhotonOutcome {
   PhotonFate fate = PhotonFate::Exited;
@@ -26,6 +42,9 @@ struct PhotonOutcome {
   // without masking, 0 when Lost). Channel c carries weight exp(-sigma_a[c] l).
   double weight = 1.0;
   std::vector<WeightLoss> losses;  // what masking removed, in order (empty without masking)
+  // Exits scored by expected value along the way, in order (empty with the
+  // analog estimator); `fate` and `weight` are then what is left at the end.
+  std::vector<ScoredExitOutcome> scored;
   // With a medulla (sim/life/medulla.h): the 3D length inside it (absorbed
   // with the medulla's sigma_a; path_length is the cortex's), and whether the
   // photon scattered there (then it is tallied in the lobe `scattered`).
@@ -55,6 +74,7 @@ struct TracerCounters {
 inline PhotonFate fate_of(int code) {
   return code == life::kExited      ? PhotonFate::Exited
          : code == life::kTruncated ? PhotonFate::Truncated
+         : code == life::kEnded     ? PhotonFate::Ended
                                     : PhotonFate::Lost;
 }
 
@@ -70,6 +90,15 @@ template <class Model>
 Vec3 exit_direction_of(const Model& model, const Vec3& d, int segments, PhotonRandom& rng) {
   if constexpr (HasExitHook<Model>) return model.exit_direction(d, segments, rng);
   else return d;
+}
+
+// The stream an exit scored by expected value draws its exit direction
+// from (exit_blur): derived from the photon's stream state after the step
+// that scored it, so that the photon's own stream, and with it its path, is
+// the same whether or not its exits are blurred; both tracers derive it so.
+inline PhotonRandom scored_exit_stream(std::uint64_t w0, std::uint64_t w1, std::uint64_t w2,
+                                       std::uint64_t w3) {
+  return PhotonRandom(life::splitmix(w0 ^ life::splitmix(w1 ^ life::splitmix(w2))), w3);
 }
 
 // The outcome of a photon whose life ended with `code`.

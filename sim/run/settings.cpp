@@ -27,6 +27,7 @@ constexpr std::size_t kMaxConfigBytes = std::size_t{16} << 20;  // 16 MiB
 
 const char* const kHSampling[] = {"stratified", "independent"};
 const char* const kPolarizations[] = {"scalar", "stokes"};
+const char* const kEstimators[] = {"analog", "expected_value"};
 const char* const kThetaBins[] = {"uniform", "equal_area"};
 
 using config::degrees_text;
@@ -134,6 +135,8 @@ void read_top_level(const Reader& r, const YAML::Node& n, Settings& s) {
     s.max_events_per_point = r.small_integer(n["max_events_per_point"], "max_events_per_point", 1);
   if (n["polarization"])
     s.polarization = static_cast<Polarization>(r.word(n["polarization"], "polarization", kPolarizations));
+  if (n["estimator"])
+    s.estimator = static_cast<Estimator>(r.word(n["estimator"], "estimator", kEstimators));
 }
 
 // The tally holds S1 and S2 doubles for every incidence, lobe, bin and channel.
@@ -180,7 +183,7 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   const YAML::Node root =
       r.section(doc, "",
                 {"photons", "seed", "output", "fiber", "roughness", "source", "tally",
-                 "max_segments", "max_events_per_point", "polarization"});
+                 "max_segments", "max_events_per_point", "polarization", "estimator"});
   Settings s;
   s.output = default_output(origin);
   read_top_level(r, root, s);
@@ -189,6 +192,13 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   read_tally(r, root, s.tally);
   check_tally_size(r, s);
   check_photon_total(r, s);
+  return s;
+}
+
+Settings parse_stored_settings_yaml(const std::string& yaml_text, const std::string& origin) {
+  Settings s = parse_settings_yaml(yaml_text, origin);
+  const YAML::Node doc = YAML::Load(yaml_text);
+  if (doc.IsMap() && !doc["estimator"]) s.estimator = Estimator::Analog;
   return s;
 }
 
@@ -241,15 +251,19 @@ std::string to_yaml(const Settings& s) {
       "  lobes: {}\n"
       "max_segments: {}\n"
       "max_events_per_point: {}\n"
-      "polarization: {}\n",
+      "polarization: {}\n"
+      "estimator: {}\n",
       s.photons, s.seed, quoted(s.output), fiber_yaml(s.fiber),
       list_text(s.source.theta_i, degrees_text), phi_i, kHSampling[s.source.h_stratified ? 0 : 1],
       s.tally.n_theta, s.tally.n_phi,
       kThetaBins[s.tally.theta_bins == ThetaBinning::Uniform ? 0 : 1], s.tally.lobes,
-      s.max_segments, s.max_events_per_point, to_string(s.polarization));
+      s.max_segments, s.max_events_per_point, to_string(s.polarization),
+      to_string(s.estimator));
 }
 
 std::string to_string(Polarization p) { return kPolarizations[static_cast<int>(p)]; }
+
+std::string to_string(Estimator e) { return kEstimators[static_cast<int>(e)]; }
 
 std::vector<Settings::Incidence> Settings::incidences() const {
   std::vector<Incidence> out;

@@ -12,6 +12,15 @@
 namespace fiberlab::sim {
 
 enum class Polarization { Scalar, Stokes };
+// How a photon's exits are scored (SPEC section 5; docs/PHYSICS.md
+// "Estimator"). `analog`: at every event the photon reflects with
+// probability F and refracts otherwise, and scores its whole weight where it
+// finally leaves. `expected_value`: at an event where one branch leaves the
+// fiber at once, that branch is scored with the weight times its probability
+// and the photon goes on along the other with the weight times one minus it
+// (Russian roulette after an event once the weight is low:
+// life::kRouletteBelow, sim/life/photon_life.h).
+enum class Estimator { Analog, ExpectedValue };
 
 struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
@@ -44,6 +53,9 @@ struct Settings {
   int max_segments = 1000;
   int max_events_per_point = 1000;  // consistency-rule bound (SPEC section 5)
   Polarization polarization = Polarization::Scalar;
+  // analog: the one with more error per CPU second on bench/configs cases b
+  // and c (bench/figure_of_merit.py; docs/PHYSICS.md "Estimator").
+  Estimator estimator = Estimator::Analog;
 
   // The incident configurations: every theta_i combined with every phi_i
   // (theta-major order). phi_i is NaN when uniform.
@@ -66,6 +78,10 @@ struct Settings {
 // the allowed range.
 Settings parse_settings_yaml(const std::string& yaml_text, const std::string& origin);
 Settings load_settings(const std::string& path);
+// A result file's stored config_yaml: as parse_settings_yaml, except that a
+// config without an `estimator` key was written before the key existed, by
+// the analog estimator.
+Settings parse_stored_settings_yaml(const std::string& yaml_text, const std::string& origin);
 
 // A command-line integer (--photons, --seed, --threads) read by the config's
 // rules: 100000 or an exactly integral 1e5; not -1, 1.5, nan or anything
@@ -79,5 +95,6 @@ std::uint64_t parse_integer_flag(const std::string& flag, const std::string& tex
 std::string to_yaml(const Settings& s);
 
 std::string to_string(Polarization p);
+std::string to_string(Estimator e);
 
 }  // namespace fiberlab::sim

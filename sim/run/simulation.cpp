@@ -343,7 +343,8 @@ void Simulation::trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tal
                                std::uint64_t per_photon) const {
   const Settings::Incidence inc = incidences_[k];
   ExitScorer scorer(grid_, settings_.fiber.sigma_a, settings_.tally.lobes,
-                    settings_.fiber.medulla ? settings_.fiber.medulla->sigma_a : std::vector<double>{});
+                    settings_.fiber.medulla ? settings_.fiber.medulla->sigma_a : std::vector<double>{},
+                    settings_.estimator == Estimator::ExpectedValue);
   auto score = [&](const FinishedPhotons& f) { scorer.score(f, tally); };
   // Every run handed out is launched and traced in full, so it counts as
   // launched here, and as progress: a counter the threads share, touched a
@@ -364,7 +365,15 @@ void Simulation::trace_photons(std::size_t k, const PhotonFeed& feed, Tally& tal
   for (PhotonRun run = counted_feed(); run.n != 0; run = counted_feed()) {
     for (std::uint64_t i = run.first; i < run.first + run.n; ++i) {
       LaunchedPhoton p = source.launch(i);
-      done->add(i, p.phi_i, tracer_.trace(p.wi, p.h, p.rng, &counters));
+      const PhotonOutcome o = tracer_.trace(p.wi, p.h, p.rng, &counters);
+      for (const ScoredExitOutcome& e : o.scored) {
+        done->add_scored(i, p.phi_i, e);
+        if (done->full()) {
+          score(*done);
+          done->n = 0;
+        }
+      }
+      done->add(i, p.phi_i, o);
       if (done->full()) {
         score(*done);
         done->n = 0;

@@ -2,6 +2,7 @@
 
 #include <fmt/core.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string_view>
 
@@ -36,8 +37,18 @@ std::uint64_t config_digest(std::string_view text) {
 // photons, counts, bin sums, ledger), each as 16 little-endian bytes: stored
 // as /checkpoint@sums_digest over every direction in order, so that a sum
 // edited within the tally's identities (a count moved between bins) is refused.
+// The ledger's roulette and the lobes' photon S2 (the last C + L C words)
+// count only where they are not all 0, so that checkpoints of the analog
+// estimator keep the digest they had before those sums existed.
 std::uint64_t add_sums(std::uint64_t h, const ExactTally& t) {
-  for (const ExactTally::Word w : t.words())
+  std::vector<ExactTally::Word> words = t.words();
+  words.resize(words.size() - t.roulette.size() - t.lobe_weight_sq_sum.size());
+  const auto zero = [](ExactTally::Word w) { return w == 0; };
+  if (!std::all_of(t.roulette.begin(), t.roulette.end(), zero))
+    words.insert(words.end(), t.roulette.begin(), t.roulette.end());
+  if (t.has_lobe_weight_sq_sum())
+    words.insert(words.end(), t.lobe_weight_sq_sum.begin(), t.lobe_weight_sq_sum.end());
+  for (const ExactTally::Word w : words)
     for (int b = 0; b < 16; ++b) h = (h ^ static_cast<unsigned char>(w >> (8 * b))) * 0x100000001b3ULL;
   return h;
 }

@@ -17,7 +17,15 @@ ExactTally::ExactTally(const TallyShape& s)
       exited(static_cast<std::size_t>(s.lobes) * s.channels, 0),
       absorbed(s.channels, 0),
       truncated(s.channels, 0),
-      lost(s.channels, 0) {}
+      lost(s.channels, 0),
+      roulette(s.channels, 0),
+      lobe_weight_sq_sum(static_cast<std::size_t>(s.lobes) * s.channels, 0) {}
+
+bool ExactTally::has_lobe_weight_sq_sum() const {
+  for (Word w : lobe_weight_sq_sum)
+    if (w != 0) return true;
+  return false;
+}
 
 namespace {
 
@@ -44,27 +52,31 @@ ExactTally& ExactTally::operator+=(const ExactTally& o) {
   add_words(absorbed, o.absorbed);
   add_words(truncated, o.truncated);
   add_words(lost, o.lost);
+  add_words(roulette, o.roulette);  // two's complement: exact modulo 2^128
+  add_words(lobe_weight_sq_sum, o.lobe_weight_sq_sum);
   return *this;
 }
 
 std::vector<ExactTally::Word> ExactTally::words() const {
   std::vector<Word> w;
-  w.reserve(1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size());
+  w.reserve(1 + count.size() + 2 * weight_sum.size() + 2 * exited.size() + 4 * absorbed.size());
   w.push_back(photons);
   w.insert(w.end(), count.begin(), count.end());
-  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
+  for (const auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost, &roulette,
+                        &lobe_weight_sq_sum})
     w.insert(w.end(), v->begin(), v->end());
   return w;
 }
 
 void ExactTally::from_words(const std::vector<Word>& w) {
   const std::size_t expected =
-      1 + count.size() + 2 * weight_sum.size() + exited.size() + 3 * absorbed.size();
+      1 + count.size() + 2 * weight_sum.size() + 2 * exited.size() + 4 * absorbed.size();
   if (w.size() != expected) throw Error("internal error: tally words of the wrong size");
   std::size_t i = 0;
   photons = static_cast<std::uint64_t>(w[i++]);
   for (auto& c : count) c = static_cast<std::uint64_t>(w[i++]);
-  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost})
+  for (auto* v : {&weight_sum, &weight_sq_sum, &exited, &absorbed, &truncated, &lost, &roulette,
+                  &lobe_weight_sq_sum})
     for (auto& x : *v) x = w[i++];
 }
 
@@ -72,9 +84,13 @@ std::vector<ExactTally::Word> ExactTally::lobe_moments() const {
   const std::size_t L = shape.lobes, C = shape.channels;
   const std::size_t per_lobe = static_cast<std::size_t>(shape.n_theta) * shape.n_phi;
   std::vector<Word> m(2 * L * C, 0);
-  for (std::size_t l = 0; l < L; ++l)
-    for (std::size_t b = 0; b < per_lobe; ++b)
-      for (std::size_t c = 0; c < C; ++c) m[L * C + l * C + c] += weight_sq_sum[(l * per_lobe + b) * C + c];
+  if (has_lobe_weight_sq_sum()) {
+    for (std::size_t i = 0; i < L * C; ++i) m[L * C + i] = lobe_weight_sq_sum[i];
+  } else {
+    for (std::size_t l = 0; l < L; ++l)
+      for (std::size_t b = 0; b < per_lobe; ++b)
+        for (std::size_t c = 0; c < C; ++c) m[L * C + l * C + c] += weight_sq_sum[(l * per_lobe + b) * C + c];
+  }
   for (std::size_t i = 0; i < L * C; ++i) m[i] = exited[i];
   return m;
 }
@@ -111,6 +127,12 @@ double nearest_double(ExactTally::Word e) {
 }
 
 }  // namespace
+
+std::vector<double> ExactTally::to_double_signed(const std::vector<Word>& v) {
+  std::vector<double> out(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) out[i] = static_cast<double>(static_cast<__int128>(v[i])) / kScale;
+  return out;
+}
 
 void ExactTally::to_double(const std::vector<Word>& v, std::vector<double>& out) {
   out.resize(v.size());

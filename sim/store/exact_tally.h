@@ -29,10 +29,12 @@ enum class BinSum { S1, S2 };
 struct ExactLedger {
   std::uint64_t photons = 0;
   std::vector<unsigned __int128> exited, absorbed, truncated, lost;
+  std::vector<unsigned __int128> roulette;  // signed, two's complement (ExactTally::roulette)
+  std::vector<unsigned __int128> lobe_weight_sq_sum;  // [lobe][channel] (ExactTally's)
 };
 
 struct ExactTally {
-  using Word = unsigned __int128;  // every sum is >= 0
+  using Word = unsigned __int128;  // every sum is >= 0, but `roulette` (two's complement)
   static constexpr double kScale = 0x1.0p60;
 
   explicit ExactTally(const TallyShape& shape);
@@ -44,18 +46,29 @@ struct ExactTally {
   std::vector<Word> exited;                     // [lobe][channel]
   std::vector<Word> absorbed, truncated;        // [channel]
   std::vector<Word> lost;                       // [channel]: removed by masking
+  // [channel]: weight Russian roulette created minus weight it destroyed
+  // (expected-value scoring; 0 otherwise), a signed 128-bit integer held in
+  // two's complement: sums wrap modulo 2^128 and stay exact.
+  std::vector<Word> roulette;
+  // [lobe][channel]: the sum over photons of the square of each photon's
+  // total in the lobe (expected-value scoring, Tally::score_lobe_square).
+  // All 0 for the analog estimator, whose lobe S2 is the sum of its bins' S2.
+  std::vector<Word> lobe_weight_sq_sum;
+  bool has_lobe_weight_sq_sum() const;
 
   // Exact sum; throws fiberlab::Error when a count would overflow 64 bits.
   ExactTally& operator+=(const ExactTally& other);
 
   // Every number as one flat array of words (photons, count, weight_sum,
-  // weight_sq_sum, exited, absorbed, truncated, lost), for element-wise sums
+  // weight_sq_sum, exited, absorbed, truncated, lost, roulette,
+  // lobe_weight_sq_sum), for element-wise sums
   // across MPI ranks; from_words() is its inverse.
   std::vector<Word> words() const;
   void from_words(const std::vector<Word>& w);
 
-  // Per lobe and channel, the lobe's S1 (= exited) and S2 (sum over its bins):
-  // [lobe][channel], S1 first, then S2. What --target-error judges.
+  // Per lobe and channel, the lobe's S1 (= exited) and S2 (lobe_weight_sq_sum
+  // where kept, else the sum over its bins): [lobe][channel], S1 first, then
+  // S2. What --target-error judges.
   std::vector<Word> lobe_moments() const;
 
   // Lobe l's bins in file order, as the result file stores them (the result
@@ -66,9 +79,13 @@ struct ExactTally {
   void lobe_counts(int l, std::vector<std::uint64_t>& out) const;
   void lobe_sums(int l, BinSum which, std::vector<double>& value,
                  std::vector<std::int64_t>& residual) const;
-  ExactLedger ledger() const { return {photons, exited, absorbed, truncated, lost}; }
+  ExactLedger ledger() const {
+    return {photons, exited, absorbed, truncated, lost, roulette, lobe_weight_sq_sum};
+  }
 
   static std::vector<double> to_double(const std::vector<Word>& v);
+  // The same for a signed (two's complement) sum: `roulette`.
+  static std::vector<double> to_double_signed(const std::vector<Word>& v);
   // Format 2 stores a bin sum E as its float64 value v = E / 2^60, rounded
   // once (to_double), and the residual r = E - v 2^60, an int64 (|r| is at
   // most half an ulp of E: 0 below 2^53, below 2^20 for sums of about 10^5

@@ -26,6 +26,7 @@ void write_parameters(h5::File& f, const Settings& s) {
   write_fiber(f, s.fiber);
   f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
   f.set_attr("/source", "polarization", to_string(s.polarization));
+  f.set_attr("/source", "estimator", to_string(s.estimator));
   f.set_attr("/source", "phi_i_uniform", static_cast<std::int64_t>(s.source.phi_i_uniform));
 }
 
@@ -55,6 +56,9 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
     append(r.absorbed, t.absorbed());
     append(r.truncated, t.truncated());
     append(r.lost, t.lost());
+    append(r.roulette, t.roulette());
+    if (settings.estimator == Estimator::ExpectedValue)
+      append(r.lobe_weight_sq_sum, ExactTally::to_double(t.exact_ledger().lobe_weight_sq_sum));
   }
   return r;
 }
@@ -101,6 +105,10 @@ void write_result(const ResultFile& r, const std::string& path,
     f.write("/ledger/absorbed", {K, C}, r.absorbed);
     f.write("/ledger/truncated", {K, C}, r.truncated);
     f.write("/ledger/lost", {K, C}, r.lost);
+    if (r.settings.estimator == Estimator::ExpectedValue) {
+      f.write("/ledger/roulette", {K, C}, r.roulette);
+      f.write("/tally/lobe_weight_sq_sum", {K, L, C}, r.lobe_weight_sq_sum);
+    }
     describe_result_file(f, r);
     describe_tally_photons(f);
     f.close();
@@ -113,7 +121,7 @@ Settings load_settings_or_result(const std::string& path) {
   const h5::File f = h5::File::open_read(path);
   if (!f.has_attr("/", "config_yaml"))
     throw Error(fmt::format("{}: HDF5 file without a config_yaml root attribute (not a fiberlab result)", path));
-  return parse_settings_yaml(f.attr_string("/", "config_yaml"), path + ":/config_yaml");
+  return parse_stored_settings_yaml(f.attr_string("/", "config_yaml"), path + ":/config_yaml");
 }
 
 Estimate bin_estimate(double s1, double s2, std::uint64_t n) {
@@ -124,11 +132,15 @@ Estimate bin_estimate(double s1, double s2, std::uint64_t n) {
 }
 
 Estimate lobe_energy(const ResultFile& r, std::size_t k, int lobe, int c) {
-  // Each photon lands in one bin, so the lobe's S2 is the sum of its bins' S2.
+  const double s1 = r.exited[(k * r.lobes + lobe) * r.channels + c];
+  // Expected-value scoring: a photon may leave in several bins of a lobe,
+  // and the lobe's S2 is the sum over photons of the square of its total.
+  if (!r.lobe_weight_sq_sum.empty())
+    return bin_estimate(s1, r.lobe_weight_sq_sum[(k * r.lobes + lobe) * r.channels + c], r.photons[k]);
+  // Analog: each photon lands in one bin, so the lobe's S2 is the sum of its bins' S2.
   double s2 = 0.0;
   for (int i = 0; i < r.grid.n_theta(); ++i)
     for (int j = 0; j < r.grid.n_phi(); ++j) s2 += r.weight_sq_sum[r.cell(k, lobe, i, j, c)];
-  const double s1 = r.exited[(k * r.lobes + lobe) * r.channels + c];
   return bin_estimate(s1, s2, r.photons[k]);
 }
 

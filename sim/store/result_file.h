@@ -27,6 +27,13 @@ struct ResultFile {
   std::vector<double> exited;           // K x L x C
   std::vector<double> absorbed, truncated;  // K x C
   std::vector<double> lost;  // K x C: removed by masking (0 unless roughness.masking)
+  // K x C, signed: weight Russian roulette created minus destroyed (0 with
+  // the analog estimator, whose files have no /ledger/roulette).
+  std::vector<double> roulette;
+  // K x L x C: per lobe, the sum over photons of the square of each one's
+  // total there (/tally/lobe_weight_sq_sum, expected-value files); empty
+  // for the analog estimator, whose lobe S2 is the sum of its bins' S2.
+  std::vector<double> lobe_weight_sq_sum;
 
   std::size_t configs() const { return photons.size(); }
   std::size_t bin_cells() const {
@@ -75,6 +82,8 @@ Settings load_settings_or_result(const std::string& path);
 struct Estimate {
   double mean, std_error;
 };
+// (its standard error from lobe_weight_sq_sum where the file has it, else
+// from the sum of the lobe's bins' S2)
 Estimate lobe_energy(const ResultFile& r, std::size_t k, int lobe, int c);
 // Probability P = S1 / N and its standard error sqrt((S2/N - P^2)/(N - 1)).
 Estimate bin_estimate(double s1, double s2, std::uint64_t n);

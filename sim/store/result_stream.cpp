@@ -53,6 +53,16 @@ constexpr DatasetShape kFormat1BinSums[] = {{"/exact/weight_sum", Stored::Pairs,
 // before it existed have neither dataset: their lost is 0.
 constexpr DatasetShape kLostDatasets[] = {{"/ledger/lost", Stored::Float64, 2},
                                           {"/exact/lost", Stored::Pairs, 2}};
+// The ledger's signed `roulette` (Russian roulette): written by the
+// expected-value estimator only; a file without it has 0.
+constexpr DatasetShape kRouletteDatasets[] = {{"/ledger/roulette", Stored::Float64, 2},
+                                              {"/exact/roulette", Stored::Pairs, 2},
+                                              {"/tally/lobe_weight_sq_sum", Stored::Float64, 3},
+                                              {"/exact/lobe_weight_sq_sum", Stored::Pairs, 3}};
+
+bool plays_roulette(const ResultFile& header) {
+  return header.settings.estimator == Estimator::ExpectedValue;
+}
 
 h5::Dims dims_of(const DatasetShape& d, hsize_t K, const TallyShape& s) {
   const hsize_t L = s.lobes, T = s.n_theta, P = s.n_phi, C = s.channels;
@@ -114,6 +124,9 @@ void ResultWriter::create_file() {
     f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
   for (const DatasetShape& d : kLostDatasets)
     f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
+  if (plays_roulette(header_))
+    for (const DatasetShape& d : kRouletteDatasets)
+      f.create_dataset(d.name, dims_of(d, K, shape_), type_of(d));
   if (!direction_seeds_.empty()) {
     std::vector<std::uint64_t> rows;
     for (std::size_t k = 0; k < direction_seeds_.size(); ++k)
@@ -245,6 +258,12 @@ void ResultWriter::write_direction(std::size_t k, const TallyShape& shape,
   f.write_slab("/exact/absorbed", k, ExactTally::to_pairs(ledger.absorbed));
   f.write_slab("/exact/truncated", k, ExactTally::to_pairs(ledger.truncated));
   f.write_slab("/exact/lost", k, ExactTally::to_pairs(ledger.lost));
+  if (plays_roulette(header_)) {
+    f.write_slab("/ledger/roulette", k, ExactTally::to_double_signed(ledger.roulette));
+    f.write_slab("/exact/roulette", k, ExactTally::to_pairs(ledger.roulette));
+    f.write_slab("/tally/lobe_weight_sq_sum", k, ExactTally::to_double(ledger.lobe_weight_sq_sum));
+    f.write_slab("/exact/lobe_weight_sq_sum", k, ExactTally::to_pairs(ledger.lobe_weight_sq_sum));
+  }
 }
 
 void ResultWriter::prepare_part(int l, int part, const LobePlans& plans, const BinSource& bins,
@@ -293,7 +312,7 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
   version_ = read_format_version(f, path);
   ResultFile& h = header_;
   h.config_yaml = f.attr_string("/", "config_yaml");
-  h.settings = parse_settings_yaml(h.config_yaml, path + ":/config_yaml");
+  h.settings = parse_stored_settings_yaml(h.config_yaml, path + ":/config_yaml");
   h.software_version = f.attr_string("/", "software_version");
   h.created_utc = f.attr_string("/", "created_utc");
   if (f.has_attr("/", "merged_seeds")) {
@@ -334,6 +353,11 @@ ResultReader::ResultReader(const std::string& path, bool allow_empty_directions)
     if (has_lost_ && f.dims(d.name) != dims_of(d, K, shape_))
       throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
                               d.name));
+  has_roulette_ = f.exists(kRouletteDatasets[1].name);
+  for (const DatasetShape& d : kRouletteDatasets)
+    if (has_roulette_ && f.dims(d.name) != dims_of(d, K, shape_))
+      throw Error(fmt::format("{}: {} does not have the shape the config and /source give", path,
+                              d.name));
   direction_seeds_.assign(K, h.seeds);
   if (f.exists("/merge/direction_seeds")) {
     h5::Dims dims;
@@ -363,8 +387,14 @@ ExactTally ResultReader::read(std::size_t k) const {
   t.absorbed = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/absorbed", k));
   t.truncated = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/truncated", k));
   if (has_lost_) t.lost = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lost", k));
+  if (has_roulette_) {
+    t.roulette = ExactTally::from_pairs(file_.read_slab_uint64s("/exact/roulette", k));
+    t.lobe_weight_sq_sum =
+        ExactTally::from_pairs(file_.read_slab_uint64s("/exact/lobe_weight_sq_sum", k));
+  }
   // Sums that break a tally's identities were damaged or edited: never added.
-  if (const std::string why = tally_inconsistency(t); !why.empty())
+  if (const std::string why = tally_inconsistency(t, header_.settings.estimator == Estimator::Analog);
+      !why.empty())
     throw Error(fmt::format("{}: incident direction {}: {}", path_, k, why));
   return t;
 }

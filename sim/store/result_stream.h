@@ -132,6 +132,7 @@ class ResultReader {
   DirectionSeeds direction_seeds_;
   TallyShape shape_;
   bool has_lost_ = false;  // /exact/lost (absent in files written before it: lost 0)
+  bool has_roulette_ = false;  // /exact/roulette (expected-value files only; else 0)
   std::int64_t version_ = 0;  // format_version: 1 (bin sums as pairs) or 2 (as residuals)
 };
 

@@ -13,6 +13,8 @@ Tally::Tally(int lobes, int n_theta, int n_phi, int channels)
       memory_(bins() * block() * sizeof(Fixed)), touched_(pages(), 0) {
   truncated_.assign(channels, 0);
   lost_.assign(channels, 0);
+  roulette_.assign(channels, 0);
+  lobe_sq_.assign(static_cast<std::size_t>(lobes) * channels, 0);
 }
 
 Tally::Tally(const Tally& o) : Tally(o.lobes_, o.n_theta_, o.n_phi_, o.channels_) { add(o); }
@@ -32,6 +34,8 @@ void Tally::clear() {
   photons_ = 0;
   std::fill(truncated_.begin(), truncated_.end(), Fixed{0});
   std::fill(lost_.begin(), lost_.end(), Fixed{0});
+  std::fill(roulette_.begin(), roulette_.end(), Fixed{0});
+  std::fill(lobe_sq_.begin(), lobe_sq_.end(), Fixed{0});
 }
 
 void Tally::score_truncated(const double* weight) {
@@ -39,17 +43,23 @@ void Tally::score_truncated(const double* weight) {
 }
 
 void Tally::score_lost(const double* lost, const double* kept) {
-  constexpr Fixed one = Fixed{1} << 60;
+  std::vector<Fixed> kept_fixed(channels_);
+  for (int c = 0; c < channels_; ++c) kept_fixed[c] = to_fixed(kept[c]);
+  score_lost(lost, kept_fixed.data());
+}
+
+void Tally::score_lost(const double* lost, const Fixed* kept) {
+  constexpr Fixed one = kOne;
   // Rounding of a photon's products: a few 2^-53 per event, so 2^-40 (about
   // 1e-12 of the photon's weight) is far beyond it, and far below any real
   // double booking (of the order of the weight itself).
-  constexpr Fixed rounding_allowance = Fixed{1} << 20;
+  constexpr Fixed rounding_allowance = kRoundingAllowance;
   for (int c = 0; c < channels_; ++c) {
-    const Fixed room = one - to_fixed(kept[c]), booked = to_fixed(lost[c]);
+    const Fixed room = one - kept[c], booked = to_fixed(lost[c]);
     if (booked - room > rounding_allowance)
       throw Error(fmt::format("internal error: a photon's lost weight {} plus its kept weight {} exceeds 1 "
                               "(channel {}) by more than rounding",
-                              lost[c], kept[c], c));
+                              lost[c], static_cast<double>(kept[c]) / kScale, c));
     lost_[c] += std::min(booked, room);
   }
 }
@@ -69,14 +79,18 @@ void Tally::add(const Tally& o, int threads) {
   for (int c = 0; c < channels_; ++c) {
     truncated_[c] += o.truncated_[c];
     lost_[c] += o.lost_[c];
+    roulette_[c] += o.roulette_[c];
   }
+  for (std::size_t i = 0; i < lobe_sq_.size(); ++i) lobe_sq_[i] += o.lobe_sq_[i];
 }
 
 bool Tally::is_zero() const {
   const auto zero = [](auto x) { return x == 0; };
   return photons_ == 0 && std::all_of(touched_.begin(), touched_.end(), zero) &&
          std::all_of(truncated_.begin(), truncated_.end(), zero) &&
-         std::all_of(lost_.begin(), lost_.end(), zero);
+         std::all_of(lost_.begin(), lost_.end(), zero) &&
+         std::all_of(roulette_.begin(), roulette_.end(), zero) &&
+         std::all_of(lobe_sq_.begin(), lobe_sq_.end(), zero);
 }
 
 ExactTally Tally::exact() const {
@@ -91,6 +105,8 @@ ExactTally Tally::exact() const {
   e.absorbed = std::move(ledger.absorbed);
   e.truncated = std::move(ledger.truncated);
   e.lost = std::move(ledger.lost);
+  e.roulette = std::move(ledger.roulette);
+  e.lobe_weight_sq_sum = std::move(ledger.lobe_weight_sq_sum);
   return e;
 }
 
@@ -154,10 +170,13 @@ ExactLedger Tally::exact_ledger() const {
     Fixed absorbed = static_cast<Fixed>(photons_) << 60;
     for (int l = 0; l < lobes_; ++l) absorbed -= exited[static_cast<std::size_t>(l) * C + c];
     absorbed -= truncated_[c] + lost_[c];
+    absorbed += roulette_[c];
     e.absorbed.push_back(static_cast<ExactTally::Word>(absorbed));
     e.truncated.push_back(static_cast<ExactTally::Word>(truncated_[c]));
     e.lost.push_back(static_cast<ExactTally::Word>(lost_[c]));
+    e.roulette.push_back(static_cast<ExactTally::Word>(roulette_[c]));  // two's complement
   }
+  for (Fixed x : lobe_sq_) e.lobe_weight_sq_sum.push_back(static_cast<ExactTally::Word>(x));
   return e;
 }
 
@@ -182,7 +201,10 @@ void Tally::add(const ExactTally& e) {
   for (std::size_t c = 0; c < C; ++c) {
     truncated_[c] += static_cast<Fixed>(e.truncated[c]);
     lost_[c] += static_cast<Fixed>(e.lost[c]);
+    roulette_[c] += static_cast<Fixed>(e.roulette[c]);
   }
+  for (std::size_t i = 0; i < lobe_sq_.size(); ++i)
+    lobe_sq_[i] += static_cast<Fixed>(e.lobe_weight_sq_sum[i]);
 }
 
 std::vector<double> Tally::to_double(const std::vector<Fixed>& v) {
@@ -212,7 +234,9 @@ std::vector<std::uint64_t> Tally::count() const {
 }
 // The ledger (SPEC section 4) from the bins: exited is the sum of S1 over a
 // lobe's bins, and every photon launched left a weight w that exited or was
-// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed.
+// truncated, had weight removed by masking (lost) and 1 - w - lost absorbed
+// (with Russian roulette, 1 + the weight it created - the weight it
+// destroyed - w - lost: the signed term `roulette` is added to absorbed).
 // Integer sums: exactly what per-photon counters would hold.
 std::vector<Tally::Fixed> Tally::exited_fixed() const {
   std::vector<Fixed> out(static_cast<std::size_t>(lobes_) * channels_, 0);
@@ -231,6 +255,7 @@ std::vector<double> Tally::exited() const { return to_double(exited_fixed()); }
 std::vector<double> Tally::absorbed() const { return ExactTally::to_double(exact_ledger().absorbed); }
 std::vector<double> Tally::truncated() const { return to_double(truncated_); }
 std::vector<double> Tally::lost() const { return to_double(lost_); }
+std::vector<double> Tally::roulette() const { return to_double(roulette_); }
 
 std::vector<std::size_t> Tally::touched_bins_per_lobe() const {
   const std::size_t per_lobe = static_cast<std::size_t>(n_theta_) * n_phi_;

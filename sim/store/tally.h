@@ -59,6 +59,44 @@ class Tally {
       s2[c] += to_fixed(w * w);
     }
   }
+  // Expected-value scoring (sim/life/exit_scoring.h): one of a photon's
+  // exits, its S1 already in fixed point (s1[c], booked so that the photon's
+  // parts never exceed its unit weight: see ExitScorer), S2 growing by
+  // s2_growth[c] (the growth of the square of the photon's total in the bin),
+  // the count by one when this is the photon's first exit in the bin, and
+  // the bin's lobe's sum of squares of photon totals by lobe_growth[c] (a
+  // photon may leave in several bins of a lobe, and the lobe's standard
+  // error needs the sum over photons of the square of its total there, not
+  // the sum of its bins' S2; the analog estimator books none: there each
+  // photon leaves once and the lobe's S2 is its bins' S2).
+  void score_exit_fixed(std::size_t bin, int lobe_of_bin, const Fixed* s1, const double* s2_growth,
+                        const double* lobe_growth, bool first) {
+    touched_[bin / kPageBins] = 1;
+    Fixed* cell = cells() + bin * block();
+    cell[0] += first ? 1 : 0;
+    Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels_;
+    for (int c = 0; c < channels_; ++c) {
+      cell[1 + c] += s1[c];
+      cell[1 + channels_ + c] += to_fixed(s2_growth[c]);
+      lobe[c] += to_fixed(lobe_growth[c]);
+    }
+  }
+  // A photon's truncated weight, already in fixed point.
+  void score_truncated_fixed(const Fixed* weight) {
+    for (int c = 0; c < channels_; ++c) truncated_[c] += weight[c];
+  }
+  // Weight Russian roulette created (> 0) or destroyed (< 0) in fixed point,
+  // absorbed along the path before it (expected-value scoring): the ledger's
+  // signed `roulette`, with exited + absorbed + truncated + lost - roulette
+  // = launched (sim/life/photon_life.h kRouletteBelow).
+  void score_roulette_fixed(const Fixed* delta) {
+    for (int c = 0; c < channels_; ++c) roulette_[c] += delta[c];
+  }
+  static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
+  static constexpr Fixed kOne = Fixed{1} << 60;
+  // What a photon's parts may exceed its unit weight by, in fixed point, as
+  // rounding (2^-40: see score_lost).
+  static constexpr Fixed kRoundingAllowance = Fixed{1} << 20;
   // Every sum back to zero (only the touched pages are written): a thread's
   // tally is reused across rounds and incident directions.
   void clear();
@@ -82,6 +120,8 @@ class Tally {
   // rounding (2^-40) is a booking error: an internal error is thrown, never
   // clamped.
   void score_lost(const double* lost, const double* kept);
+  // The same with the kept weight in fixed point (as booked).
+  void score_lost(const double* lost, const Fixed* kept);
   // Every launched photon must have been scored (exited, truncated, lost): what
   // is absorbed is derived from that (launched - exited - truncated - lost, exact).
   void add_launched(std::uint64_t n) { photons_ += n; }
@@ -115,6 +155,7 @@ class Tally {
   std::vector<double> absorbed() const;   // [channel]
   std::vector<double> truncated() const;  // [channel]
   std::vector<double> lost() const;       // [channel]
+  std::vector<double> roulette() const;   // [channel], signed
 
  private:
   // Bins are tracked in pages of kPageBins consecutive bins.
@@ -125,7 +166,6 @@ class Tally {
   std::size_t page_begin(std::size_t p) const { return p * kPageBins * block(); }
   std::size_t page_end(std::size_t p) const { return std::min((p + 1) * kPageBins, bins()) * block(); }
   Fixed* cells() const { return static_cast<Fixed*>(memory_.data()); }
-  static Fixed to_fixed(double w) { return static_cast<Fixed>(static_cast<std::int64_t>(w * kScale + 0.5)); }
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
   // that scoring a photon touches one or two cache lines, not three arrays.
@@ -140,6 +180,8 @@ class Tally {
   std::vector<std::uint8_t> touched_;   // [page]: 1 once a cell of the page was written
   std::vector<Fixed> truncated_;
   std::vector<Fixed> lost_;
+  std::vector<Fixed> roulette_;  // signed
+  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_exit_fixed's lobe_growth
 };
 
 }  // namespace fiberlab::sim
