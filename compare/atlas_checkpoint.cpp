@@ -557,7 +557,7 @@ AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const 
     LobeFit lf;
     lf.lobe = from_cell<int>(r, n[0], where + ".lobe_fit.lobe");
     if (lf.lobe < 0 || lf.lobe >= fiber.lobes) r.fail(fmt::format("{}: per-lobe fit of lobe {} is outside the fiber's {} lobes", where, lf.lobe, fiber.lobes));
-    const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, lobe_name(lf.lobe, fiber.lobes));
+    const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, fiber_lobe_names(fiber.fiber).at(static_cast<std::size_t>(lf.lobe)));
     lf.fit = fit_from(r, n + 1, s.lobe_fits.values, at.lobe_fit_value, per_lobe_keys(model, out.fit.keys, lf.lobe),
                       model, out.fit.params, lobe_where);
     out.lobe_fits.push_back(std::move(lf));

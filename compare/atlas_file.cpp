@@ -261,16 +261,13 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
 void write_atlas_axis_names(h5::File& f, const AtlasConfig& config) {
   // A fiber with a medulla has one lobe more, `scattered` (docs/FUR.md): the
   // file's lobe axis is the longest, NaN where a fiber has no such lobe.
-  int lobes = 0, channels = 0;
-  bool from_melanin = true, scattered = false;
+  int channels = 0;
+  bool from_melanin = true;
   for (const AtlasFiber& fiber : config.fibers) {
-    const bool medulla = fiber.settings.fiber.medulla.has_value();
-    lobes = std::max(lobes, fiber.settings.tally.lobes + (medulla ? 1 : 0));
-    scattered = scattered || medulla;
     channels = std::max(channels, static_cast<int>(fiber.settings.fiber.sigma_a.size()));
     from_melanin = from_melanin && fiber.settings.fiber.eumelanin.has_value();
   }
-  write_axis_names(f, lobes, channels, from_melanin, scattered);
+  write_axis_names(f, atlas_lobe_names(config.fibers), channels, from_melanin);
 }
 
 void write_atlas_file(const std::string& path, const AtlasConfig& config,

@@ -46,13 +46,12 @@ int lobe_count(const std::vector<AtlasFiberResult>& fibers) {
   return L;
 }
 
-// The name of lobe l on that axis: the last is `scattered` when a fiber has
-// a medulla (docs/FUR.md).
+// The name of lobe l on the atlas's lobe axis (atlas_lobe_names: the last is
+// `scattered` when a fiber has a medulla, docs/FUR.md).
 std::string lobe_label(int l, const std::vector<AtlasFiberResult>& fibers) {
-  const bool scattered = std::any_of(fibers.begin(), fibers.end(), [](const AtlasFiberResult& f) {
-    return f.fiber.settings.fiber.medulla.has_value();
-  });
-  return lobe_names(lobe_count(fibers), scattered).at(static_cast<std::size_t>(l));
+  std::vector<AtlasFiber> of;
+  for (const AtlasFiberResult& f : fibers) of.push_back(f.fiber);
+  return atlas_lobe_names(of).at(static_cast<std::size_t>(l));
 }
 
 // The config's model_parameters, one sentence (empty when there are none).

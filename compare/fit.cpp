@@ -135,8 +135,9 @@ void check_fit_keys(const std::string& model_name, const std::vector<std::string
   }
 }
 
-std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what) {
-  const std::vector<std::string> known = lobe_names(lobes);
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, const std::vector<std::string>& known,
+                                 const std::string& what) {
+  const int lobes = static_cast<int>(known.size());
   std::vector<int> out;
   for (const std::string& name : names) {
     int found = -1;
@@ -521,10 +522,11 @@ std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::str
   if (lobes.empty())
     for (int l = 0; l < result.lobes; ++l) lobes.push_back(l);
   std::vector<LobeFit> out;
+  const std::vector<std::string> names = result.lobe_names();
   for (int lobe : lobes) {
     Options one = options;
     one.lobes = {lobe};
-    const std::string name = lobe_name(lobe, result.lobes);
+    const std::string& name = names.at(static_cast<std::size_t>(lobe));
     try {
       out.push_back({lobe, fit_model(result, model_name, start, per_lobe_keys(model_name, keys, lobe), one,
                                      max_iterations, [&](const std::string& line) {

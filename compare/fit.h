@@ -115,10 +115,12 @@ struct FitResult {
   double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
 };
 
-// Tally lobe indices of lobe names (R, TT, TRT, ..., the last lobe's "p>=N",
-// or a lobe index), checked against `lobes`; throws fiberlab::Error naming
-// `what` (the flag or config key) and the allowed names.
-std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what);
+// Lobe indices of lobe names (one of `known`, the lobe axis's names: R, TT,
+// TRT, ..., the last lobe by p's "p>=N", `scattered` with a medulla; or a
+// lobe index); throws fiberlab::Error naming `what` (the flag or config key)
+// and the allowed names.
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, const std::vector<std::string>& known,
+                                 const std::string& what);
 
 // The keys of a per-lobe fit of lobe `lobe`: a per-lobe list key of the
 // model (beta_long, beta_azim) becomes that lobe's entry (beta_long[lobe]),

@@ -21,7 +21,7 @@ std::string unit_of(const std::string& key) {
 
 }  // namespace
 
-std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
+std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
   std::string s = fmt::format("\nfit ({} residuals, {} iterations, {} model evaluations, {}: {}):\n",
                               fr.residuals, fr.iterations, fr.evaluations, outcome_name(fr.outcome),
                               fr.stop_reason);
@@ -35,13 +35,13 @@ std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& 
     const auto& b = before.rows[i];
     if (!b.judged) continue;
     s += fmt::format("  theta_i {:7.2f} phi_i {:>7} {:>5} c{}: {:10.3f} -> {:10.3f}\n", rad_to_deg(b.theta_i),
-                     phi_text(b.phi_i), lobe_name(b.lobe, lobes), b.channel, b.bins.per_dof(),
+                     phi_text(b.phi_i), lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof(),
                      after.rows[i].bins.per_dof());
   }
   return s;
 }
 
-std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
+std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
   std::string md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations; {}: {}).\n\n"
                                "| key | start | fitted | error | unscaled error |\n|---|---|---|---|---|\n",
                                fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations,
@@ -54,7 +54,7 @@ std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdi
     const auto& b = before.rows[i];
     if (!b.judged) continue;
     md += fmt::format("| {:.2f} | {} | {} | {} | {:.3f} | {:.3f} |\n", rad_to_deg(b.theta_i), phi_text(b.phi_i),
-                      lobe_name(b.lobe, lobes), b.channel, b.bins.per_dof(), after.rows[i].bins.per_dof());
+                      lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof(), after.rows[i].bins.per_dof());
   }
   return md;
 }
