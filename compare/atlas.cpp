@@ -52,9 +52,11 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
   return compare(r, predict_result(*model, r), analytic::theta_r_shifts(name, p));
 }
 
-// "fitted (converged: why)", "fitted (at a bound: key = value; why)" or
-// "fitted (not converged: why)": the per-fiber table's status.
+// "fitted (converged: why)", "fitted (at a bound: key = value; why)",
+// "fitted (not converged: why)" or "not fitted: why" (no key acts on the
+// fitted bins): the per-fiber table's status.
 std::string fit_status(const FitResult& fit) {
+  if (fit.outcome == FitOutcome::NotFitted) return "not fitted: " + fit.stop_reason;
   std::string bound;
   for (std::size_t j = 0; j < fit.keys.size(); ++j)
     if (fit.at_bound[j]) bound += fmt::format("{}{} = {:.6g}", bound.empty() ? "" : ", ", fit.keys[j], fit.value[j]);

@@ -22,6 +22,13 @@ std::string unit_of(const std::string& key) {
 }  // namespace
 
 std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
+  if (fr.outcome == FitOutcome::NotFitted) {
+    std::string s = fmt::format("\nnot fitted: {} ({} residuals, {} model evaluations)\n  chi2/dof {:.4f} (dof {})\n",
+                                fr.stop_reason, fr.residuals, fr.evaluations, fr.per_dof(), fr.dof);
+    for (std::size_t i = 0; i < fr.keys.size(); ++i)
+      s += fmt::format("  {:<14} {:12.6g} {} (its start; not fitted)\n", fr.keys[i], fr.value[i], unit_of(fr.keys[i]));
+    return s;
+  }
   std::string s = fmt::format("\nfit ({} residuals, {} iterations, {} model evaluations, {}: {}):\n",
                               fr.residuals, fr.iterations, fr.evaluations, outcome_name(fr.outcome),
                               fr.stop_reason);
@@ -42,6 +49,13 @@ std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& 
 }
 
 std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
+  if (fr.outcome == FitOutcome::NotFitted) {
+    std::string md = fmt::format("## Fit\n\nNot fitted: {} (chi2/dof {:.4f} over {} dof).\n\n"
+                                 "| key | value (its start) |\n|---|---|\n",
+                                 fr.stop_reason, fr.per_dof(), fr.dof);
+    for (std::size_t i = 0; i < fr.keys.size(); ++i) md += fmt::format("| {} | {:.6g} |\n", fr.keys[i], fr.value[i]);
+    return md;
+  }
   std::string md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations; {}: {}).\n\n"
                                "| key | start | fitted | error | unscaled error |\n|---|---|---|---|---|\n",
                                fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations,

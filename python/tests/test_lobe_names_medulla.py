@@ -93,10 +93,14 @@ def test_per_lobe_fit_lines_name_the_file_lobes(fur, fiberlab_binary):
                          capture_output=True, text=True)
     assert out.returncode in (0, 1), out.stderr
     assert re.findall(r"^per-lobe fit of (\S+):", out.stdout, re.M) == names
-    # Each lobe's before -> after line names that lobe.
+    # Each fitted lobe's before -> after line names that lobe; marschner2003
+    # predicts nothing in p>=3 and `scattered`, whose fits say so (compare/fit.h NotFitted).
     for name in names:
         block = out.stdout.split("per-lobe fit of %s:" % name)[1].split("per-lobe fit of")[0]
-        assert re.findall(r"phi_i\s+\S+\s+(\S+) c0:", block) == [name]
+        if name in (names[3], names[4]):
+            assert block.startswith("\nnot fitted: no free parameter acts on this lobe ("), block
+        else:
+            assert re.findall(r"phi_i\s+\S+\s+(\S+) c0:", block) == [name]
     # The progress lines on stderr too.
     assert re.findall(r"^(\S+) fit: \d+ residuals", out.stderr, re.M) == names
     report = (d / "fit_report" / "report.md").read_text()
@@ -120,7 +124,7 @@ def test_python_records_and_fit_tables_name_the_file_lobes(fur):
 @pytest.fixture(scope="module")
 def atlas(fur, fiberlab_binary):
     d, names = fur
-    config = ATLAS.replace("EXTRA", "scattered")
+    config = ATLAS.replace("EXTRA", "%s, scattered" % names[3])
     (d / "atlas.yaml").write_text(config)
     out = subprocess.run([fiberlab_binary, "atlas", str(d / "atlas.yaml"), "-o", str(d / "atlas.h5")],
                          capture_output=True, text=True)
@@ -133,14 +137,24 @@ def test_atlas_fits_and_names_the_scattered_lobe(atlas):
     assert names[-1] == "scattered" and len(names) == 5
     # fit.lobes names `scattered`: only the medullated fiber (2) has it.
     fits = re.findall(r"^  marschner2003 per-lobe (\S+) fit: \d+ residuals", stderr, re.M)
-    assert fits.count("scattered") == 1 and fits.count("R") == 2
+    assert fits == ["R", "TT", names[3], "R", "TT", names[3], "scattered"]
     tables = (d / "atlas_report" / "atlas_tables.md").read_text()
     headline = re.findall(r"^\| marschner2003 \| 2 \| (\S+) \|", tables, re.M)
     assert headline == names
-    # The per-fiber per-lobe lines of the medullated fiber name `scattered`
-    # and the last lobe by p as the file does.
-    lines = [line for line in tables.splitlines() if "medulla" in line and "marschner2003" in line]
-    assert any("scattered:" in line or "scattered" in line for line in lines), lines
+    # The per-fiber per-lobe lines name the lobes as the file does; no key of
+    # marschner2003 acts on p>=3 or `scattered` (it predicts nothing there).
+    not_fitted = "not fitted: no free parameter acts on this lobe"
+    rows = [line for line in tables.splitlines() if re.match(r"\| \d+\. .* \| marschner2003 \|", line)]
+    plain, medullated = [r for r in rows if "medulla" not in r], [r for r in rows if "medulla" in r]
+    assert len(plain) == 1 and len(medullated) == 1
+    assert "%s: %s" % (names[3], not_fitted) in plain[0] and "scattered" not in plain[0]
+    assert "%s: %s; scattered: %s" % (names[3], not_fitted, not_fitted) in medullated[0]
+    assert re.findall(r"^  marschner2003 (\S+): " + not_fitted, stderr, re.M) == [names[3], names[3], "scattered"]
+    # The file's per-lobe status lines too.
+    with h5py.File(d / "atlas.h5", "r") as f:
+        lines = f["models/marschner2003"].attrs["lobe_fit_lines"]
+    lines = lines.decode() if isinstance(lines, bytes) else lines
+    assert lines.count(not_fitted) == 3
 
 
 def test_atlas_fit_lobes_refuses_an_unknown_lobe(fur, fiberlab_binary):
