@@ -166,3 +166,19 @@ def test_atlas_fit_lobes_refuses_an_unknown_lobe(fur, fiberlab_binary):
     assert out.stderr.count("\n") == 1
     assert "fit.lobes: unknown lobe 'TRRT' (allowed: R, TT, TRT, p>=3, scattered" in out.stderr.replace(",", ", ")
     assert not (d / "bad.h5").exists()
+
+
+def test_atlas_fit_of_scattered_alone_skips_the_plain_fiber(fur, fiberlab_binary):
+    # fit.lobes [scattered]: the fiber without a medulla has none of them and
+    # says so; the medullated one is fitted (joint fit over `scattered`,
+    # where no key acts: not fitted either, and says why).
+    d, _ = fur
+    (d / "only.yaml").write_text(ATLAS.replace("R, TT, EXTRA", "scattered").replace("per_lobe: true", "per_lobe: false"))
+    out = subprocess.run([fiberlab_binary, "atlas", str(d / "only.yaml"), "-o", str(d / "only.h5")],
+                         capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    with h5py.File(d / "only.h5", "r") as f:
+        status = f["models/marschner2003"].attrs["status"]
+    status = (status.decode() if isinstance(status, bytes) else status).split("\n")
+    assert status == ["not fitted: fit.lobes names none of the fiber's lobes (R,TT,TRT,p>=3)",
+                      "not fitted: no free parameter acts on this lobe"], status
