@@ -58,7 +58,7 @@ Comparison set_up(const CompareRequest& o) {
   }
   c.fit_options = copt;  // the lobes the fit judges and fits
   if (!o.fit_lobes.empty())
-    c.fit_options.lobes = compare::parse_fit_lobes(split_commas(o.fit_lobes), result.lobes, "--fit-lobes");
+    c.fit_options.lobes = compare::parse_fit_lobes(split_commas(o.fit_lobes), result.lobe_names(), "--fit-lobes");
   if (c.from_file) c.file_prediction = predicted_by_file(result, o);
   if (!o.report.empty()) compare::make_report_dir(o.report);
   return c;

@@ -47,7 +47,7 @@ std::vector<LobeFitVerdict> fit_each_lobe(const sim::ResultFile& result, const s
 FitReport fit(const sim::ResultFile& result, const FitRequest& r,
               const std::function<void(const std::string&)>& progress) {
   compare::Options o = r.options;
-  if (!r.lobes.empty()) o.lobes = compare::parse_fit_lobes(r.lobes, result.lobes, "lobes");
+  if (!r.lobes.empty()) o.lobes = compare::parse_fit_lobes(r.lobes, result.lobe_names(), "lobes");
   if (r.max_iterations < 1) throw Error("max_iterations must be an integer >= 1");
   if (r.keys.empty()) throw Error("fit: give at least one key to fit (e.g. [\"beta_long\"])");
   std::set<std::string> seen;

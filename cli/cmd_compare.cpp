@@ -33,10 +33,11 @@ void print_progress(const std::string& line) { fmt::print(stderr, "{}\n", line);
 std::string per_lobe_fits(const app::Comparison& c, const compare::Verdict& before) {
   std::string md = "\n## Per-lobe fits\n";
   for (const app::LobeFitVerdict& lf : app::fit_each_lobe(c, before, print_progress)) {
-    const std::string name = compare::lobe_name(lf.lobe, c.result.lobes);
+    const std::vector<std::string> names = c.result.lobe_names();
+    const std::string& name = names.at(static_cast<std::size_t>(lf.lobe));
     fmt::print("\nper-lobe fit of {}:", name);
-    fmt::print("{}", compare::fit_text(lf.fit, lf.before, lf.after, c.result.lobes));
-    md += fmt::format("\n### {}\n\n", name) + compare::fit_markdown(lf.fit, lf.before, lf.after, c.result.lobes);
+    fmt::print("{}", compare::fit_text(lf.fit, lf.before, lf.after, names));
+    md += fmt::format("\n### {}\n\n", name) + compare::fit_markdown(lf.fit, lf.before, lf.after, names);
   }
   return md;
 }
@@ -51,7 +52,7 @@ void compare_command(const app::CompareRequest& o) {
   app::Predicted current = c.from_file ? c.file_prediction : app::predicted_by_model(result, c.spec, c.params, c.fiber_notes);
   fmt::print("{}", current.header);
   compare::Verdict v = app::judge(c, current);
-  fmt::print("{}", compare::verdict_table(v, result.lobes));
+  fmt::print("{}", compare::verdict_table(v, result.lobe_names()));
 
   analytic::ModelParameters params = c.params;
   std::string fit_json = "null", fit_md;
@@ -61,11 +62,11 @@ void compare_command(const app::CompareRequest& o) {
     current = std::move(fit.predicted);
     const compare::Verdict before = v;
     v = fit.after;
-    fmt::print("{}", compare::fit_text(fit.fit, before, v, result.lobes));
-    fit_md = compare::fit_markdown(fit.fit, before, v, result.lobes);
+    fmt::print("{}", compare::fit_text(fit.fit, before, v, result.lobe_names()));
+    fit_md = compare::fit_markdown(fit.fit, before, v, result.lobe_names());
     fit_json = compare::fit_json(fit.fit, before, v);
     fmt::print("\nafter the fit: {}", current.header);
-    fmt::print("{}", compare::verdict_table(v, result.lobes));
+    fmt::print("{}", compare::verdict_table(v, result.lobe_names()));
     if (o.per_lobe) fit_md += per_lobe_fits(c, before);
   }
 

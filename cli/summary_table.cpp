@@ -9,17 +9,8 @@
 
 namespace fiberlab::cli {
 
-namespace {
-
-std::string lobe_name(int lobe, int lobes) {
-  static const char* names[] = {"R", "TT", "TRT", "TRRT", "TR3T", "TR4T"};
-  if (lobe == lobes - 1 && lobes > 1) return fmt::format("p>={}", lobe);
-  return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
-}
-
-}  // namespace
-
 void print_summary(std::FILE* out, const sim::ResultFile& r) {
+  const std::vector<std::string> lobe_names = r.lobe_names();
   for (std::size_t k = 0; k < r.configs(); ++k) {
     const double N = static_cast<double>(r.photons[k]);
     const std::string phi = std::isnan(r.phi_i[k]) ? std::string("uniform")
@@ -30,7 +21,7 @@ void print_summary(std::FILE* out, const sim::ResultFile& r) {
     for (int c = 0; c < r.channels; ++c) fmt::print(out, " {:>24}", fmt::format("channel {}", c));
     fmt::print(out, "\n");
     for (int l = 0; l < r.lobes; ++l) {
-      fmt::print(out, "  {:<10}", lobe_name(l, r.lobes));
+      fmt::print(out, "  {:<10}", lobe_names.at(static_cast<std::size_t>(l)));
       for (int c = 0; c < r.channels; ++c) {
         const sim::Estimate e = sim::lobe_energy(r, k, l, c);
         fmt::print(out, " {:>24}", estimate_text(e.mean, e.std_error));

@@ -4,11 +4,15 @@
 
 namespace fiberlab {
 
+namespace {
+
 std::string lobe_name(int lobe, int lobes) {
   static const char* names[] = {"R", "TT", "TRT", "TRRT", "TR3T", "TR4T"};
   if (lobe == lobes - 1 && lobes > 1) return fmt::format("p>={}", lobe);
   return lobe < 6 ? names[lobe] : fmt::format("p={}", lobe);
 }
+
+}  // namespace
 
 std::vector<std::string> lobe_names(int lobes, bool scattered) {
   const int by_p = scattered ? lobes - 1 : lobes;
@@ -31,6 +35,16 @@ std::string join_names(const std::vector<std::string>& names) {
   return s;
 }
 
+std::vector<std::string> split_names(const std::string& joined) {
+  std::vector<std::string> out;
+  for (std::size_t a = 0;;) {
+    const std::size_t b = joined.find(',', a);
+    out.push_back(joined.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) return out;
+    a = b + 1;
+  }
+}
+
 void describe(h5::File& f, const std::string& path, const std::string& dimensions, const std::string& units,
               const std::string& description) {
   if (!dimensions.empty()) f.set_attr(path, "dimensions", dimensions);
@@ -38,8 +52,8 @@ void describe(h5::File& f, const std::string& path, const std::string& dimension
   f.set_attr(path, "description", description);
 }
 
-void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin, bool scattered) {
-  f.set_attr("/", "lobe_names", join_names(lobe_names(lobes, scattered)));
+void write_axis_names(h5::File& f, const std::vector<std::string>& lobe_names, int channels, bool from_melanin) {
+  f.set_attr("/", "lobe_names", join_names(lobe_names));
   f.set_attr("/", "channel_names", join_names(channel_names(channels, from_melanin)));
 }
 

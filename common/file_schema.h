@@ -11,18 +11,22 @@
 namespace fiberlab {
 
 // Tally lobe names (SPEC s6): lobes 0..L-2 by their paths (R, TT, TRT, TRRT,
-// ...), the last one collecting every larger p ("p>=3" for L = 4).
-std::string lobe_name(int lobe, int lobes);
-// With `scattered` (a fiber with a medulla, docs/FUR.md) the last of the
-// `lobes` is "scattered" and the others are named as for lobes - 1.
+// ...), the last one collecting every larger p ("p>=3" for L = 4). With
+// `scattered` (a fiber with a medulla, docs/FUR.md) the last of the `lobes`
+// is "scattered" and the others are named as for lobes - 1. Called by the
+// owners of a lobe axis (sim::ResultFile::lobe_names(), a prediction's, an
+// atlas's), which every writer of `lobe_names` and every table takes its
+// names from.
 std::vector<std::string> lobe_names(int lobes, bool scattered = false);
 
 // Channel names: "R", "G", "B" for a fiber whose sigma_a came from melanin
 // (three channels, d'Eon et al. 2011 s6.1), else "c0", "c1", ...
 std::vector<std::string> channel_names(int channels, bool from_melanin);
 
-// Comma-separated, as stored in the attributes below.
+// Comma-separated, as stored in the attributes below; split_names reads
+// them back.
 std::string join_names(const std::vector<std::string>& names);
+std::vector<std::string> split_names(const std::string& joined);
 
 // Dimension labels of a histogram dataset ((K, L, n_theta, n_phi, C) and its
 // sub-shapes), as the attribute `dimensions` holds them.
@@ -43,9 +47,9 @@ void write_described(h5::File& f, const std::string& path, const h5::Dims& dims,
   describe(f, path, dimensions, units, description);
 }
 
-// Root attributes `lobe_names` and `channel_names` (comma-separated).
-void write_axis_names(h5::File& f, int lobes, int channels, bool from_melanin,
-                      bool scattered = false);
+// Root attributes `lobe_names` (the axis owner's names, above) and
+// `channel_names` (comma-separated).
+void write_axis_names(h5::File& f, const std::vector<std::string>& lobe_names, int channels, bool from_melanin);
 
 // Where the bin edges, solid angles and incident directions are: in a
 // result or prediction file /bins/... and /source/... (common/result_layout.h

@@ -8,6 +8,7 @@
 
 #include "analytic/model_registry.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/interrupt.h"
 #include "compare/models.h"
 #include "sim/store/result_file.h"
@@ -51,14 +52,27 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
   return compare(r, predict_result(*model, r), analytic::theta_r_shifts(name, p));
 }
 
-// "fitted (converged: why)", "fitted (at a bound: key = value; why)" or
-// "fitted (not converged: why)": the per-fiber table's status.
+// "fitted (converged: why)", "fitted (at a bound: key = value; why)",
+// "fitted (not converged: why)" or "not fitted: why" (no key acts on the
+// fitted bins): the per-fiber table's status.
 std::string fit_status(const FitResult& fit) {
+  if (fit.outcome == FitOutcome::NotFitted) return "not fitted: " + fit.stop_reason;
   std::string bound;
   for (std::size_t j = 0; j < fit.keys.size(); ++j)
     if (fit.at_bound[j]) bound += fmt::format("{}{} = {:.6g}", bound.empty() ? "" : ", ", fit.keys[j], fit.value[j]);
   if (fit.outcome == FitOutcome::AtBound) return fmt::format("fitted (at a bound: {}; {})", bound, fit.stop_reason);
   return fmt::format("fitted ({}: {})", outcome_name(fit.outcome), fit.stop_reason);
+}
+
+// The lobes of fit.lobes this fiber has (empty: every lobe). fit.lobes
+// indexes the atlas's lobe axis, whose `scattered` only a medullated fiber
+// has; the other lobes have the same index in every fiber (the tally is
+// shared).
+std::vector<int> fiber_fit_lobes(const AtlasConfig& config, const sim::ResultFile& r) {
+  std::vector<int> out;
+  for (int l : config.fit_lobes)
+    if (l < r.lobes) out.push_back(l);
+  return out;
 }
 
 // fit.per_lobe: whether the model has a per-lobe parameter among `keys`
@@ -93,7 +107,7 @@ void fit_lobe_by_lobe(const AtlasConfig& config, const sim::ResultFile& r, const
   check_interrupt();
   try {
     Options fit_options;
-    fit_options.lobes = config.fit_lobes;
+    fit_options.lobes = fiber_fit_lobes(config, r);
     m.lobe_fits = fit_each_lobe(r, model, m.fit.params, keys, fit_options, config.max_iterations,
                                 [&](const std::string& line) {
                                   check_interrupt();
@@ -110,7 +124,8 @@ void fit_lobe_by_lobe(const AtlasConfig& config, const sim::ResultFile& r, const
     m.lobe_fit_lines.push_back(fit_status(lf.fit));
     for (const LobeComparison& c : judge_model(r, model, lf.fit.params))
       if (c.lobe == lf.lobe) m.after_lobe_fit.push_back(c);
-    say(control, fmt::format("  {} {}: {}", name, lobe_name(lf.lobe, r.lobes), m.lobe_fit_lines.back()));
+    say(control, fmt::format("  {} {}: {}", name, r.lobe_names().at(static_cast<std::size_t>(lf.lobe)),
+                             m.lobe_fit_lines.back()));
   }
 }
 
@@ -137,11 +152,13 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
     m.status = "not fitted: its parameter table marks no parameter free";
   } else if (config.max_iterations == 0) {
     m.status = "not fitted: fit.max_iterations = 0";
+  } else if (!config.fit_lobes.empty() && fiber_fit_lobes(config, r).empty()) {
+    m.status = fmt::format("not fitted: fit.lobes names none of the fiber's lobes ({})", join_names(r.lobe_names()));
   } else {
     check_interrupt();
     try {
       Options fit_options;
-      fit_options.lobes = config.fit_lobes;
+      fit_options.lobes = fiber_fit_lobes(config, r);
       m.fit = fit_model(r, model, p, keys, fit_options, config.max_iterations, [&](const std::string& line) {
         check_interrupt();
         say(control, "  " + name + " " + line);

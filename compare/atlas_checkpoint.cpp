@@ -394,10 +394,17 @@ FitResult fit_from(const Reader& r, const double* n, const std::vector<double>& 
     fit.error_unscaled.push_back(v[3]);
     fit.at_bound.push_back(from_cell<bool>(r, v[4], where + ".fit.at_bound"));
   }
-  // The outcome follows from these (fit_model's rule); the stop reason is
-  // kept in the model's status line.
+  // The outcome follows from these (fit_model's rule: a fit that moves
+  // nothing takes no iteration and has NaN errors, compare/fit.h NotFitted);
+  // the stop reason is kept in the model's status line (a per-lobe fit's in
+  // its lobe_fit_lines).
   const bool bound = std::find(fit.at_bound.begin(), fit.at_bound.end(), true) != fit.at_bound.end();
-  fit.outcome = !fit.converged ? FitOutcome::NotConverged : bound ? FitOutcome::AtBound : FitOutcome::Converged;
+  const bool not_fitted = !fit.converged && fit.iterations == 0 && !fit.error.empty() &&
+                          std::all_of(fit.error.begin(), fit.error.end(), [](double e) { return std::isnan(e); });
+  fit.outcome = not_fitted       ? FitOutcome::NotFitted
+                : !fit.converged ? FitOutcome::NotConverged
+                : bound          ? FitOutcome::AtBound
+                                 : FitOutcome::Converged;
   try {
     fit.params = start;
     for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
@@ -557,7 +564,7 @@ AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const 
     LobeFit lf;
     lf.lobe = from_cell<int>(r, n[0], where + ".lobe_fit.lobe");
     if (lf.lobe < 0 || lf.lobe >= fiber.lobes) r.fail(fmt::format("{}: per-lobe fit of lobe {} is outside the fiber's {} lobes", where, lf.lobe, fiber.lobes));
-    const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, lobe_name(lf.lobe, fiber.lobes));
+    const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, fiber_lobe_names(fiber.fiber).at(static_cast<std::size_t>(lf.lobe)));
     lf.fit = fit_from(r, n + 1, s.lobe_fits.values, at.lobe_fit_value, per_lobe_keys(model, out.fit.keys, lf.lobe),
                       model, out.fit.params, lobe_where);
     out.lobe_fits.push_back(std::move(lf));

@@ -16,6 +16,7 @@
 #include "analytic/physical_defaults.h"
 #include "common/config_reader.h"
 #include "common/error.h"
+#include "common/file_schema.h"
 #include "common/fiber.h"
 #include "common/units.h"
 #include "compare/fit.h"
@@ -421,7 +422,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
             f.label += fmt::format(", medulla k {:g} sigma_s {:g}", md->radius, md->sigma_s);
           c.fibers.push_back(std::move(f));
         }
-  // fit.lobes: names of the tally's lobes (every fiber shares the tally).
+  // fit.lobes: names on the atlas's lobe axis (`scattered` too when a fiber has a medulla).
   if (top["fit"] && top["fit"]["lobes"]) {
     const YAML::Node lobes = top["fit"]["lobes"];
     std::vector<std::string> names;
@@ -430,7 +431,7 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
       names.push_back(n.Scalar());
     }
     try {
-      c.fit_lobes = parse_fit_lobes(names, c.fibers.at(0).settings.tally.lobes, "fit.lobes");
+      c.fit_lobes = parse_fit_lobes(names, atlas_lobe_names(c.fibers), "fit.lobes");
     } catch (const Error& e) {
       r.fail(e.what());
     }
@@ -449,6 +450,20 @@ AtlasConfig load_atlas_config(const std::string& path) {
   text.resize(static_cast<std::size_t>(in.gcount()));
   if (text.size() > kMaxConfigBytes) throw Error(path + ": atlas config is larger than 1 MiB");
   return parse_atlas_config(text, path);
+}
+
+std::vector<std::string> fiber_lobe_names(const AtlasFiber& fiber) {
+  const sim::Settings& s = fiber.settings;
+  return lobe_names(s.tally_lobes(), s.fiber.medulla.has_value());
+}
+
+std::vector<std::string> atlas_lobe_names(const std::vector<AtlasFiber>& fibers) {
+  std::vector<std::string> longest;
+  for (const AtlasFiber& f : fibers) {
+    std::vector<std::string> names = fiber_lobe_names(f);
+    if (names.size() > longest.size()) longest = std::move(names);
+  }
+  return longest;
 }
 
 const std::string& registered_model(const AtlasConfig& config, const std::string& entry) {

@@ -21,7 +21,9 @@
 //   #  [deon2011, {name: chiang2016_pbrt, model: chiang2016, parameters: {mp: pbrt_v4}}]
 //   model_parameters:     # optional: fixed (not fitted) parameters per model
 //     huang2022: {quadrature_points: 262144}
-//   fit: {max_iterations: 20, lobes: [R, TT, TRT]}   # lobes: optional, default every lobe
+//   fit: {max_iterations: 20, lobes: [R, TT, TRT]}   # lobes: optional, default every lobe;
+//   # any name of the atlas's lobe axis (atlas_lobe_names: `scattered` too
+//   # when a fiber has a medulla; a fiber fits those of them it has)
 //   # per_lobe: optional (false): after the joint fit, each lobe of fit.lobes
 //   # fitted alone from the joint fit's values (compare/atlas.h)
 //
@@ -78,12 +80,21 @@ struct AtlasConfig {
   // variant, its model's then its own), checked.
   std::map<std::string, std::vector<std::string>> model_parameters;
   int max_iterations = 20;
-  // fit.lobes: the tally lobes the fit judges and fits (empty: every lobe).
+  // fit.lobes: the lobes the fit judges and fits, indices into
+  // atlas_lobe_names() (empty: every lobe).
   std::vector<int> fit_lobes;
   // fit.per_lobe: after the joint fit, each of those lobes fitted alone.
   bool per_lobe = false;
   std::vector<double> theta_i;  // radians
 };
+
+// The lobe names of a fiber's result (sim::ResultFile::lobe_names() of its
+// run): the tally's lobes by p, `scattered` last with a medulla (docs/FUR.md).
+std::vector<std::string> fiber_lobe_names(const AtlasFiber& fiber);
+// The atlas's lobe axis, what its file's `lobe_names` holds: the longest of
+// any fiber's (every fiber shares the tally, so it is a medullated fiber's
+// when there is one), named as that fiber names them.
+std::vector<std::string> atlas_lobe_names(const std::vector<AtlasFiber>& fibers);
 
 // The registered model an entry of config.models runs (itself unless a variant).
 const std::string& registered_model(const AtlasConfig& config, const std::string& entry);

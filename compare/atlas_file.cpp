@@ -133,7 +133,7 @@ void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const st
     for (std::size_t j = 0; j < r.lobe_fits.size(); ++j) {
       const LobeFit& lf = r.lobe_fits[j];
       const std::size_t at = i * s.L + lf.lobe;
-      fitted[at] = 1;
+      fitted[at] = lf.fit.outcome != FitOutcome::NotFitted;  // else its line says why not
       lines[at] = r.lobe_fit_lines.at(j);
       fits.set(at, lf.fit);
     }
@@ -158,7 +158,8 @@ void write_lobe_fits(h5::File& f, const Shape& s, const std::string& g, const st
   f.set_attr("/" + g, "lobe_fit_lines", joined(lines));
   const h5::Dims FLd{s.F, s.L}, FLP{s.F, s.L, P};
   const std::string key_unit = "the key's unit (degrees for angles)";
-  put(f, g + "/lobe_fitted", FLd, fitted, "fiber,lobe", "0/1", "1: the lobe was fitted alone (fit.per_lobe)");
+  put(f, g + "/lobe_fitted", FLd, fitted, "fiber,lobe", "0/1", "1: the lobe was fitted alone (fit.per_lobe); 0 also where no free parameter acts on "
+      "the lobe (its lobe_fit_lines entry says so)");
   put(f, g + "/lobe_fit_converged", FLd, fits.converged, "fiber,lobe", "0/1", "1: the lobe's own fit converged");
   put(f, g + "/model_energy_lobe_fit", s.dims(), energy, kAtlasDims, "fraction of incident light",
       "the model's lobe energy with that lobe's own fitted parameters (NaN: not fitted lobe by lobe)");
@@ -261,16 +262,13 @@ void write_model(h5::File& f, const Shape& s, const AtlasConfig& config, const s
 void write_atlas_axis_names(h5::File& f, const AtlasConfig& config) {
   // A fiber with a medulla has one lobe more, `scattered` (docs/FUR.md): the
   // file's lobe axis is the longest, NaN where a fiber has no such lobe.
-  int lobes = 0, channels = 0;
-  bool from_melanin = true, scattered = false;
+  int channels = 0;
+  bool from_melanin = true;
   for (const AtlasFiber& fiber : config.fibers) {
-    const bool medulla = fiber.settings.fiber.medulla.has_value();
-    lobes = std::max(lobes, fiber.settings.tally.lobes + (medulla ? 1 : 0));
-    scattered = scattered || medulla;
     channels = std::max(channels, static_cast<int>(fiber.settings.fiber.sigma_a.size()));
     from_melanin = from_melanin && fiber.settings.fiber.eumelanin.has_value();
   }
-  write_axis_names(f, lobes, channels, from_melanin, scattered);
+  write_axis_names(f, atlas_lobe_names(config.fibers), channels, from_melanin);
 }
 
 void write_atlas_file(const std::string& path, const AtlasConfig& config,

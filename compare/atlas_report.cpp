@@ -30,7 +30,7 @@ std::string num(double x, const char* spec = "{:.3g}") {
 double per_dof(double chi2, int dof) { return dof > 0 ? chi2 / dof : std::nan(""); }
 
 std::string fitted_params(const AtlasModelResult& m) {
-  if (!m.fitted) return m.status;
+  if (!m.fitted || m.fit.outcome == FitOutcome::NotFitted) return m.status;
   std::string s;
   for (std::size_t j = 0; j < m.fit.keys.size(); ++j)
     s += fmt::format("{}{} = {:.4g} ± {:.2g}{}", j ? ", " : "", m.fit.keys[j], m.fit.value[j], m.fit.error[j],
@@ -46,13 +46,12 @@ int lobe_count(const std::vector<AtlasFiberResult>& fibers) {
   return L;
 }
 
-// The name of lobe l on that axis: the last is `scattered` when a fiber has
-// a medulla (docs/FUR.md).
+// The name of lobe l on the atlas's lobe axis (atlas_lobe_names: the last is
+// `scattered` when a fiber has a medulla, docs/FUR.md).
 std::string lobe_label(int l, const std::vector<AtlasFiberResult>& fibers) {
-  const bool scattered = std::any_of(fibers.begin(), fibers.end(), [](const AtlasFiberResult& f) {
-    return f.fiber.settings.fiber.medulla.has_value();
-  });
-  return lobe_names(lobe_count(fibers), scattered).at(static_cast<std::size_t>(l));
+  std::vector<AtlasFiber> of;
+  for (const AtlasFiberResult& f : fibers) of.push_back(f.fiber);
+  return atlas_lobe_names(of).at(static_cast<std::size_t>(l));
 }
 
 // The config's model_parameters, one sentence (empty when there are none).
@@ -86,8 +85,13 @@ void copy_atlas_file(const std::string& atlas_path, const std::string& dir) {
 std::string lobe_fitted_params(const AtlasModelResult& m, const std::vector<AtlasFiberResult>& fibers) {
   if (m.lobe_fits.empty()) return m.lobe_fit_status;
   std::string s;
-  for (const LobeFit& lf : m.lobe_fits) {
+  for (std::size_t i = 0; i < m.lobe_fits.size(); ++i) {
+    const LobeFit& lf = m.lobe_fits[i];
     s += fmt::format("{}{}:", s.empty() ? "" : "; ", lobe_label(lf.lobe, fibers));
+    if (lf.fit.outcome == FitOutcome::NotFitted) {  // its status line says why ("not fitted: ...")
+      s += " " + m.lobe_fit_lines.at(i);
+      continue;
+    }
     for (std::size_t j = 0; j < lf.fit.keys.size(); ++j)
       s += fmt::format(" {} = {:.4g} ± {:.2g}{}", lf.fit.keys[j], lf.fit.value[j], lf.fit.error[j],
                        lf.fit.at_bound[j] ? " (at bound)" : "");

@@ -14,12 +14,12 @@ namespace {
 std::string write_staged(const CompareReport& rep, ReportFolder& folder, const sim::ResultFile& result,
                          const std::vector<std::vector<double>>& bins, const Verdict& v) {
   const std::string& dir = folder.staging();
-  write_text(dir, "metrics.csv", verdict_csv(v, result.lobes));
+  write_text(dir, "metrics.csv", verdict_csv(v, result.lobe_names()));
   const std::string json = fmt::format(
       "{{\n  \"kind\": \"compare\",\n  \"result\": {},\n  \"model\": {},\n  \"params\": {},\n  \"criterion\": {},\n"
       "  \"accepted\": {},\n  \"fit\": {},\n  \"lobes\": {}\n}}\n",
       json_string(rep.result_path), json_string(rep.label), rep.params_json, json_string(v.criterion),
-      v.all_accepted ? "true" : "false", rep.fit_json, verdict_json_rows(v, result.lobes));
+      v.all_accepted ? "true" : "false", rep.fit_json, verdict_json_rows(v, result.lobe_names()));
   write_text(dir, "metrics.json", json);
   write_compare_data(dir, result, bins, rep.label, rep.plot_channel);
   const PlotOutcome plots = make_plots("compare", dir);
@@ -27,7 +27,7 @@ std::string write_staged(const CompareReport& rep, ReportFolder& folder, const s
                                "Verdict: **{}** ({} of {} judged lobes accepted).\n\n",
                                rep.result_path, rep.label, rep.header, v.criterion,
                                v.all_accepted ? "accepted" : "rejected", v.judged - v.rejected, v.judged);
-  md += verdict_markdown(v, result.lobes);
+  md += verdict_markdown(v, result.lobe_names());
   md += "\n" + rep.fit_markdown;
   md += "\n## Plots\n\n";
   if (plots.html) md += "All figures on one page: [report.html](report.html).\n\n";

@@ -26,8 +26,6 @@ void check_options(const Options& o, std::optional<double> max_chi2, OptionSpell
   if (max_chi2) check(*max_chi2, "max_chi2", "--max-chi2", *max_chi2 > 0.0, "a number > 0");
 }
 
-std::string lobe_name(int lobe, int lobes) { return fiberlab::lobe_name(lobe, lobes); }
-
 namespace {
 
 // One histogram cell (a bin, a marginal bin or the pooled rest) in the

@@ -99,6 +99,4 @@ std::vector<double> normalised_residuals(const sim::ResultFile& result, const Se
                                          const std::vector<std::vector<double>>& model_bins,
                                          const Options& options = {});
 
-std::string lobe_name(int lobe, int lobes);
-
 }  // namespace fiberlab::compare

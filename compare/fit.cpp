@@ -135,8 +135,9 @@ void check_fit_keys(const std::string& model_name, const std::vector<std::string
   }
 }
 
-std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what) {
-  const std::vector<std::string> known = lobe_names(lobes);
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, const std::vector<std::string>& known,
+                                 const std::string& what) {
+  const int lobes = static_cast<int>(known.size());
   std::vector<int> out;
   for (const std::string& name : names) {
     int found = -1;
@@ -172,6 +173,7 @@ const char* outcome_name(FitOutcome o) {
     case FitOutcome::Converged: return "converged";
     case FitOutcome::AtBound: return "at a bound";
     case FitOutcome::NotConverged: return "not converged";
+    case FitOutcome::NotFitted: return "not fitted";
   }
   return "not converged";
 }
@@ -455,6 +457,28 @@ void finish(const FitProblem& problem, const Iterate& it, int max_iterations, Fi
   fr.params = problem.params_at(it.x);
 }
 
+// Whether no key changes any residual: every derivative exactly 0 (the
+// model's prediction of the fitted bins does not depend on the keys; a
+// difference of exactly 0 is no rounding: a key that enters the prediction
+// changes some bits of it).
+bool no_key_acts(const Eigen::MatrixXd& J) { return J.size() > 0 && (J.array() == 0.0).all(); }
+
+// The result of a fit that moves nothing (FitOutcome::NotFitted, fit.h).
+void finish_not_fitted(const FitProblem& problem, const Iterate& it, const Options& options, FitResult& fr) {
+  fr.outcome = FitOutcome::NotFitted;
+  fr.converged = false;
+  fr.stop_reason = options.lobes.size() == 1 ? kNoKeyActsOnLobe : "no free parameter acts on the fitted lobes";
+  fr.dof = fr.residuals;
+  fr.chi2 = fr.chi2_start;
+  for (int j = 0; j < problem.n(); ++j) {
+    fr.value.push_back(it.x[j]);
+    fr.error.push_back(std::nan(""));
+    fr.error_unscaled.push_back(std::nan(""));
+    fr.at_bound.push_back(false);
+  }
+  fr.params = problem.params_at(it.x);
+}
+
 std::string iteration_line(const FitProblem& problem, const Iterate& it, const FitResult& fr) {
   std::string values;
   for (int j = 0; j < problem.n(); ++j) values += fmt::format(" {}={:.6g}", problem.keys()[j], it.x[j]);
@@ -482,16 +506,21 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   ++fr.evaluations;
   const long m = it.r.size();
   fr.residuals = static_cast<int>(m);
+  fr.chi2_start = it.r.squaredNorm();
+  it.chi2 = fr.chi2_start;
+  it.J = problem.jacobian(it.x, m);
+  fr.evaluations += 2 * n;
+  if (no_key_acts(it.J)) {
+    finish_not_fitted(problem, it, options, fr);
+    if (progress) progress(fmt::format("fit: {} residuals, not fitted: {}", m, fr.stop_reason));
+    return fr;
+  }
   fr.dof = static_cast<int>(m) - n;
   if (fr.dof <= 0) throw Error(fmt::format("--fit: {} residuals for {} parameters", m, n));
-  fr.chi2_start = it.r.squaredNorm();
   if (progress)
     progress(fmt::format("fit: {} residuals, {} parameters, start chi2/dof {:.4f}; each iteration costs {} "
                          "model evaluations",
                          m, n, fr.chi2_start / fr.dof, 2 * n + 1));
-  it.chi2 = fr.chi2_start;
-  it.J = problem.jacobian(it.x, m);
-  fr.evaluations += 2 * n;
   it.last_step = Eigen::VectorXd::Zero(n);
   for (fr.iterations = 0; fr.iterations < max_iterations; ++fr.iterations) {
     const bool improved = take_step(problem, it, fr);
@@ -521,10 +550,11 @@ std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::str
   if (lobes.empty())
     for (int l = 0; l < result.lobes; ++l) lobes.push_back(l);
   std::vector<LobeFit> out;
+  const std::vector<std::string> names = result.lobe_names();
   for (int lobe : lobes) {
     Options one = options;
     one.lobes = {lobe};
-    const std::string name = lobe_name(lobe, result.lobes);
+    const std::string& name = names.at(static_cast<std::size_t>(lobe));
     try {
       out.push_back({lobe, fit_model(result, model_name, start, per_lobe_keys(model_name, keys, lobe), one,
                                      max_iterations, [&](const std::string& line) {

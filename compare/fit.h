@@ -97,8 +97,16 @@ void check_fit_keys(const std::string& model_name, const std::vector<std::string
 // moved every parameter by a negligible part of its error, or no downhill
 // step existed at any damping. AtBound: converged with a parameter held on
 // an end of fit_range(). NotConverged: the iteration cap came first.
-enum class FitOutcome { Converged, AtBound, NotConverged };
-const char* outcome_name(FitOutcome o);  // "converged", "at a bound", "not converged"
+// NotFitted: no key changes any fitted residual (every derivative at the
+// start is exactly 0, e.g. a per-lobe fit of a lobe the model predicts
+// nothing in, or whose prediction none of the keys enters): there is no fit,
+// the values stay at the start, their errors are NaN, chi2 is the start's
+// over dof = residuals, and no iteration is taken.
+enum class FitOutcome { Converged, AtBound, NotConverged, NotFitted };
+// "converged", "at a bound", "not converged", "not fitted"
+const char* outcome_name(FitOutcome o);
+// The stop reason of a NotFitted fit of one lobe.
+inline constexpr const char* kNoKeyActsOnLobe = "no free parameter acts on this lobe";
 
 struct FitResult {
   std::vector<std::string> keys;
@@ -108,17 +116,19 @@ struct FitResult {
   std::vector<bool> at_bound;          // the value sits on an end of fit_range()
   double chi2_start = 0.0, chi2 = 0.0;
   int residuals = 0, dof = 0, iterations = 0, evaluations = 0;
-  bool converged = false;  // outcome != NotConverged
+  bool converged = false;  // outcome is Converged or AtBound
   FitOutcome outcome = FitOutcome::NotConverged;
   std::string stop_reason;  // one line: why the fit stopped (the test that ended it, with its numbers)
   analytic::ModelParameters params;  // at the minimum
   double per_dof() const { return dof > 0 ? chi2 / dof : 0.0; }
 };
 
-// Tally lobe indices of lobe names (R, TT, TRT, ..., the last lobe's "p>=N",
-// or a lobe index), checked against `lobes`; throws fiberlab::Error naming
-// `what` (the flag or config key) and the allowed names.
-std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, int lobes, const std::string& what);
+// Lobe indices of lobe names (one of `known`, the lobe axis's names: R, TT,
+// TRT, ..., the last lobe by p's "p>=N", `scattered` with a medulla; or a
+// lobe index); throws fiberlab::Error naming `what` (the flag or config key)
+// and the allowed names.
+std::vector<int> parse_fit_lobes(const std::vector<std::string>& names, const std::vector<std::string>& known,
+                                 const std::string& what);
 
 // The keys of a per-lobe fit of lobe `lobe`: a per-lobe list key of the
 // model (beta_long, beta_azim) becomes that lobe's entry (beta_long[lobe]),

@@ -21,7 +21,19 @@ std::string unit_of(const std::string& key) {
 
 }  // namespace
 
-std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
+std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
+  if (fr.outcome == FitOutcome::NotFitted) {
+    std::string s = fmt::format("\nnot fitted: {} ({} residuals, {} model evaluations)\n  chi2/dof {:.4f} (dof {})\n",
+                                fr.stop_reason, fr.residuals, fr.evaluations, fr.per_dof(), fr.dof);
+    for (std::size_t i = 0; i < fr.keys.size(); ++i)
+      s += fmt::format("  {:<14} {:12.6g} {} (its start; not fitted)\n", fr.keys[i], fr.value[i], unit_of(fr.keys[i]));
+    s += "  chi2/dof per lobe (unchanged):\n";
+    for (const auto& b : before.rows)
+      if (b.judged)
+        s += fmt::format("  theta_i {:7.2f} phi_i {:>7} {:>5} c{}: {:10.3f}\n", rad_to_deg(b.theta_i), phi_text(b.phi_i),
+                         lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof());
+    return s;
+  }
   std::string s = fmt::format("\nfit ({} residuals, {} iterations, {} model evaluations, {}: {}):\n",
                               fr.residuals, fr.iterations, fr.evaluations, outcome_name(fr.outcome),
                               fr.stop_reason);
@@ -35,13 +47,25 @@ std::string fit_text(const FitResult& fr, const Verdict& before, const Verdict& 
     const auto& b = before.rows[i];
     if (!b.judged) continue;
     s += fmt::format("  theta_i {:7.2f} phi_i {:>7} {:>5} c{}: {:10.3f} -> {:10.3f}\n", rad_to_deg(b.theta_i),
-                     phi_text(b.phi_i), lobe_name(b.lobe, lobes), b.channel, b.bins.per_dof(),
+                     phi_text(b.phi_i), lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof(),
                      after.rows[i].bins.per_dof());
   }
   return s;
 }
 
-std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, int lobes) {
+std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names) {
+  if (fr.outcome == FitOutcome::NotFitted) {
+    std::string md = fmt::format("## Fit\n\nNot fitted: {} (chi2/dof {:.4f} over {} dof).\n\n"
+                                 "| key | value (its start) |\n|---|---|\n",
+                                 fr.stop_reason, fr.per_dof(), fr.dof);
+    for (std::size_t i = 0; i < fr.keys.size(); ++i) md += fmt::format("| {} | {:.6g} |\n", fr.keys[i], fr.value[i]);
+    md += "\n| theta_i | phi_i | lobe | channel | chi2/dof (unchanged) |\n|---|---|---|---|---|\n";
+    for (const auto& b : before.rows)
+      if (b.judged)
+        md += fmt::format("| {:.2f} | {} | {} | {} | {:.3f} |\n", rad_to_deg(b.theta_i), phi_text(b.phi_i),
+                          lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof());
+    return md;
+  }
   std::string md = fmt::format("## Fit\n\nchi2/dof {:.4f} -> {:.4f} over {} dof ({} iterations; {}: {}).\n\n"
                                "| key | start | fitted | error | unscaled error |\n|---|---|---|---|---|\n",
                                fr.chi2_start / fr.dof, fr.per_dof(), fr.dof, fr.iterations,
@@ -54,7 +78,7 @@ std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdi
     const auto& b = before.rows[i];
     if (!b.judged) continue;
     md += fmt::format("| {:.2f} | {} | {} | {} | {:.3f} | {:.3f} |\n", rad_to_deg(b.theta_i), phi_text(b.phi_i),
-                      lobe_name(b.lobe, lobes), b.channel, b.bins.per_dof(), after.rows[i].bins.per_dof());
+                      lobe_names.at(static_cast<std::size_t>(b.lobe)), b.channel, b.bins.per_dof(), after.rows[i].bins.per_dof());
   }
   return md;
 }

@@ -3,6 +3,7 @@
 // values with their uncertainties, and the chi-square before and after the
 // fit for every judged lobe (incident direction, lobe, channel).
 #include <string>
+#include <vector>
 
 #include "compare/fit.h"
 #include "compare/verdict.h"
@@ -11,8 +12,8 @@ namespace fiberlab::compare {
 
 // `before` and `after`: the verdicts with the start and the fitted parameters
 // (same rows, same order).
-std::string fit_text(const FitResult& fit, const Verdict& before, const Verdict& after, int lobes);
-std::string fit_markdown(const FitResult& fit, const Verdict& before, const Verdict& after, int lobes);
+std::string fit_text(const FitResult& fit, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names);
+std::string fit_markdown(const FitResult& fit, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names);
 std::string fit_json(const FitResult& fit, const Verdict& before, const Verdict& after);
 
 }  // namespace fiberlab::compare

@@ -56,7 +56,7 @@ void write_prediction(const std::string& path, const PredictionFile& p, const si
     h5::File f = h5::File::create(out.temp_path(), out.target());
     write_file_identity(f, "fiber-prediction", utc_timestamp());
     f.set_attr("/", "config_yaml", sim::to_yaml(settings));
-    write_axis_names(f, p.lobes, p.channels, settings.fiber.eumelanin.has_value());
+    write_axis_names(f, p.lobe_names(), p.channels, settings.fiber.eumelanin.has_value());
     write_bins(f, p.grid);
     write_incidences(f, p.theta_i, p.phi_i);
     describe_bins_and_source(f);
@@ -223,10 +223,11 @@ std::string describe_prediction(const PredictionFile& p) {
   s += fmt::format("bins: {} x {} (theta x phi), {} lobes, {} channel(s), {} incident direction(s)\n",
                    p.grid.n_theta(), p.grid.n_phi(), p.lobes, p.channels, p.configs());
   if (!p.approximations.empty()) s += "approximations in effect:\n" + split_lines_joined(p.approximations);
+  const std::vector<std::string> lobe_names = p.lobe_names();
   for (std::size_t k = 0; k < p.configs(); ++k) {
     s += incidence_label(p.theta_i[k], p.phi_i[k]) + ":";
     for (int l = 0; l < p.lobes; ++l) {
-      s += fmt::format("  {}", lobe_name(l, p.lobes));
+      s += fmt::format("  {}", lobe_names.at(static_cast<std::size_t>(l)));
       for (int c = 0; c < p.channels; ++c) {
         double e = 0.0;
         const std::size_t cells = static_cast<std::size_t>(p.grid.n_theta()) * p.grid.n_phi();

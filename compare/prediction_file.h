@@ -19,6 +19,7 @@
 
 #include "analytic/model_params.h"
 #include "common/bin_grid.h"
+#include "common/file_schema.h"
 #include "sim/store/result_file.h"
 
 namespace fiberlab::compare {
@@ -33,6 +34,9 @@ struct PredictionFile {
   std::vector<double> probability;     // K x L x n_theta x n_phi x C
   std::vector<std::string> approximations;
   std::size_t configs() const { return theta_i.size(); }
+  // The lobe axis's names (the file's `lobe_names`): a model predicts lobes
+  // by p only (R, TT, ..., p>=N), never `scattered` (docs/FUR.md).
+  std::vector<std::string> lobe_names() const { return fiberlab::lobe_names(lobes); }
   std::size_t per_config() const {
     return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
   }

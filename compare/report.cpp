@@ -55,7 +55,7 @@ void write_compare_data(const std::string& dir, const sim::ResultFile& r,
     f.set_attr("/", "model", model_label);
     f.set_attr("/", "plot_channel", static_cast<std::int64_t>(plot_channel));
     f.set_attr("/", "config_yaml", r.config_yaml);
-    write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value());
+    write_axis_names(f, r.lobe_names(), r.channels, r.settings.fiber.eumelanin.has_value());
     f.write("theta_edges", {nt + 1}, r.grid.theta_edges);
     f.write("phi_edges", {np + 1}, r.grid.phi_edges);
     std::vector<double> omega(nt * np);
@@ -100,6 +100,10 @@ std::string describe_report_data(const std::string& path) {
   const std::vector<double> sim = f.read_doubles("/sim_p", d, "");
   const std::vector<double> model = f.read_doubles("/model_p", d, "sim_p's shape");
   const std::size_t L = d[1], bins = d[2] * d[3], C = d[4];
+  // The lobes as the file names them (a medullated fiber's last is `scattered`).
+  const std::vector<std::string> lobe_names = split_names(f.attr_string("/", "lobe_names"));
+  if (lobe_names.size() != L)
+    throw Error(fmt::format("{}: attribute lobe_names names {} lobes; /sim_p has {}", path, lobe_names.size(), L));
   std::string s = fmt::format("{}: fiberlab report data of `{}` (model {}; software {}, created {})\n", path,
                               f.attr_string("/", "kind"), f.attr_string("/", "model"),
                               f.attr_string("/", "software_version"), f.attr_string("/", "created_utc"));
@@ -109,7 +113,7 @@ std::string describe_report_data(const std::string& path) {
   for (std::size_t k = 0; k < d[0]; ++k) {
     s += incidence_label(theta_i[k], phi_i[k]) + ":";
     for (std::size_t l = 0; l < L; ++l) {
-      s += fmt::format("  {}", lobe_name(static_cast<int>(l), static_cast<int>(L)));
+      s += fmt::format("  {}", lobe_names[l]);
       for (std::size_t c = 0; c < C; ++c) {
         double e_sim = 0.0, e_model = 0.0;
         for (std::size_t b = 0; b < bins; ++b) {

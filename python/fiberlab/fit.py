@@ -25,8 +25,10 @@ class Fit:
     (predict(result, model, **fit.params) is the fitted model).
     before, after: the per-lobe Comparisons with the start and the fitted
     parameters (their .table is the per-lobe table).
-    outcome: "converged", "at a bound" or "not converged"; stop_reason: the
-    test that ended the fit, in one line (compare/fit.h).
+    outcome: "converged", "at a bound", "not converged" or "not fitted" (no
+    key changes the fitted bins' prediction: values at their start, errors
+    NaN, compare/fit.h NotFitted); stop_reason: the test that ended the fit,
+    in one line.
     lobe_fits: with fit(..., per_lobe=True), each lobe's own fit as `compare
     --per-lobe` prints it, {lobe name: Fit} in lobe order (its keys the
     lobe's own, beta_long[p]; its before and after that lobe's rows); empty

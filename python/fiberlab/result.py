@@ -114,7 +114,7 @@ class Result:
 
     @functools.cached_property
     def lobe_names(self):
-        return list(_fiberlab.lobe_names(self._file.lobes, self._file.settings.medulla))
+        return list(self._file.lobe_names)
 
     @functools.cached_property
     def channel_names(self):

@@ -39,7 +39,7 @@ py::dict params_dict(const std::string& model_name, const analytic::ModelParamet
 // "criterion"} (comparison_binding.cpp).
 compare::Options comparison_options(std::optional<double> max_chi2, double min_effective, double model_error,
                                     double min_energy);
-py::dict verdict_dict(const compare::Verdict& v, int lobes);
+py::dict verdict_dict(const compare::Verdict& v, const std::vector<std::string>& lobe_names);
 
 void bind_result(py::module_& m);      // result_binding.cpp: ResultFile, Settings, estimators, I/O
 void bind_run(py::module_& m);         // run_binding.cpp: the simulation

@@ -23,14 +23,14 @@ namespace {
 // Row i of a verdict, keyed as in `fiberlab compare --report`'s metrics.json
 // (angles in degrees), with the verdict the CLI prints: "accepted",
 // "rejected" or "not judged" (accepted is true for judged, accepted lobes only).
-py::dict row(const compare::Verdict& v, std::size_t i, int lobes) {
+py::dict row(const compare::Verdict& v, std::size_t i, const std::vector<std::string>& lobe_names) {
   const compare::LobeComparison& r = v.rows[i];
   py::dict d;
   d["k"] = r.k;
   d["theta_i_deg"] = rad_to_deg(r.theta_i);
   d["phi_i_deg"] = rad_to_deg(r.phi_i);
   d["lobe"] = r.lobe;
-  d["lobe_name"] = compare::lobe_name(r.lobe, lobes);
+  d["lobe_name"] = lobe_names.at(static_cast<std::size_t>(r.lobe));
   d["channel"] = r.channel;
   d["sim_energy"] = r.sim_energy;
   d["sim_error"] = r.sim_error;
@@ -95,7 +95,7 @@ py::dict compare_bins(const sim::ResultFile& r, py::array_t<double, py::array::c
     v = compare::judge(compare::compare(r, bins, alpha.empty() ? std::vector<double>{0.0} : alpha, o),
                        max_chi2 ? *max_chi2 : 0.0);
   }
-  return verdict_dict(v, r.lobes);
+  return verdict_dict(v, r.lobe_names());
 }
 
 }  // namespace
@@ -112,9 +112,9 @@ compare::Options comparison_options(std::optional<double> max_chi2, double min_e
   return o;
 }
 
-py::dict verdict_dict(const compare::Verdict& v, int lobes) {
+py::dict verdict_dict(const compare::Verdict& v, const std::vector<std::string>& lobe_names) {
   py::list rows;
-  for (std::size_t i = 0; i < v.rows.size(); ++i) rows.append(row(v, i, lobes));
+  for (std::size_t i = 0; i < v.rows.size(); ++i) rows.append(row(v, i, lobe_names));
   py::dict d;
   d["rows"] = rows;
   d["judged"] = v.judged;

@@ -47,7 +47,7 @@ class FitProgress {
 // One fit's numbers and its verdicts before and after, as fiberlab.Fit takes them.
 py::dict fit_dict(const compare::FitResult& fr, const std::string& model_name,
                   const analytic::ModelParameters& start, const compare::Verdict& before,
-                  const compare::Verdict& after, int lobes) {
+                  const compare::Verdict& after, const std::vector<std::string>& lobe_names) {
   py::dict d;
   d["keys"] = fr.keys;
   d["start"] = fr.start;
@@ -66,8 +66,8 @@ py::dict fit_dict(const compare::FitResult& fr, const std::string& model_name,
   d["stop_reason"] = fr.stop_reason;
   d["params_start"] = params_dict(model_name, start);
   d["params"] = params_dict(model_name, fr.params);
-  d["before"] = verdict_dict(before, lobes);
-  d["after"] = verdict_dict(after, lobes);
+  d["before"] = verdict_dict(before, lobe_names);
+  d["after"] = verdict_dict(after, lobe_names);
   return d;
 }
 
@@ -96,12 +96,12 @@ py::dict fit(const sim::ResultFile& result, const std::string& model_name, const
     }
   }
   if (stopped) relay.rethrow();
-  py::dict d = fit_dict(report.fit, model_name, report.start, report.before, report.after, result.lobes);
+  py::dict d = fit_dict(report.fit, model_name, report.start, report.before, report.after, result.lobe_names());
   py::list lobe_fits;
   for (const app::LobeFitVerdict& lf : report.lobe_fits) {
-    py::dict one = fit_dict(lf.fit, model_name, report.start, lf.before, lf.after, result.lobes);
+    py::dict one = fit_dict(lf.fit, model_name, report.start, lf.before, lf.after, result.lobe_names());
     one["lobe"] = lf.lobe;
-    one["lobe_name"] = compare::lobe_name(lf.lobe, result.lobes);
+    one["lobe_name"] = result.lobe_names().at(static_cast<std::size_t>(lf.lobe));
     lobe_fits.append(one);
   }
   d["lobe_fits"] = lobe_fits;

@@ -119,6 +119,8 @@ void bind_result(py::module_& m) {
       .def_property_readonly("software_version", [](const Result& r) { return r.software_version; })
       .def_property_readonly("created_utc", [](const Result& r) { return r.created_utc; })
       .def_property_readonly("lobes", [](const Result& r) { return r.lobes; })
+      .def_property_readonly("lobe_names", [](const Result& r) { return r.lobe_names(); },
+                             "the file's lobe_names (sim::ResultFile::lobe_names())")
       .def_property_readonly("channels", [](const Result& r) { return r.channels; })
       .def_property_readonly("theta_binning", [](const Result& r) { return to_string(r.grid.theta_binning); })
       .def_property_readonly("theta_edges", [](const Result& r) {

@@ -63,6 +63,10 @@ ResultFile make_result(const Settings& settings, const BinGrid& grid,
   return r;
 }
 
+std::vector<std::string> ResultFile::lobe_names() const {
+  return fiberlab::lobe_names(lobes, settings.fiber.medulla.has_value());
+}
+
 void write_result_header(h5::File& f, const ResultFile& r) {
   write_file_identity(f, "fiber-histogram", r.created_utc);
   // Exact uint64: every seed in [0, 2^64 - 1] round-trips, and merge tells
@@ -76,8 +80,7 @@ void write_result_header(h5::File& f, const ResultFile& r) {
 }
 
 void describe_result_file(h5::File& f, const ResultFile& r) {
-  write_axis_names(f, r.lobes, r.channels, r.settings.fiber.eumelanin.has_value(),
-                   r.settings.fiber.medulla.has_value());
+  write_axis_names(f, r.lobe_names(), r.channels, r.settings.fiber.eumelanin.has_value());
   describe_bins_and_source(f);
   describe_result_datasets(f);
   if (f.exists("/exact")) describe_exact_datasets(f);

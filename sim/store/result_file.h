@@ -36,6 +36,11 @@ struct ResultFile {
   std::vector<double> lobe_weight_sq_sum;
 
   std::size_t configs() const { return photons.size(); }
+  // The names of the lobe axis, what the file's attribute `lobe_names` holds
+  // (describe_result_file writes these): R, TT, ..., p>=N by p, and
+  // `scattered` last for a fiber with a medulla (docs/FUR.md). Every table,
+  // line and record that names a lobe of this result takes it from here.
+  std::vector<std::string> lobe_names() const;
   std::size_t bin_cells() const {
     return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
   }

@@ -51,9 +51,16 @@ f, m = h5py.File(sys.argv[1], "r"), int(sys.argv[2])
 names = f.attrs["lobe_names"]
 names = names.decode() if isinstance(names, bytes) else str(names)
 fitted = f["models/marschner2003/lobe_fitted"][...]
+lines = f["models/marschner2003"].attrs["lobe_fit_lines"]
+lines = (lines.decode() if isinstance(lines, bytes) else str(lines)).split("\n")
 print(f"lobe_names {names}; marschner2003 lobe_fitted per fiber {fitted.tolist()}")
 assert names.split(",")[-1] == "scattered", names
-assert fitted.shape == (2, 5) and fitted[m].all() and fitted[1 - m, :4].all() and not fitted[1 - m, 4], fitted
+# Every lobe of the fiber has its per-lobe fit's line; marschner2003 predicts
+# nothing in p>=3 and `scattered`, so those say "not fitted" (lobe_fitted 0).
+assert len(lines) == 10 and all(lines[5 * m:5 * m + 5]) and all(lines[5 * (1 - m):5 * (1 - m) + 4]), lines
+assert not lines[5 * (1 - m) + 4], lines
+assert lines[5 * m + 4] == "not fitted: no free parameter acts on this lobe", lines
+assert fitted.shape == (2, 5) and fitted[:, :3].all() and not fitted[:, 3:].any(), fitted
 PY
   interrupt_atlas "$work/$name.yaml" "$name.res" INT "" --threads 1
   if [ "$got" != 130 ] || ! tail -n 1 "$work/$name.res.err" | grep -q ": 1 of 2 fibers saved in"; then
