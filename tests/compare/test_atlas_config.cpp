@@ -157,9 +157,9 @@ TEST(AtlasConfig, FitModelParametersReachTheModelsVariants) {
 // 0.85, white) at theta_i 45 deg against 4x the points: the mean over bins
 // with >= 10 expected photons of (bin error)^2 / (p / N) (the simulated
 // bin's variance, weights 1) is below 0.01 for every lobe (an RMS error
-// below 0.1 standard error, issue 35's target) and below 1e-3 for p >= 3
-// (its M_p integrated per theta bin: only its total carries quadrature
-// error). Measured: TT 0.004, TRT 0.005, R and p >= 3 below 5e-4. Judging
+// below 0.1 standard error: huang2022's accuracy target for the atlas) and
+// below 1e-3 for p >= 3 (its M_p integrated per theta bin: only its total
+// carries quadrature error). Measured: TT 0.004, TRT 0.005, R and p >= 3 below 5e-4. Judging
 // at the fit's 2^19 points instead (model_parameters given the
 // fit.model_parameters value) gives TT 0.104 and TRT 0.120, which this
 // catches.
