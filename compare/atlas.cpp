@@ -52,6 +52,34 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
   return compare(r, predict_result(*model, r), analytic::theta_r_shifts(name, p));
 }
 
+// The parameters a fit starts from: the judged ones `p` with the entry's
+// fit.model_parameters on top (compare/atlas_config.h), e.g. huang2022's
+// cheaper quadrature. Those keys are fixed, so a fit moves only its own keys.
+analytic::ModelParameters fit_start(const AtlasConfig& config, const std::string& entry, const std::string& model,
+                                    const analytic::ModelParameters& p) {
+  analytic::ModelParameters out = p;
+  const auto settings = config.fit_model_parameters.find(entry);
+  if (settings == config.fit_model_parameters.end()) return out;
+  const analytic::ParamTable& table = analytic::model_info(model).params;
+  for (const std::string& kv : settings->second) {
+    const std::size_t eq = kv.find('=');
+    analytic::find_param(table, kv.substr(0, eq))->set(out, kv.substr(eq + 1));
+  }
+  compare::make_model(model, out);  // the model's own checks
+  return out;
+}
+
+// A fit's result judged: `judged` (the parameters without fit-only settings)
+// with the fitted keys' values, so fit.params is what the "after" columns
+// use (and what a resumed checkpoint rebuilds from its start, the same way).
+// Without fit-only settings fit.params is left as the fit returned it.
+void judge_with(const AtlasConfig& config, const std::string& entry, const std::string& model,
+                const analytic::ModelParameters& judged, FitResult& fit) {
+  if (!config.fit_model_parameters.count(entry)) return;
+  fit.params = judged;
+  for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
+}
+
 // "fitted (converged: why)", "fitted (at a bound: key = value; why)",
 // "fitted (not converged: why)" or "not fitted: why" (no key acts on the
 // fitted bins): the per-fiber table's status.
@@ -108,7 +136,8 @@ void fit_lobe_by_lobe(const AtlasConfig& config, const sim::ResultFile& r, const
   try {
     Options fit_options;
     fit_options.lobes = fiber_fit_lobes(config, r);
-    m.lobe_fits = fit_each_lobe(r, model, m.fit.params, keys, fit_options, config.max_iterations,
+    m.lobe_fits = fit_each_lobe(r, model, fit_start(config, name, model, m.fit.params), keys, fit_options,
+                                config.max_iterations,
                                 [&](const std::string& line) {
                                   check_interrupt();
                                   say(control, "  " + name + " per-lobe " + line);
@@ -120,7 +149,8 @@ void fit_lobe_by_lobe(const AtlasConfig& config, const sim::ResultFile& r, const
     return;
   }
   m.lobe_fit_status = "fitted lobe by lobe";
-  for (const LobeFit& lf : m.lobe_fits) {
+  for (LobeFit& lf : m.lobe_fits) {
+    judge_with(config, name, model, m.fit.params, lf.fit);
     m.lobe_fit_lines.push_back(fit_status(lf.fit));
     for (const LobeComparison& c : judge_model(r, model, lf.fit.params))
       if (c.lobe == lf.lobe) m.after_lobe_fit.push_back(c);
@@ -159,10 +189,12 @@ AtlasModelResult evaluate_model(const AtlasConfig& config, const AtlasFiber& fib
     try {
       Options fit_options;
       fit_options.lobes = fiber_fit_lobes(config, r);
-      m.fit = fit_model(r, model, p, keys, fit_options, config.max_iterations, [&](const std::string& line) {
-        check_interrupt();
-        say(control, "  " + name + " " + line);
-      });
+      m.fit = fit_model(r, model, fit_start(config, name, model, p), keys, fit_options, config.max_iterations,
+                        [&](const std::string& line) {
+                          check_interrupt();
+                          say(control, "  " + name + " " + line);
+                        });
+      judge_with(config, name, model, p, m.fit);
       m.fitted = true;
       m.status = fit_status(m.fit);
       m.params_after = analytic::describe_params(model, m.fit.params);

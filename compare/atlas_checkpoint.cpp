@@ -612,6 +612,9 @@ std::string atlas_config_identity(const AtlasConfig& config) {
   for (const auto& [model, settings] : config.model_parameters)
     s += fmt::format("model_parameters.{}: {}\n", model, joined(settings, " "));
   s += fmt::format("fit.max_iterations: {}\n", config.max_iterations);
+  // Absent, the identity is the same as without the key.
+  for (const auto& [entry, settings] : config.fit_model_parameters)
+    s += fmt::format("fit.model_parameters.{}: {}\n", entry, joined(settings, " "));
   // fit.lobes and fit.per_lobe change the results; absent, the identity is the same as without these keys.
   if (!config.fit_lobes.empty()) {
     s += "fit.lobes:";

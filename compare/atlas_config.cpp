@@ -332,6 +332,26 @@ std::map<std::string, std::vector<std::string>> read_model_parameters(const Read
   return out;
 }
 
+// fit.model_parameters: {MODEL: {KEY: VALUE, ...}, ...} for the models of the
+// entries (model_parameters' rules), given to each entry running MODEL.
+std::map<std::string, std::vector<std::string>> read_fit_model_parameters(const Reader& r, const YAML::Node& n,
+                                                                          const std::vector<ModelEntry>& entries) {
+  std::map<std::string, std::vector<std::string>> out;
+  if (!n) return out;
+  std::set<std::string> chosen;
+  for (const ModelEntry& e : entries) chosen.insert(e.model);
+  only_keys(r, n, "fit.model_parameters", chosen);
+  for (const auto& kv : n) {
+    const std::string model = kv.first.Scalar();
+    const std::vector<std::string> settings =
+        read_fixed_settings(r, kv.second, "fit.model_parameters." + model, model);
+    if (settings.empty()) continue;
+    for (const ModelEntry& e : entries)
+      if (e.model == model) out[e.name] = settings;
+  }
+  return out;
+}
+
 }  // namespace
 
 AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& origin) {
@@ -362,7 +382,8 @@ AtlasConfig parse_atlas_config(const std::string& yaml_text, const std::string& 
   }
   c.model_parameters = read_model_parameters(r, top["model_parameters"], entries);
   if (const YAML::Node fit = top["fit"]) {
-    only_keys(r, fit, "fit", {"max_iterations", "lobes", "per_lobe"});
+    only_keys(r, fit, "fit", {"max_iterations", "lobes", "per_lobe", "model_parameters"});
+    c.fit_model_parameters = read_fit_model_parameters(r, fit["model_parameters"], entries);
     if (fit["max_iterations"])
       c.max_iterations = static_cast<int>(integer(r, fit["max_iterations"], "fit.max_iterations", 0, 1000));
     if (const YAML::Node per_lobe = fit["per_lobe"]) {

@@ -43,6 +43,12 @@
 // "before" comparison, the fit and the "after" one; each value is checked by
 // the table's own parser when the config is read.
 //
+// fit.model_parameters: the same rules, for settings applied on top of the
+// above only while fitting (a cheaper quadrature, say): the "before" and
+// "after fit" comparisons, chi-squares and everything judged use the
+// parameters without them. A model's settings hold for its variants too. A
+// free key is refused here as well: the fit moves it.
+//
 // Each fiber is checked by the simulator's own config parser (the entry is
 // written as a simulator config and parsed back), so a roughness model the
 // simulator learns later is accepted here without change. Everything is
@@ -79,6 +85,9 @@ struct AtlasConfig {
   // Entry name -> its fixed settings "KEY=VALUE" (model_parameters; for a
   // variant, its model's then its own), checked.
   std::map<std::string, std::vector<std::string>> model_parameters;
+  // Entry name -> its fit-only settings "KEY=VALUE" (fit.model_parameters of
+  // its model), applied on top of model_parameters while fitting; checked.
+  std::map<std::string, std::vector<std::string>> fit_model_parameters;
   int max_iterations = 20;
   // fit.lobes: the lobes the fit judges and fits, indices into
   // atlas_lobe_names() (empty: every lobe).

@@ -26,6 +26,16 @@ std::string joined(const std::vector<std::string>& lines) {
   return s;
 }
 
+// "KEY=VALUE KEY=VALUE" (an entry's settings, as the variants' attribute).
+std::string joined_settings(const std::vector<std::string>& settings) {
+  std::string s;
+  for (const std::string& kv : settings) {
+    if (!s.empty()) s += ' ';
+    s += kv;
+  }
+  return s;
+}
+
 // Sizes shared by every array.
 struct Shape {
   hsize_t F, K, L, C;
@@ -304,6 +314,15 @@ void write_atlas_file(const std::string& path, const AtlasConfig& config,
           for (const std::string& kv : fixed->second) settings += (settings.empty() ? "" : " ") + kv;
         f.set_attr("/models/" + v->first, "fixed_parameters", settings);
       }
+      // fit.model_parameters: what the fit ran with beside what was judged
+      // (the "before" and "after fit" columns: the model's defaults with
+      // fixed_parameters; compare/atlas_config.h).
+      if (const auto fit = config.fit_model_parameters.find(config.models[m]); fit != config.fit_model_parameters.end()) {
+        const auto fixed = config.model_parameters.find(config.models[m]);
+        const std::string g = "/models/" + config.models[m];
+        f.set_attr(g, "fixed_parameters", fixed == config.model_parameters.end() ? "" : joined_settings(fixed->second));
+        f.set_attr(g, "fit_only_parameters", joined_settings(fit->second));
+      }
     }
     f.close();
   }
@@ -404,6 +423,11 @@ std::string describe_atlas_file(const std::string& path) {
                                                        : "";
     s += fmt::format("model {}{}: applicable to {}, fitted to {}, converged on {} of {} fibers\n", m, variant,
                      count(g + "applicable"), count(g + "fitted"), count(g + "converged"), F[0]);
+    if (f.has_attr(g, "fit_only_parameters"))
+      s += fmt::format("  fitted with {} on top of its fixed parameters; judged without them ({})\n",
+                       f.attr_string(g, "fit_only_parameters"),
+                       f.attr_string(g, "fixed_parameters").empty() ? "the model's defaults"
+                                                                    : f.attr_string(g, "fixed_parameters"));
     if (f.has_attr(g, "lobe_fit_status")) s += describe_lobe_fits(f, g, F[0]);
     start = comma + 1;
   }

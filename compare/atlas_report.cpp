@@ -67,7 +67,17 @@ std::string fixed_parameters(const AtlasConfig& config) {
                      model, variant == config.variant_of.end() ? "" : " (" + variant->second + ")");
     for (const std::string& kv : settings) s += " " + kv;
   }
-  return s.empty() ? s : s + ".";
+  s = s.empty() ? s : s + ".";
+  // fit.model_parameters: the fits ran with these; everything judged did not.
+  std::string fit;
+  for (const auto& [entry, settings] : config.fit_model_parameters) {
+    fit += fmt::format("{}{}:", fit.empty() ? "" : "; ", entry);
+    for (const std::string& kv : settings) fit += " " + kv;
+  }
+  if (!fit.empty())
+    s += " Fitted with (fit.model_parameters, on top of the above while fitting only; the before and after "
+         "columns and every chi-square are computed without them): " + fit + ".";
+  return s;
 }
 
 // report_data.h5 (what scripts/plot_atlas.py reads) is the atlas file

@@ -14,6 +14,12 @@ set_tests_properties(atlas_variants_cli PROPERTIES TIMEOUT 300)
 add_test(NAME atlas_huang_cycles_cli
          COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_huang_cycles.sh $<TARGET_FILE:fiberlab>)
 set_tests_properties(atlas_huang_cycles_cli PROPERTIES TIMEOUT 300)
+# fit.model_parameters: huang2022 fitted at a cheap quadrature, judged at
+# another; after-fit chi-square equal to a separate compare of the fitted
+# values at the judged one; bad settings refused in one line.
+add_test(NAME atlas_fit_settings_cli
+         COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cli/atlas_fit_settings.sh $<TARGET_FILE:fiberlab>)
+set_tests_properties(atlas_fit_settings_cli PROPERTIES TIMEOUT 300)
 # `mpirun -np 2 fiberlab atlas` (and its --resume of a one-process
 # checkpoint) bit-identical to one process; skipped without mpirun.
 add_test(NAME atlas_mpi_cli
