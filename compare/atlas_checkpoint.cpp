@@ -565,8 +565,9 @@ AtlasModelResult read_model(const Reader& r, const Stored& s, Cursor& at, const 
     lf.lobe = from_cell<int>(r, n[0], where + ".lobe_fit.lobe");
     if (lf.lobe < 0 || lf.lobe >= fiber.lobes) r.fail(fmt::format("{}: per-lobe fit of lobe {} is outside the fiber's {} lobes", where, lf.lobe, fiber.lobes));
     const std::string lobe_where = fmt::format("{}, per-lobe fit of {}", where, fiber_lobe_names(fiber.fiber).at(static_cast<std::size_t>(lf.lobe)));
-    lf.fit = fit_from(r, n + 1, s.lobe_fits.values, at.lobe_fit_value, per_lobe_keys(model, out.fit.keys, lf.lobe),
-                      model, out.fit.params, lobe_where);
+    const std::vector<std::string> lobe_keys = per_lobe_keys(model, out.fit.keys, lf.lobe);
+    lf.fit = fit_from(r, n + 1, s.lobe_fits.values, at.lobe_fit_value, lobe_keys, model,
+                      lobe_fit_start(model, out.fit.params, lobe_keys), lobe_where);  // as fit_each_lobe starts
     out.lobe_fits.push_back(std::move(lf));
     out.lobe_fit_lines.push_back(s.lobe_fits.lines[at.lobe_fit]);
   }

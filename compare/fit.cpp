@@ -542,6 +542,19 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
   return fr;
 }
 
+analytic::ModelParameters lobe_fit_start(const std::string& model_name, const analytic::ModelParameters& start,
+                                         const std::vector<std::string>& lobe_keys) {
+  analytic::ModelParameters out = start;
+  const int lobes = analytic::predicted_lobes(model_name, start);
+  for (const std::string& key : lobe_keys) {
+    const Key k = parse_key(key);
+    const analytic::ParamSpec* spec = spec_of(model_name, k);
+    if (k.index < 0 || !spec || !spec->per_lobe || !is_list(*spec)) continue;
+    for (int p = 0; p < lobes; ++p) spec->set_entry(out, p, spec->get_entry(start, p));
+  }
+  return out;
+}
+
 std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::string& model_name,
                                    const analytic::ModelParameters& start, const std::vector<std::string>& keys,
                                    const Options& options, int max_iterations,
@@ -556,7 +569,8 @@ std::vector<LobeFit> fit_each_lobe(const sim::ResultFile& result, const std::str
     one.lobes = {lobe};
     const std::string& name = names.at(static_cast<std::size_t>(lobe));
     try {
-      out.push_back({lobe, fit_model(result, model_name, start, per_lobe_keys(model_name, keys, lobe), one,
+      const std::vector<std::string> lobe_keys = per_lobe_keys(model_name, keys, lobe);
+      out.push_back({lobe, fit_model(result, model_name, lobe_fit_start(model_name, start, lobe_keys), lobe_keys, one,
                                      max_iterations, [&](const std::string& line) {
                                        if (progress) progress(name + " " + line);
                                      })});

@@ -144,9 +144,20 @@ FitResult fit_model(const sim::ResultFile& result, const std::string& model_name
                     const Options& options = {}, int max_iterations = 40,
                     const std::function<void(const std::string&)>& progress = {});
 
+// The start of a per-lobe fit with keys `lobe_keys` (per_lobe_keys()):
+// `start` with each per-lobe list those keys move entry by entry
+// (beta_long[p]) written out with one entry per predicted lobe, each the
+// value that lobe had (a list's last entry applies to every larger p,
+// analytic/model_params.h). The same model, whose fitted entry then moves
+// only its own lobe, so the fit's params predict every other lobe as `start`.
+analytic::ModelParameters lobe_fit_start(const std::string& model_name, const analytic::ModelParameters& start,
+                                         const std::vector<std::string>& lobe_keys);
+
 // One fit per lobe: for each lobe of options.lobes (every lobe of the
 // result when empty), fit_model() on that lobe's bins alone with
-// per_lobe_keys(model, keys, lobe), from the same start.
+// per_lobe_keys(model, keys, lobe), from lobe_fit_start() of the same start:
+// each LobeFit's params hold the fitted entry for its lobe and the start's
+// values for the others (predicting with them is the start on every other lobe).
 struct LobeFit {
   int lobe = 0;
   FitResult fit;

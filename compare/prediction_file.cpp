@@ -139,6 +139,13 @@ PredictionFile read_header(const h5::File& f, const std::string& path, h5::Dims&
                             path, dims[0], dims[1], dims[2], dims[3], dims[4], p.theta_i.size(), nt, np));
   p.lobes = static_cast<int>(dims[1]);
   p.channels = static_cast<int>(dims[4]);
+  // A medullated fiber's prediction names its zero last lobe `scattered` (write_prediction).
+  if (f.has_attr("/", "lobe_names")) {
+    const std::string names = f.attr_string("/", "lobe_names");
+    const std::string last = "scattered";
+    p.scattered = p.lobes > 1 && names.size() >= last.size() &&
+                  names.compare(names.size() - last.size(), last.size(), last) == 0;
+  }
   return p;
 }
 

@@ -33,10 +33,13 @@ struct PredictionFile {
   int lobes = 0, channels = 0;
   std::vector<double> probability;     // K x L x n_theta x n_phi x C
   std::vector<std::string> approximations;
+  // The last lobe is a medulla's `scattered` (docs/FUR.md), which a model
+  // never predicts: its bins are zero (app::predict pads them).
+  bool scattered = false;
   std::size_t configs() const { return theta_i.size(); }
-  // The lobe axis's names (the file's `lobe_names`): a model predicts lobes
-  // by p only (R, TT, ..., p>=N), never `scattered` (docs/FUR.md).
-  std::vector<std::string> lobe_names() const { return fiberlab::lobe_names(lobes); }
+  // The lobe axis's names (the file's `lobe_names`): the lobes by p (R, TT,
+  // ..., p>=N), then `scattered` for a fiber with a medulla.
+  std::vector<std::string> lobe_names() const { return fiberlab::lobe_names(lobes, scattered); }
   std::size_t per_config() const {
     return static_cast<std::size_t>(lobes) * grid.n_theta() * grid.n_phi() * channels;
   }

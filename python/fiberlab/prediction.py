@@ -50,7 +50,7 @@ class Prediction:
 
     def __init__(self, probability, like=None, model="user", params=None, alpha=None,
                  theta_i=None, phi_i=None, theta_edges=None, phi_edges=None, channel_names=None,
-                 _from_model=False):
+                 lobe_names=None, _from_model=False):
         try:
             probability = np.ascontiguousarray(probability, dtype=np.float64)
         except (TypeError, ValueError) as e:
@@ -65,6 +65,7 @@ class Prediction:
             theta_i, phi_i = like.theta_i, like.phi_i
             theta_edges, phi_edges = like.theta_edges, like.phi_edges
             channel_names = like.channel_names
+            lobe_names = like.lobe_names
         elif probability.ndim != 5:
             raise _fiberlab.Error("probability must be 5-dimensional (K, lobes, n_theta, n_phi, channels)")
         if not np.all(np.isfinite(probability)):
@@ -84,10 +85,15 @@ class Prediction:
         self.theta_edges, self.phi_edges = theta_edges, phi_edges
         C = probability.shape[4]
         self.channel_names = list(channel_names) if channel_names is not None else ["c%d" % c for c in range(C)]
+        L = probability.shape[1]
+        if lobe_names is not None and len(lobe_names) != L:
+            raise _fiberlab.Error("lobe_names has %d names, probability %d lobes" % (len(lobe_names), L))
+        self._lobe_names = list(lobe_names) if lobe_names is not None else list(_fiberlab.lobe_names(L))
 
     @property
     def lobe_names(self):
-        return list(_fiberlab.lobe_names(self.probability.shape[1]))
+        """R, TT, ..., p>=N; `scattered` last for a fiber with a medulla (docs/FUR.md)."""
+        return list(self._lobe_names)
 
     @property
     def solid_angle(self):
@@ -143,6 +149,9 @@ def predict(result_or_config, model, **params):
     predict(result, "deon2011", beta_long=[5, 2.5, 10], absorption="chord").
     Prediction.params holds every parameter in the same units, so
     predict(result, model, **prediction.params) gives the same prediction.
+    For a fiber with a medulla the last lobe is `scattered`, which no model
+    predicts: its bins are zero, as in `fiberlab predict` and `fiberlab
+    compare --model` (docs/FUR.md), so compare(result, predict(result, ...)) works.
     """
     if not isinstance(model, str):
         raise _fiberlab.Error("model must be a model name (%s), not %s"
@@ -153,7 +162,7 @@ def predict(result_or_config, model, **params):
     return Prediction(d["probability"], model=model, params=d["params"], alpha=np.degrees(d["alpha"]),
                       theta_i=np.degrees(d["theta_i"]), phi_i=np.degrees(d["phi_i"]),
                       theta_edges=np.degrees(d["theta_edges"]), phi_edges=np.degrees(d["phi_edges"]),
-                      channel_names=channel_names(settings), _from_model=True)
+                      channel_names=channel_names(settings), lobe_names=d["lobe_names"], _from_model=True)
 
 
 SUPPORTED_FORMAT_VERSION = 2  # common/result_layout.h kFormatVersion (2 changed result files only)
@@ -200,8 +209,9 @@ def load_prediction(path):
         params = _params_in_set_units(model, {k: v for k, v in group.attrs.items() if k != "model"})
         alpha = np.degrees(np.atleast_1d(group.attrs["alpha"])) if "alpha" in group.attrs else [0.0]
         channels = text(f.attrs["channel_names"]).split(",") if "channel_names" in f.attrs else None
+        lobes = text(f.attrs["lobe_names"]).split(",") if "lobe_names" in f.attrs else None
         return Prediction(group["probability"][...], model=model, params=params, alpha=alpha,
                           theta_i=np.degrees(f["source/theta_i"][...]), phi_i=np.degrees(f["source/phi_i"][...]),
                           theta_edges=np.degrees(f["bins/theta_edges"][...]),
                           phi_edges=np.degrees(f["bins/phi_edges"][...]), channel_names=channels,
-                          _from_model=True)
+                          lobe_names=lobes, _from_model=True)

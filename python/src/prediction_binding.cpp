@@ -1,7 +1,7 @@
 // fiberlab.predict from Python: an analytic model's bin probabilities for the
 // histogram of a configuration, exactly as `fiberlab predict` makes them
 // (app::choose_model and app::predict: the config's defaults, then KEY=VALUE
-// overrides in the --set syntax).
+// overrides in the --set syntax; a medullated fiber's zero `scattered` lobe).
 #include <pybind11/stl.h>
 
 #include <string>
@@ -57,6 +57,7 @@ py::dict predict(const sim::Settings& s, const std::string& model_name, const st
   const py::ssize_t K = static_cast<py::ssize_t>(pred.configs());
   py::dict d;
   d["probability"] = to_array(pred.probability, {K, pred.lobes, grid.n_theta(), grid.n_phi(), pred.channels});
+  d["lobe_names"] = pred.lobe_names();  // `scattered` last for a fiber with a medulla (app::predict pads it)
   d["params"] = params_dict(model_name, chosen.params);
   d["alpha"] = analytic::theta_r_shifts(chosen.spec.name, chosen.params);  // radians, for compare::compare
   d["theta_i"] = to_array(pred.theta_i, {K});

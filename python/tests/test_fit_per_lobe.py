@@ -6,6 +6,7 @@ prints for the same file, lobe by lobe."""
 import re
 import subprocess
 
+import numpy as np
 import pytest
 
 import fiberlab
@@ -54,6 +55,25 @@ def test_each_lobe_recovers_its_own_width(widths_fit):
         assert lf.after.accepted
     # One width for every lobe cannot be all three: the joint fit is rejected.
     assert not f.after.accepted
+
+
+def test_a_lobe_fits_params_predict_its_lobe_as_fitted_and_the_others_as_the_start(widths_result, widths_fit):
+    """The start has one beta_long for every lobe (START); each lobe fit's
+    params hold the full per-lobe list (compare/fit.h fit_each_lobe), so
+    predict(**lf.params) is the fitted model on that lobe (its chi-square is
+    the fit's after-fit one, lobe by lobe) and the start on every other lobe."""
+    start = fiberlab.predict(widths_result, "deon2011", **widths_fit.params_start).probability
+    for name, lf in widths_fit.lobe_fits.items():
+        p = lf.lobe
+        assert len(lf.params["beta_long"]) == len(WIDTHS), (name, lf.params["beta_long"])
+        fitted = fiberlab.predict(widths_result, "deon2011", **lf.params)
+        others = [q for q in range(len(WIDTHS)) if q != p]
+        assert np.array_equal(fitted.probability[:, others], start[:, others]), name
+        assert not np.array_equal(fitted.probability[:, p], start[:, p]), name  # the fit moved its lobe
+        rows = [r for r in fiberlab.compare(widths_result, fitted).records if r["lobe"] == p]
+        assert [(r["k"], r["channel"], r["dof"]) for r in rows] == \
+            [(r["k"], r["channel"], r["dof"]) for r in lf.after.records]
+        assert [r["chi2"] for r in rows] == pytest.approx([r["chi2"] for r in lf.after.records], rel=1e-9)
 
 
 def test_lobe_table_has_a_row_per_lobe(widths_fit):

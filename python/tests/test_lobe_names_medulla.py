@@ -112,13 +112,70 @@ def test_python_records_and_fit_tables_name_the_file_lobes(fur):
     r = fiberlab.load(str(d / "fur.h5"))
     assert r.lobe_names == names
     # The model predicts the lobes by p; its `scattered` lobe is empty (docs/FUR.md).
-    by_p = fiberlab.predict(r, "marschner2003").probability
-    c = fiberlab.compare(r, np.concatenate([by_p, np.zeros_like(by_p[:, :1])], axis=1))
+    c = fiberlab.compare(r, fiberlab.predict(r, "marschner2003"))
     assert [(x["lobe"], x["lobe_name"]) for x in c.records] == list(enumerate(names))
     f = fiberlab.fit(r, "marschner2003", ["beta_long"], per_lobe=True)
     assert [(x["lobe"], x["lobe_name"]) for x in f.after.records] == list(enumerate(names))
     assert list(f.lobe_fits) == names
     assert [row["lobe_name"] for row in f.lobe_table.to_dict("records")] == names
+
+
+def command_rows(stdout):
+    """`fiberlab compare`'s table (compare/compare_report.cpp): per row the
+    lobe name and E_sim, se, E_model, z, chi2/dof, dof and the verdict as printed."""
+    rows = []
+    for line in stdout.splitlines():
+        f = line.split()
+        if len(f) >= 18 and re.match(r"-?\d+\.\d\d$", f[0]) and f[5] == "+-":
+            rows.append({"lobe_name": f[2], "channel": int(f[3]), "sim_energy": float(f[4]),
+                         "sim_error": float(f[6]), "model_energy": float(f[7]), "energy_z": float(f[8]),
+                         "chi2_per_dof": float(f[9]), "dof": int(f[10]), "verdict": " ".join(f[17:]).lower()})
+    return rows
+
+
+def test_python_predict_of_a_medullated_result_compares_as_the_command(fur, fiberlab_binary):
+    # Python's predict() gives the result's lobe axis (the model's lobes by p,
+    # then an empty `scattered`), so compare() takes it and its table is the
+    # one `fiberlab compare --model` prints for the same file: the oracle is
+    # the command's stdout, parsed here.
+    d, names = fur
+    r = fiberlab.load(str(d / "fur.h5"))
+    pred = fiberlab.predict(r, "marschner2003")
+    assert pred.probability.shape == r.mean.shape
+    assert pred.lobe_names == names
+    assert not pred.probability[:, -1].any()  # no model predicts `scattered`
+    records = fiberlab.compare(r, pred).records
+    out = subprocess.run([fiberlab_binary, "compare", str(d / "fur.h5"), "--model", "marschner2003"],
+                         capture_output=True, text=True)
+    assert out.returncode in (0, 1), out.stderr
+    rows = command_rows(out.stdout)
+    assert [row["lobe_name"] for row in rows] == names
+    assert len(records) == len(rows)
+    for rec, row in zip(records, rows):
+        assert (rec["lobe_name"], rec["channel"], rec["dof"], rec["verdict"]) == \
+            (row["lobe_name"], row["channel"], row["dof"], row["verdict"])
+        # The printed digits: half a unit of the last one (and a relative 1e-9 for the chi-square).
+        assert rec["sim_energy"] == pytest.approx(row["sim_energy"], abs=5e-7)
+        assert rec["model_energy"] == pytest.approx(row["model_energy"], abs=5e-7)
+        assert rec["energy_z"] == pytest.approx(row["energy_z"], abs=0.05 + 1e-9)
+        assert rec["chi2_per_dof"] == pytest.approx(row["chi2_per_dof"], abs=5e-4 + 1e-9 * row["chi2_per_dof"])
+
+
+def test_cli_prediction_file_of_a_medullated_config_names_scattered(fur, fiberlab_binary):
+    # `fiberlab predict` pads the same lobe (app::predict): its file has the
+    # result's lobe names (read with h5py) and `compare --prediction` takes it.
+    d, names = fur
+    subprocess.run([fiberlab_binary, "predict", str(d / "fur.yaml"), "--model", "marschner2003", "-o",
+                    str(d / "pred.h5")], check=True, capture_output=True)
+    assert attr_names(d / "pred.h5") == names
+    with h5py.File(d / "pred.h5", "r") as f:
+        p = f["prediction/probability"][...]
+    assert p.shape[1] == len(names) and not p[:, -1].any()
+    out = subprocess.run([fiberlab_binary, "compare", str(d / "fur.h5"), "--prediction", str(d / "pred.h5")],
+                         capture_output=True, text=True)
+    assert out.returncode in (0, 1), out.stderr
+    assert [row["lobe_name"] for row in command_rows(out.stdout)] == names
+    assert fiberlab.load(str(d / "pred.h5")).lobe_names == names
 
 
 @pytest.fixture(scope="module")

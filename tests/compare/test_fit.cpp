@@ -7,12 +7,16 @@
 
 #include <omp.h>
 
+#include <algorithm>
 #include <cstdio>
 
 #include "analytic/deon2011.h"
 #include "analytic/model_registry.h"
 #include "common/error.h"
+#include "common/bin_grid.h"
+#include "common/units.h"
 #include "compare/fit.h"
+#include "compare/models.h"
 #include "tests/compare/compare_test_support.h"
 
 namespace fiberlab::compare {
@@ -118,6 +122,39 @@ TEST(Fit, ScaleTiltIsTheShiftRule) {
   EXPECT_NEAR(get_parameter("deon2011", p, "scale_tilt"), 3.0, 1e-12);
   set_parameter("deon2011", p, "beta_long[2]", 7.0);
   EXPECT_NEAR(rad_to_deg(analytic::for_lobe(d.beta_long, 2)), 7.0, 1e-12);
+}
+
+// A per-lobe fit's start writes a one-entry beta_long out per predicted
+// lobe (the same model: its bins equal the start's exactly), so setting the
+// lobe's entry moves that lobe alone; the one-entry list itself would carry
+// the value to every lobe (analytic/model_params.h: the last entry applies
+// to every larger p).
+TEST(Fit, LobeFitStartWritesTheListOutPerLobe) {
+  analytic::ModelParameters start = analytic::default_params("deon2011");
+  set_parameter("deon2011", start, "beta_long", 9.0);
+  ASSERT_EQ(start.as<analytic::Deon2011Params>().beta_long.size(), 1u);
+  const int lobes = analytic::predicted_lobes("deon2011", start);
+  ASSERT_GE(lobes, 3);
+  analytic::ModelParameters lobe = lobe_fit_start("deon2011", start, per_lobe_keys("deon2011", {"beta_long"}, 1));
+  const std::vector<double>& list = lobe.as<analytic::Deon2011Params>().beta_long;
+  ASSERT_EQ(list.size(), static_cast<std::size_t>(lobes));
+  for (double b : list) EXPECT_NEAR(rad_to_deg(b), 9.0, 1e-12);
+  const BinGrid grid = BinGrid::make(18, 12, ThetaBinning::Uniform);
+  const auto bins = [&](const analytic::ModelParameters& p) {
+    return predict_bins(*compare::make_model("deon2011", p), grid, deg_to_rad(30.0), 0.0, lobes,
+                        analytic::predicted_channels("deon2011", p));
+  };
+  EXPECT_EQ(bins(lobe), bins(start));
+  // The lobe's entry now moves lobe 1 only: every other lobe's bins stay the start's.
+  set_parameter("deon2011", lobe, "beta_long[1]", 4.0);
+  const std::vector<double> a = bins(start);
+  const std::vector<double> b = bins(lobe);
+  const std::size_t cells = a.size() / static_cast<std::size_t>(lobes);
+  for (int l = 0; l < lobes; ++l) {
+    const auto at = [&](const std::vector<double>& v, int i) { return v.begin() + static_cast<std::ptrdiff_t>(i * cells); };
+    const bool same = std::equal(at(a, l), at(a, l + 1), at(b, l));
+    EXPECT_EQ(same, l != 1) << "lobe " << l;
+  }
 }
 
 // The fit's model evaluations run in parallel (compare/fit.cpp: the 2n x K
