@@ -131,6 +131,25 @@ void exit_angles(FinishedPhotons& f) {
   }
 }
 
+// The exit directions of rows [n, n + k) of f that exited, through the
+// model's exit hook, each from the stream `stream_of` makes of its lane's
+// four words (the photon's own, or scored_exit_stream's for a scored exit).
+template <class Model, class Light, class StreamOf>
+void apply_exit_hook(const Model& model, const life::PhotonState<Lanes, Light>& s, std::uint64_t lanes,
+                     int n, int k, FinishedPhotons& f, StreamOf stream_of) {
+  alignas(64) std::uint64_t w[4][W];
+  for (int q = 0; q < 4; ++q) life::pack_store(s.rng.word(q), lanes, w[q]);
+  for (int j = 0; j < k; ++j) {
+    if (!f.exited[n + j]) continue;
+    PhotonRandom rng = stream_of(w[0][j], w[1][j], w[2][j], w[3][j]);
+    const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
+                                     f.segments[n + j], rng);
+    f.dx[n + j] = d.x();
+    f.dy[n + j] = d.y();
+    f.dz[n + j] = d.z();
+  }
+}
+
 // The photons of a vector whose lanes `lanes` finished this step, appended
 // to the block f (which has room for W more past them: sim/simd/lane_packing.h).
 // Their fates and exit directions as finished_outcome (sim/life/tracer.h) gives
@@ -181,19 +200,10 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
     const int j = n + std::countr_zero(rest);
     f.dx[j] = f.dy[j] = f.dz[j] = 0.0;
   }
-  if constexpr (HasExitHook<Model>) {
-    alignas(64) std::uint64_t w[4][W];
-    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
-    for (int j = 0; j < k; ++j) {
-      if (!f.exited[n + j]) continue;
-      PhotonRandom rng(life::LaneRandom<double>(w[0][j], w[1][j], w[2][j], w[3][j]));
-      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
-                                       f.segments[n + j], rng);
-      f.dx[n + j] = d.x();
-      f.dy[n + j] = d.y();
-      f.dz[n + j] = d.z();
-    }
-  }
+  if constexpr (HasExitHook<Model>)
+    apply_exit_hook(model, s, lanes, n, k, f, [](auto a, auto b, auto c, auto d) {
+      return PhotonRandom(life::LaneRandom<double>(a, b, c, d));
+    });
   f.n = n + k;
 }
 
@@ -240,19 +250,10 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
     f.scattered[n + j] = (scattered >> j) & 1;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
   }
-  if constexpr (HasExitHook<Model>) {
-    alignas(64) std::uint64_t w[4][W];
-    for (int q = 0; q < 4; ++q) pack_store(s.rng.word(q), lanes, w[q]);
-    for (int j = 0; j < k; ++j) {
-      if (!f.exited[n + j]) continue;
-      PhotonRandom rng = scored_exit_stream(w[0][j], w[1][j], w[2][j], w[3][j]);
-      const Vec3 d = exit_direction_of(model, Vec3(f.dx[n + j], f.dy[n + j], f.dz[n + j]),
-                                       f.segments[n + j], rng);
-      f.dx[n + j] = d.x();
-      f.dy[n + j] = d.y();
-      f.dz[n + j] = d.z();
-    }
-  }
+  if constexpr (HasExitHook<Model>)
+    apply_exit_hook(model, s, lanes, n, k, f, [](auto a, auto b, auto c, auto d) {
+      return scored_exit_stream(a, b, c, d);
+    });
   f.n = n + k;
 }
 
