@@ -8,6 +8,7 @@
 #include "app/fit.h"
 #include "app/comma_list.h"
 #include "common/error.h"
+#include "compare/fit_settings.h"
 #include "compare/prediction_file.h"
 #include "compare/report.h"
 
@@ -43,8 +44,8 @@ Comparison set_up(const CompareRequest& o) {
     throw Error("compare: give either --model NAME or --prediction PRED.h5 (exactly one)");
   if (c.from_file && (!o.settings.empty() || !o.fit.empty()))
     throw Error("compare --prediction: --set and --fit need a --model (a file's parameters cannot be changed)");
-  if (o.fit.empty() && (o.per_lobe || !o.fit_lobes.empty()))
-    throw Error("compare: --fit-lobes and --per-lobe need --fit KEYS");
+  if (o.fit.empty() && (o.per_lobe || !o.fit_lobes.empty() || !o.fit_settings.empty()))
+    throw Error("compare: --fit-lobes, --per-lobe and --fit-set need --fit KEYS");
   c.result = sim::read_result(o.result);
   const sim::ResultFile& result = c.result;
   if (o.channel < 0 || o.channel >= result.channels)
@@ -55,6 +56,9 @@ Comparison set_up(const CompareRequest& o) {
     c.params = compare::params_for(result.settings, c.spec, o.settings, &c.fiber_notes);
     compare::make_model(c.spec.name, c.params);  // the model's own checks, before any output
     compare::check_fit_keys(c.spec.name, c.fit_keys);
+    compare::check_fit_settings(c.spec.name, o.fit_settings, c.fit_keys, "--fit-set");
+    c.fit_settings = o.fit_settings;
+    compare::with_fit_settings(c.spec.name, c.params, c.fit_settings);  // the model's own checks
   }
   c.fit_options = copt;  // the lobes the fit judges and fits
   if (!o.fit_lobes.empty())
@@ -81,7 +85,9 @@ compare::Verdict judge(const Comparison& c, const Predicted& p) {
 
 JointFit fit_jointly(const Comparison& c, const std::function<void(const std::string&)>& progress) {
   JointFit j;
-  j.fit = compare::fit_model(c.result, c.spec.name, c.params, c.fit_keys, c.fit_options, kFitIterations, progress);
+  j.fit = compare::fit_model(c.result, c.spec.name, compare::with_fit_settings(c.spec.name, c.params, c.fit_settings),
+                             c.fit_keys, c.fit_options, kFitIterations, progress);
+  if (!c.fit_settings.empty()) compare::put_onto_judged(c.spec.name, c.params, j.fit);
   // The verdict and the report use the fitted model.
   j.predicted = predicted_by_model(c.result, c.spec, j.fit.params);
   j.after = judge(c, j.predicted);
@@ -92,7 +98,7 @@ std::vector<LobeFitVerdict> fit_each_lobe(const Comparison& c, const compare::Ve
                                           const std::function<void(const std::string&)>& progress) {
   // Each lobe is judged with the fit's options; the command's verdict stays the joint fit's.
   return app::fit_each_lobe(c.result, c.spec.name, c.params, c.fit_keys, c.fit_options, c.max_chi2, kFitIterations,
-                            before, progress);
+                            before, progress, c.fit_settings);
 }
 
 }  // namespace fiberlab::app

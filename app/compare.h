@@ -24,6 +24,7 @@ struct CompareRequest {
   std::string result, model, prediction, fit, report, fit_lobes;
   bool per_lobe = false;
   std::vector<std::string> settings;
+  std::vector<std::string> fit_settings;  // --fit-set KEY=VALUE (compare/fit_settings.h)
   std::optional<double> max_chi2;  // none: the five-sigma rule of compare/verdict.h
   double min_effective = compare::Options{}.min_effective;
   double model_error = compare::Options{}.model_rel_error;
@@ -50,6 +51,7 @@ struct Comparison {
   analytic::ModelParameters params;    // --model, before any fit
   std::vector<std::string> fiber_notes;  // the approximate mappings from the simulated fiber
   std::vector<std::string> fit_keys;
+  std::vector<std::string> fit_settings;  // applied only while fitting (compare/fit_settings.h)
   Predicted file_prediction;  // --prediction: the file's bins
 };
 

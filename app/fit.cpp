@@ -4,6 +4,7 @@
 
 #include "analytic/model_registry.h"
 #include "common/error.h"
+#include "compare/fit_settings.h"
 #include "compare/models.h"
 
 namespace fiberlab::app {
@@ -34,10 +35,12 @@ std::vector<LobeFitVerdict> fit_each_lobe(const sim::ResultFile& result, const s
                                           const analytic::ModelParameters& start,
                                           const std::vector<std::string>& keys, const compare::Options& options,
                                           double max_chi2, int max_iterations, const compare::Verdict& before,
-                                          const std::function<void(const std::string&)>& progress) {
+                                          const std::function<void(const std::string&)>& progress,
+                                          const std::vector<std::string>& fit_settings) {
   std::vector<LobeFitVerdict> out;
-  for (const compare::LobeFit& lf :
-       compare::fit_each_lobe(result, model, start, keys, options, max_iterations, progress)) {
+  for (compare::LobeFit& lf : compare::fit_each_lobe(result, model, compare::with_fit_settings(model, start, fit_settings),
+                                                     keys, options, max_iterations, progress)) {
+    if (!fit_settings.empty()) compare::put_onto_judged(model, start, lf.fit);
     const compare::Verdict after = judge_model(result, model, lf.fit.params, options, max_chi2);
     out.push_back({lf.lobe, lf.fit, only_lobe(before, lf.lobe, max_chi2), only_lobe(after, lf.lobe, max_chi2)});
   }
@@ -58,13 +61,16 @@ FitReport fit(const sim::ResultFile& result, const FitRequest& r,
   out.start = compare::params_for(result.settings, spec, r.sets);
   compare::make_model(spec.name, out.start);  // the model's own checks, before the fit
   for (const std::string& key : r.keys) compare::check_fit_key(spec.name, key);
+  compare::check_fit_settings(spec.name, r.fit_settings, r.keys, "fit_settings");
+  const analytic::ModelParameters fitting = compare::with_fit_settings(spec.name, out.start, r.fit_settings);
   const double limit = r.max_chi2 ? *r.max_chi2 : 0.0;
   out.before = judge_model(result, spec.name, out.start, o, limit);
-  out.fit = compare::fit_model(result, spec.name, out.start, r.keys, o, r.max_iterations, progress);
+  out.fit = compare::fit_model(result, spec.name, fitting, r.keys, o, r.max_iterations, progress);
+  if (!r.fit_settings.empty()) compare::put_onto_judged(spec.name, out.start, out.fit);
   out.after = judge_model(result, spec.name, out.fit.params, o, limit);
   if (r.per_lobe)
     out.lobe_fits = fit_each_lobe(result, spec.name, out.start, r.keys, o, limit, r.max_iterations, out.before,
-                                  progress);
+                                  progress, r.fit_settings);
   return out;
 }
 

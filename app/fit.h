@@ -30,6 +30,7 @@ struct FitRequest {
   std::string model;
   std::vector<std::string> keys;   // what to fit (compare::check_fit_key)
   std::vector<std::string> sets;   // KEY=VALUE overrides of the start
+  std::vector<std::string> fit_settings;  // KEY=VALUE applied only while fitting (compare/fit_settings.h)
   std::vector<std::string> lobes;  // the lobes the fit judges and fits; empty: every lobe
   compare::Options options;        // checked by compare::check_options
   std::optional<double> max_chi2;
@@ -56,13 +57,15 @@ struct FitReport {
 // `start` (compare::fit_each_lobe: a per-lobe key becomes the lobe's own
 // entry), judged after its fit with `options` and `max_chi2` (0: the
 // five-sigma rule); `before` is the verdict at `start`, of which each lobe
-// keeps its rows. `compare --per-lobe` and fiberlab.fit(per_lobe=True) both
+// keeps its rows. `fit_settings` apply while fitting only: each lobe's
+// params are then `start` at its fitted values (compare/fit_settings.h). `compare --per-lobe` and fiberlab.fit(per_lobe=True) both
 // give these.
 std::vector<LobeFitVerdict> fit_each_lobe(const sim::ResultFile& result, const std::string& model,
                                           const analytic::ModelParameters& start,
                                           const std::vector<std::string>& keys, const compare::Options& options,
                                           double max_chi2, int max_iterations, const compare::Verdict& before,
-                                          const std::function<void(const std::string&)>& progress = {});
+                                          const std::function<void(const std::string&)>& progress = {},
+                                          const std::vector<std::string>& fit_settings = {});
 
 // Checks the request (keys given once each, the model's own checks), then
 // fits (jointly; with per_lobe, then each lobe alone from the same start). `progress` gets compare::fit_model's line per iteration; what it

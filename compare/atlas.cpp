@@ -10,6 +10,7 @@
 #include "common/error.h"
 #include "common/file_schema.h"
 #include "common/interrupt.h"
+#include "compare/fit_settings.h"
 #include "compare/models.h"
 #include "sim/store/result_file.h"
 #include "sim/run/simulation.h"
@@ -57,16 +58,9 @@ std::vector<LobeComparison> judge_model(const sim::ResultFile& r, const std::str
 // cheaper quadrature. Those keys are fixed, so a fit moves only its own keys.
 analytic::ModelParameters fit_start(const AtlasConfig& config, const std::string& entry, const std::string& model,
                                     const analytic::ModelParameters& p) {
-  analytic::ModelParameters out = p;
   const auto settings = config.fit_model_parameters.find(entry);
-  if (settings == config.fit_model_parameters.end()) return out;
-  const analytic::ParamTable& table = analytic::model_info(model).params;
-  for (const std::string& kv : settings->second) {
-    const std::size_t eq = kv.find('=');
-    analytic::find_param(table, kv.substr(0, eq))->set(out, kv.substr(eq + 1));
-  }
-  compare::make_model(model, out);  // the model's own checks
-  return out;
+  if (settings == config.fit_model_parameters.end()) return p;
+  return with_fit_settings(model, p, settings->second);
 }
 
 // A fit's result judged: `judged` (the parameters without fit-only settings)
@@ -75,9 +69,7 @@ analytic::ModelParameters fit_start(const AtlasConfig& config, const std::string
 // Without fit-only settings fit.params is left as the fit returned it.
 void judge_with(const AtlasConfig& config, const std::string& entry, const std::string& model,
                 const analytic::ModelParameters& judged, FitResult& fit) {
-  if (!config.fit_model_parameters.count(entry)) return;
-  fit.params = judged;
-  for (std::size_t j = 0; j < fit.keys.size(); ++j) set_parameter(model, fit.params, fit.keys[j], fit.value[j]);
+  if (config.fit_model_parameters.count(entry)) put_onto_judged(model, judged, fit);
 }
 
 // "fitted (converged: why)", "fitted (at a bound: key = value; why)",

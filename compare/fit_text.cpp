@@ -83,7 +83,8 @@ std::string fit_markdown(const FitResult& fr, const Verdict& before, const Verdi
   return md;
 }
 
-std::string fit_json(const FitResult& fr, const Verdict& before, const Verdict& after) {
+std::string fit_json(const FitResult& fr, const Verdict& before, const Verdict& after,
+                     const std::vector<std::string>& fit_only_settings) {
   std::string items, per_lobe;
   for (std::size_t i = 0; i < fr.keys.size(); ++i)
     items += fmt::format("{}{{\"key\": {}, \"start\": {}, \"value\": {}, \"error\": {}, \"error_unscaled\": {}}}",
@@ -97,12 +98,15 @@ std::string fit_json(const FitResult& fr, const Verdict& before, const Verdict& 
                             b.lobe, b.channel, json_number(b.bins.per_dof()),
                             json_number(after.rows[i].bins.per_dof()));
   }
+  std::string settings;
+  for (const std::string& s : fit_only_settings) settings += (settings.empty() ? "" : ", ") + json_string(s);
   return fmt::format(
       "{{\"parameters\": [{}], \"chi2_start\": {}, \"chi2\": {}, \"dof\": {}, \"iterations\": {}, "
-      "\"converged\": {}, \"outcome\": {}, \"stop_reason\": {}, \"error_scale\": \"sqrt(max(1, chi2/dof))\", \"per_lobe\": [{}]}}",
+      "\"converged\": {}, \"outcome\": {}, \"stop_reason\": {}, \"error_scale\": \"sqrt(max(1, chi2/dof))\", "
+      "\"fit_only_settings\": [{}], \"per_lobe\": [{}]}}",
       items, json_number(fr.chi2_start), json_number(fr.chi2), fr.dof, fr.iterations,
       fr.converged ? "true" : "false", json_string(outcome_name(fr.outcome)), json_string(fr.stop_reason),
-      per_lobe);
+      settings, per_lobe);
 }
 
 }  // namespace fiberlab::compare

@@ -14,6 +14,8 @@ namespace fiberlab::compare {
 // (same rows, same order).
 std::string fit_text(const FitResult& fit, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names);
 std::string fit_markdown(const FitResult& fit, const Verdict& before, const Verdict& after, const std::vector<std::string>& lobe_names);
-std::string fit_json(const FitResult& fit, const Verdict& before, const Verdict& after);
+// fit_only_settings: `compare --fit-set`'s KEY=VALUE (compare/fit_settings.h), listed as such.
+std::string fit_json(const FitResult& fit, const Verdict& before, const Verdict& after,
+                     const std::vector<std::string>& fit_only_settings = {});
 
 }  // namespace fiberlab::compare

@@ -118,7 +118,8 @@ def _fit_from(d, model, lobe=None):
 
 def fit(result, model, keys, max_chi2=None, min_effective=DEFAULTS["min_effective"],
         model_error=DEFAULTS["model_error"], min_energy=DEFAULTS["min_energy"],
-        max_iterations=DEFAULTS["max_iterations"], lobes=None, progress=None, per_lobe=False, **fixed):
+        max_iterations=DEFAULTS["max_iterations"], lobes=None, progress=None, per_lobe=False,
+        fit_settings=None, **fixed):
     """Fits `keys` of analytic model `model` to a Result, as `fiberlab compare
     RESULT --model MODEL --fit KEYS --set KEY=VALUE...` does. keys: a list
     (or a comma-separated string) of the model's numeric keys: eta,
@@ -135,6 +136,12 @@ def fit(result, model, keys, max_chi2=None, min_effective=DEFAULTS["min_effectiv
     model with per-lobe shifts) becomes the lobe's own entry, scalars are
     fitted to that lobe's bins (compare/fit.h per_lobe_keys); the result's
     lobe_fits and lobe_table hold them.
+    fit_settings: a dict of the model's parameters applied only while
+    fitting, as `compare --fit-set KEY=VALUE` (e.g. {"quadrature_points":
+    2**19} fits huang2022 at a cheap quadrature); params, before and after
+    are at the judged parameters (without them), chi2_before and
+    chi2_after are the fit's own (with them). A fitted key, a key the
+    simulated fiber sets (eta, sigma_a, ...) or an unknown key is refused.
     Ctrl-C stops a fit at the next iteration (KeyboardInterrupt).
     """
     from .result import Result
@@ -155,9 +162,14 @@ def fit(result, model, keys, max_chi2=None, min_effective=DEFAULTS["min_effectiv
         raise _fiberlab.Error("lobes must be None or a list of lobe names (e.g. [\"TRT\"])")
     if not isinstance(per_lobe, (bool, np.bool_)):
         raise _fiberlab.Error("per_lobe must be True or False, not %r" % (per_lobe,))
+    if fit_settings is None:
+        fit_settings = {}
+    if not isinstance(fit_settings, dict) or not all(isinstance(k, str) for k in fit_settings):
+        raise _fiberlab.Error("fit_settings must be None or a dict of the model's parameters "
+                              "(e.g. {\"quadrature_points\": 524288}), not %r" % (fit_settings,))
     if progress is not None and not callable(progress):
         raise _fiberlab.Error("progress must be None or a callable(line)")
     d = _fiberlab.fit(result._file, model, list(keys), settings_overrides(fixed),
                       *_options(max_chi2, min_effective, model_error, min_energy), max_iterations, list(lobes),
-                      bool(per_lobe), progress)
+                      bool(per_lobe), progress, settings_overrides(fit_settings))
     return _fit_from(d, model)

@@ -74,7 +74,7 @@ py::dict fit_dict(const compare::FitResult& fr, const std::string& model_name,
 py::dict fit(const sim::ResultFile& result, const std::string& model_name, const std::vector<std::string>& keys,
              const std::vector<std::string>& sets, std::optional<double> max_chi2, double min_effective,
              double model_error, double min_energy, int max_iterations, const std::vector<std::string>& lobes,
-             bool per_lobe, py::object progress) {
+             bool per_lobe, py::object progress, const std::vector<std::string>& fit_settings) {
   app::FitRequest request;
   request.model = model_name;
   request.keys = keys;
@@ -84,6 +84,7 @@ py::dict fit(const sim::ResultFile& result, const std::string& model_name, const
   request.max_chi2 = max_chi2;
   request.max_iterations = max_iterations;
   request.per_lobe = per_lobe;
+  request.fit_settings = fit_settings;
   FitProgress relay(std::move(progress));
   app::FitReport report;
   bool stopped = false;
@@ -115,6 +116,7 @@ void bind_fit(py::module_& m) {
         py::arg("max_chi2") = py::none(), py::arg("min_effective") = compare::Options{}.min_effective,
         py::arg("model_error") = compare::Options{}.model_rel_error, py::arg("min_energy") = compare::Options{}.min_lobe_energy, py::arg("max_iterations") = app::kFitIterations, py::arg("lobes") = std::vector<std::string>{},
         py::arg("per_lobe") = false, py::arg("progress") = py::none(),
+        py::arg("fit_settings") = std::vector<std::string>{},
         "app::fit (the fit of `fiberlab compare --fit`, and with per_lobe each lobe's own as --per-lobe) with "
         "the verdicts before and after it");
 }
