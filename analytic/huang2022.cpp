@@ -6,8 +6,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <type_traits>
 #include <variant>
+
+#include <omp.h>
 
 #include "analytic/huang2022_lanes.h"
 #include "analytic/longitudinal_lobes.h"
@@ -496,26 +499,44 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
-// The same points W at a time through the lanes' paths (huang2022_lanes.h):
-// deposit(exits, u) takes each group's exits and coordinates. The last
-// group's lanes past point n - 1 carry weight 0 (their paths end at the
+// The same points W at a time through the lanes' paths (huang2022_lanes.h),
+// lane groups [first, end) of the ceil(n / W) groups (point i0 = W g starts
+// group g): deposit(exits, u) takes each group's exits and coordinates. The
+// last group's lanes past point n - 1 carry weight 0 (their paths end at the
 // entry).
 template <class Deposit>
-void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposit) {
+void integrate_lanes(const huang_lanes::Tracer& tracer, long n, long first, long end, Deposit&& deposit) {
   using huang_lanes::B;
   constexpr int W = huang_lanes::kWidth;
   const double base = 1.0 / static_cast<double>(n);
-  Halton set(0, n, static_cast<std::uint64_t>(n) + W);
+  Halton set(static_cast<std::uint64_t>(first) * W, n, static_cast<std::uint64_t>(n) + W);
   alignas(64) double u[kDims][W], share[W];
   B ub[kDims];
   huang_lanes::Exits exits;
-  for (long i0 = 0; i0 < n; i0 += W) {
+  for (long i0 = first * W; i0 < end * W; i0 += W) {
     set.get_lanes<W>(u);
     for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? base : 0.0;
     for (int k = 0; k < kDims; ++k) ub[k] = B::load_aligned(u[k]);
     tracer.trace(ub, B::load_aligned(share), exits);
     deposit(exits, u);
   }
+}
+
+// The point set in kPointBlocks contiguous blocks of lane groups, each traced
+// into its own accumulator and summed in block order afterwards (the
+// caller): the same numbers for any number of threads, which the atlas's
+// bit-identity across threads, ranks and resumes needs. The blocks run on
+// OpenMP threads unless the caller is already in a parallel region
+// (compare's fits and predict_result run configurations in parallel; no
+// nested team then).
+constexpr int kPointBlocks = 16;
+template <class Deposit>
+void integrate_blocks(const huang_lanes::Tracer& tracer, long n, Deposit&& deposit) {
+  const long groups = (n + huang_lanes::kWidth - 1) / huang_lanes::kWidth;
+#pragma omp parallel for schedule(dynamic) if (!omp_in_parallel())
+  for (int b = 0; b < kPointBlocks; ++b)
+    integrate_lanes(tracer, n, groups * b / kPointBlocks, groups * (b + 1) / kPointBlocks,
+                    [&](const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) { deposit(b, e, u); });
 }
 
 // Bit l set where lane l of m is.
@@ -709,6 +730,11 @@ class BinSink : public Sink {
   }
   void lost(bool, const double*) override {}
   void incident(double) override {}
+  // Adds another block's bins and residual (the same grid and model).
+  void add(const BinSink& other) {
+    for (std::size_t k = 0; k < out_.size(); ++k) out_[k] += other.out_[k];
+    for (std::size_t k = 0; k < residual_.size(); ++k) residual_[k] += other.residual_[k];
+  }
   // Spreads the residual (call once, after the points).
   void finish() {
     const int np = grid_.n_phi(), nt = grid_.n_theta();
@@ -748,6 +774,16 @@ class BinSink : public Sink {
   double scale_[kResidualP];
   std::vector<double> residual_;  // per theta bin (sampled spread) or in row 0 (the total)
 };
+
+// to += from, term by term (the same model and channels).
+void add_energies(HuangEnergies& to, const HuangEnergies& from) {
+  for (std::size_t k = 0; k < to.lobe.size(); ++k) to.lobe[k] += from.lobe[k];
+  for (std::size_t c = 0; c < to.masked.size(); ++c) {
+    to.masked[c] += from.masked[c];
+    to.stopped[c] += from.stopped[c];
+  }
+  to.incident += from.incident;
+}
 
 class EnergySink : public Sink {
  public:
@@ -871,9 +907,16 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
     integrate(paths, params_.quadrature_points, sink);
   } else {
+    // Block 0 deposits into out (sink), block b > 0 into block_out[b - 1].
     const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
-    integrate_lanes(tracer, params_.quadrature_points,
-                    [&](const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) { sink.lanes(e, u); });
+    std::vector<std::vector<double>> block_out(kPointBlocks - 1, std::vector<double>(out.size(), 0.0));
+    std::deque<BinSink> sinks;
+    for (std::vector<double>& o : block_out) sinks.emplace_back(paths, grid, theta_i, phi_i, o);
+    integrate_blocks(tracer, params_.quadrature_points,
+                     [&](int b, const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) {
+                       (b == 0 ? sink : sinks[b - 1]).lanes(e, u);
+                     });
+    for (const BinSink& s : sinks) sink.add(s);
   }
   sink.finish();
   return out;
@@ -886,9 +929,16 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
     integrate(paths, params_.quadrature_points, sink);
   } else {
+    // Block 0 sums into e (sink), block b > 0 into block_e[b - 1].
     const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
-    integrate_lanes(tracer, params_.quadrature_points,
-                    [&](const huang_lanes::Exits& x, const double(*)[huang_lanes::kWidth]) { sink.lanes(x); });
+    std::vector<HuangEnergies> block_e(kPointBlocks - 1);
+    std::deque<EnergySink> sinks;
+    for (HuangEnergies& x : block_e) sinks.emplace_back(paths, x);
+    integrate_blocks(tracer, params_.quadrature_points,
+                     [&](int b, const huang_lanes::Exits& x, const double(*)[huang_lanes::kWidth]) {
+                       (b == 0 ? sink : sinks[b - 1]).lanes(x);
+                     });
+    for (const HuangEnergies& x : block_e) add_energies(e, x);
   }
   return e;
 }

@@ -129,7 +129,9 @@
 // `quadrature_points` (2^23 by default); bin_probabilities() and energies()
 // trace 8 points at a time in SIMD lanes (4 without AVX-512;
 // huang2022_lanes.h, the same transport as the scalar paths that density()
-// uses). The quadrature error of R, TT and TRT falls about 4x per 4x
+// uses), in 16 fixed blocks of the point set run on OpenMP threads (unless
+// called inside a parallel region) and summed in block order: the same
+// bits for any number of threads. The quadrature error of R, TT and TRT falls about 4x per 4x
 // points (a push-forward of a fixed point set into bins converges like an
 // estimate from as many independent paths, a little better; the error
 // comes from the facet normals' coordinates, not from h: an

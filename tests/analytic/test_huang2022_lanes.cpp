@@ -13,6 +13,8 @@
 // lane group's padding points given weight.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -119,4 +121,30 @@ TEST(Huang2022, LanesEqualTheScalarPathsInBins) {
       expect_close(lanes.bin_probabilities(g, ti, pi), scalar.bin_probabilities(g, ti, pi), 1e-13,
                    k.name + " " + std::to_string(g.n_theta()));
     }
+}
+
+// The quadrature's points run in a fixed number of blocks summed in block
+// order: 1, 2 or 3 threads give the same bits (the atlas's bit-identity
+// across threads, ranks and resumes rests on it). Mutation caught: the
+// blocks summed as their threads finish (a per-thread accumulator).
+TEST(Huang2022, BinsAndEnergiesAreTheSameOnAnyNumberOfThreads) {
+  const int threads = omp_get_max_threads();
+  const BinGrid g = BinGrid::make(18, 36, ThetaBinning::Uniform);
+  for (const Case& k : cases()) {
+    const Huang2022 model(k.p);
+    const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
+    omp_set_num_threads(1);
+    const std::vector<double> bins1 = model.bin_probabilities(g, ti, pi);
+    const HuangEnergies e1 = model.energies(ti, pi);
+    for (int n : {2, 3}) {
+      omp_set_num_threads(n);
+      EXPECT_EQ(model.bin_probabilities(g, ti, pi), bins1) << k.name << ", " << n << " threads";
+      const HuangEnergies en = model.energies(ti, pi);
+      EXPECT_EQ(en.lobe, e1.lobe) << k.name << ", " << n << " threads";
+      EXPECT_EQ(en.masked, e1.masked) << k.name;
+      EXPECT_EQ(en.stopped, e1.stopped) << k.name;
+      EXPECT_EQ(en.incident, e1.incident) << k.name;
+    }
+  }
+  omp_set_num_threads(threads);
 }
