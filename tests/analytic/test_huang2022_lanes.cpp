@@ -1,6 +1,6 @@
-// huang2022's SIMD paths (analytic/huang2022_lanes.h) against its scalar
-// paths (huang2022.cpp's Paths, the ones density() uses): the same point set
-// through both must give the same lobe energies, losses and bins up to
+// huang2022's SIMD paths (analytic/huang2022_lanes.h) in double against its
+// scalar paths (huang2022.cpp's Paths, the ones density() uses): the same
+// point set through both must give the same lobe energies, losses and bins up to
 // rounding, in every mode of the model (roughness 0 and > 0, each masking,
 // both fluxes, both residuals, tilt, ellipse, absorbing channels, 2 to 4
 // lobes, a point count that is not a multiple of the lane width,
@@ -97,7 +97,8 @@ void expect_close(const std::vector<double>& a, const std::vector<double>& b, do
 TEST(Huang2022, LanesEqualTheScalarPathsInEnergy) {
   for (const Case& k : cases()) {
     Huang2022 lanes(k.p), scalar(k.p);
-    scalar.set_scalar_paths(true);
+    lanes.set_paths(HuangPaths::DoubleLanes);
+    scalar.set_paths(HuangPaths::Scalar);
     const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
     const HuangEnergies a = lanes.energies(ti, pi), b = scalar.energies(ti, pi);
     expect_close(a.lobe, b.lobe, 1e-12, k.name + " lobe");
@@ -116,7 +117,8 @@ TEST(Huang2022, LanesEqualTheScalarPathsInBins) {
        {BinGrid::make(24, 36, ThetaBinning::Uniform), BinGrid::make(17, 35, ThetaBinning::EqualArea)})
     for (const Case& k : cases()) {
       Huang2022 lanes(k.p), scalar(k.p);
-      scalar.set_scalar_paths(true);
+      lanes.set_paths(HuangPaths::DoubleLanes);
+      scalar.set_paths(HuangPaths::Scalar);
       const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
       expect_close(lanes.bin_probabilities(g, ti, pi), scalar.bin_probabilities(g, ti, pi), 1e-13,
                    k.name + " " + std::to_string(g.n_theta()));
@@ -147,4 +149,46 @@ TEST(Huang2022, BinsAndEnergiesAreTheSameOnAnyNumberOfThreads) {
     }
   }
   omp_set_num_threads(threads);
+}
+
+// The float lanes (the quadrature's) against the double lanes on the same
+// points. Float arithmetic rounds each path's weight and exit direction by
+// a few 1e-7 relative; the quadrature's own error is ~1e-3 of a lobe at
+// 2^18 points and 0.1 standard error of the atlas's bins at its default
+// (analytic/huang2022.h). Per lobe and channel the energies must agree to
+// 1e-5 relative (measured up to 3.1e-6: cycles_eval's residual, whose
+// 1 - R2 cancels in float as R2 -> 1) and the bins to 1e-4 of the lobe's
+// energy in L1 (measured up to 1.7e-5: exits within float rounding of a bin
+// edge, ~1e-7 rad, land in the neighbouring bin). The theta grid has 25 bins
+// so that no case's specular cone theta_r = -theta_i is a bin edge (a
+// smooth fiber puts its whole R lobe on that cone, where rounding alone
+// decides the bin, in double as in float). Mutation caught: the residual's
+// denominator as 1 - A (1 - T) in the float lanes (1.1e-3 on white fibers).
+TEST(Huang2022, FloatLanesAreTheDoubleLanesToRounding) {
+  const BinGrid g = BinGrid::make(25, 36, ThetaBinning::Uniform);
+  for (Case k : cases()) {
+    k.p.quadrature_points = 1 << 18;
+    Huang2022 f(k.p), d(k.p);
+    d.set_paths(HuangPaths::DoubleLanes);
+    const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
+    const HuangEnergies ef = f.energies(ti, pi), ed = d.energies(ti, pi);
+    const std::vector<double> bf = f.bin_probabilities(g, ti, pi), bd = d.bin_probabilities(g, ti, pi);
+    const int C = static_cast<int>(k.p.sigma_a.size()), L = k.p.lobes;
+    const std::size_t per_lobe = static_cast<std::size_t>(g.n_theta()) * g.n_phi() * C;
+    for (int l = 0; l < L; ++l)
+      for (int c = 0; c < C; ++c) {
+        const double x = ed.lobe[l * C + c];
+        if (x < 1e-6) continue;
+        double l1 = 0.0;
+        for (std::size_t b = l * per_lobe + c; b < (l + 1) * per_lobe; b += C) l1 += std::abs(bf[b] - bd[b]);
+        std::printf("%s, lobe %d channel %d: energy %.2g, bins (L1) %.2g relative\n", k.name.c_str(), l, c,
+                    std::abs(ef.lobe[l * C + c] - x) / x, l1 / x);
+        EXPECT_NEAR(ef.lobe[l * C + c], x, 1e-5 * x) << k.name << " lobe " << l << " channel " << c;
+        EXPECT_LT(l1, 1e-4 * x) << k.name << " lobe " << l << " channel " << c;
+      }
+    for (int c = 0; c < C; ++c) {
+      EXPECT_NEAR(ef.masked[c], ed.masked[c], 1e-6) << k.name;
+      EXPECT_NEAR(ef.stopped[c], ed.stopped[c], 1e-6) << k.name;
+    }
+  }
 }
