@@ -708,16 +708,28 @@ class BinSink : public Sink {
       unsigned settle = lane_bits(near);
       alignas(64) T phi[W];
       if (settle & bits) f.store_aligned(phi);
+      // The lanes' weights in double and their bins' offsets in out_, for
+      // all lanes at once (vectorised loops), then the live lanes deposited.
       const double s = scale_[p] * share;
-      for (int c = 0; c < C_; ++c) e.w[p][c].store_aligned(w[c]);
+      alignas(64) double wd[kMaxChannels][W];
+      for (int c = 0; c < C_; ++c) {
+        e.w[p][c].store_aligned(w[c]);
+        for (int l = 0; l < W; ++l) wd[c][l] = s * static_cast<double>(w[c][l]);
+      }
       const int lobe = lobe_index(p, L_);
+      alignas(64) std::int64_t offset[W];
+      const std::int64_t first = static_cast<std::int64_t>(lobe) * nt * np;
+      for (int l = 0; l < W; ++l)
+        offset[l] = (first + static_cast<std::int64_t>(ai[l]) * np + static_cast<std::int64_t>(aj[l])) * C_;
       for (; bits != 0; bits &= bits - 1) {
         const int l = std::countr_zero(bits);
-        const double angle = at[l];
-        double* b = settle >> l & 1 ? bin(lobe, grid_.theta_bin(uniform ? angle : std::asin(angle)),
-                                         grid_.phi_bin(wrap_angle(static_cast<double>(phi[l]))))
-                                    : bin(lobe, static_cast<int>(ai[l]), static_cast<int>(aj[l]));
-        for (int c = 0; c < C_; ++c) b[c] += s * static_cast<double>(w[c][l]);
+        double* b = &out_[static_cast<std::size_t>(offset[l])];
+        if (settle >> l & 1) {
+          const double angle = at[l];
+          b = bin(lobe, grid_.theta_bin(uniform ? angle : std::asin(angle)),
+                  grid_.phi_bin(wrap_angle(static_cast<double>(phi[l]))));
+        }
+        for (int c = 0; c < C_; ++c) b[c] += wd[c][l];
       }
     }
     if (v_ >= kMinExactResidualV) {
