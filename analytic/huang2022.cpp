@@ -682,10 +682,11 @@ class BinSink : public Sink {
     const int nt = grid_.n_theta(), np = grid_.n_phi();
     const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
     alignas(64) T at[W], ai[W], aj[W], w[kMaxChannels][W];
-    // floor(g) clamped to [0, n - 1] into out; the lanes near an integer.
+    // floor(g) clamped to [0, n - 1] into out (0 for a dead lane's NaN: its
+    // offset below is computed, not used); the lanes near an integer.
     auto index = [](const B& g, int n, T* out) {
       const B f = xsimd::floor(g), r = g - f;
-      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), f)).store_aligned(out);
+      xsimd::select(f >= B(0.0), xsimd::min(B(n - 1.0), f), B(0.0)).store_aligned(out);
       const B tol(near_edge<T>(n));
       return (r < tol) | (r > B(1.0) - tol);
     };
