@@ -527,9 +527,9 @@ void integrate_lanes(const Tracer& tracer, long n, long first, long end, Deposit
   }
 }
 
-// The point set in kPointBlocks contiguous blocks of lane groups, each traced
-// into its own accumulator (sinks[b]) and summed in block order afterwards
-// (the caller): the same numbers for any number of threads, which the
+// The point set in kPointBlocks contiguous blocks of lane groups, block b's
+// exits handed to deposit(b, exits, u) for an accumulator of its own, which
+// the caller sums in block order afterwards: the same numbers for any number of threads, which the
 // atlas's bit-identity across threads, ranks and resumes needs. The blocks
 // run on OpenMP threads unless the caller is already in a parallel region
 // (compare's fits and predict_result run configurations in parallel; no
