@@ -6,8 +6,11 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <deque>
 #include <type_traits>
 #include <variant>
+
+#include <omp.h>
 
 #include "analytic/huang2022_lanes.h"
 #include "analytic/longitudinal_lobes.h"
@@ -432,7 +435,8 @@ class Paths {
       Weights e;
       for (int c = 0; c < C_; ++c) {
         const double a_avg = std::sqrt(a1->c[c] * a.c[c]);
-        e.c[c] = wr[c] * a_avg * t_avg / (1.0 - a_avg * (1.0 - t_avg));
+        // 1 - A (1 - T) written (1 - A) + A T: no cancellation as T -> 1e-5 (white, trapped by TIR).
+        e.c[c] = wr[c] * a_avg * t_avg / ((1.0 - a_avg) + a_avg * t_avg);
       }
       sink.residual(e.c, pt.u[7], pt.u[8]);
     });
@@ -453,7 +457,7 @@ class Paths {
     Weights e;
     for (int c = 0; c < C_; ++c) {
       const double A = a.c[c];
-      e.c[c] = entry.weight * entry.t1 * r2 * r2 * t_avg * A * A * A / (1.0 - A * (1.0 - t_avg));
+      e.c[c] = entry.weight * entry.t1 * r2 * r2 * t_avg * A * A * A / ((1.0 - A) + A * t_avg);
     }
     sink.residual(e.c, pt.u[7], pt.u[8]);
   }
@@ -496,39 +500,75 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
-// The same points W at a time through the lanes' paths (huang2022_lanes.h):
-// deposit(exits, u) takes each group's exits and coordinates. The last
-// group's lanes past point n - 1 carry weight 0 (their paths end at the
-// entry).
-template <class Deposit>
-void integrate_lanes(const huang_lanes::Tracer& tracer, long n, Deposit&& deposit) {
-  using huang_lanes::B;
-  constexpr int W = huang_lanes::kWidth;
-  const double base = 1.0 / static_cast<double>(n);
-  Halton set(0, n, static_cast<std::uint64_t>(n) + W);
-  alignas(64) double u[kDims][W], share[W];
+// The same points W at a time through the lanes' paths (huang2022_lanes.h),
+// lane groups [first, end) of the ceil(n / W) groups (point i0 = W g starts
+// group g): deposit(exits, u) takes each group's exits (per unit share,
+// the lanes' number type) and coordinates (double). The last group's lanes
+// past point n - 1 carry weight 0 (their paths end at the entry).
+template <class Tracer, class Deposit>
+void integrate_lanes(const Tracer& tracer, long n, long first, long end, Deposit&& deposit) {
+  using B = typename Tracer::Batch;
+  using T = typename B::value_type;
+  constexpr int W = Tracer::kWidth;
+  Halton set(static_cast<std::uint64_t>(first) * W, n, static_cast<std::uint64_t>(n) + W);
+  alignas(64) double u[kDims][W];
+  alignas(64) T ut[kDims][W], share[W];
   B ub[kDims];
-  huang_lanes::Exits exits;
-  for (long i0 = 0; i0 < n; i0 += W) {
+  typename Tracer::Exits exits;
+  for (long i0 = first * W; i0 < end * W; i0 += W) {
     set.get_lanes<W>(u);
-    for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? base : 0.0;
-    for (int k = 0; k < kDims; ++k) ub[k] = B::load_aligned(u[k]);
+    for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? T(1) : T(0);
+    for (int k = 0; k < kDims; ++k) {
+      for (int l = 0; l < W; ++l) ut[k][l] = static_cast<T>(u[k][l]);
+      ub[k] = B::load_aligned(ut[k]);
+    }
     tracer.trace(ub, B::load_aligned(share), exits);
     deposit(exits, u);
   }
 }
 
+// The point set in kPointBlocks contiguous blocks of lane groups, block b's
+// exits handed to deposit(b, exits, u) for an accumulator of its own, which
+// the caller sums in block order afterwards: the same numbers for any number of threads, which the
+// atlas's bit-identity across threads, ranks and resumes needs. The blocks
+// run on OpenMP threads unless the caller is already in a parallel region
+// (compare's fits and predict_result run configurations in parallel; no
+// nested team then).
+constexpr int kPointBlocks = 16;
+template <class Tracer, class Deposit>
+void integrate_blocks(const Tracer& tracer, long n, Deposit&& deposit) {
+  const long groups = (n + Tracer::kWidth - 1) / Tracer::kWidth;
+#pragma omp parallel for schedule(dynamic) if (!omp_in_parallel())
+  for (int b = 0; b < kPointBlocks; ++b)
+    integrate_lanes(tracer, n, groups * b / kPointBlocks, groups * (b + 1) / kPointBlocks,
+                    [&](const auto& e, const auto* u) { deposit(b, e, u); });
+}
+
 // Bit l set where lane l of m is.
-unsigned lane_bits(const huang_lanes::M& m) {
-  using huang_lanes::B;
+template <class M>
+unsigned lane_bits(const M& m) {
 #if defined(__AVX512F__)
-  if constexpr (huang_lanes::kWidth == 8) return static_cast<unsigned>(static_cast<__mmask8>(m.data));
+  // AVX-512's masks are the bits themselves (8 doubles, 16 floats).
+  if constexpr (M::size == 8 || M::size == 16) return static_cast<unsigned>(m.data);
 #endif
-  alignas(64) double f[huang_lanes::kWidth];
+  using B = typename M::batch_type;
+  using T = typename B::value_type;
+  alignas(64) T f[M::size];
   xsimd::select(m, B(1.0), B(0.0)).store_aligned(f);
   unsigned bits = 0;
-  for (int l = 0; l < huang_lanes::kWidth; ++l) bits |= (f[l] != 0.0 ? 1u : 0u) << l;
+  for (std::size_t l = 0; l < M::size; ++l) bits |= (f[l] != 0 ? 1u : 0u) << l;
   return bits;
+}
+
+// The sum of a vector's lanes in double (float lanes' weights are summed in
+// double).
+template <class B>
+double sum_lanes(const B& x) {
+  alignas(64) typename B::value_type a[B::size];
+  x.store_aligned(a);
+  double s = 0.0;
+  for (std::size_t l = 0; l < B::size; ++l) s += static_cast<double>(a[l]);
+  return s;
 }
 
 // The residual's inclination for the point (u1, u2): a von Mises-Fisher
@@ -627,28 +667,33 @@ class BinSink : public Sink {
     for (int p = 0; p < kResidualP; ++p) scale_[p] = paths.scale(p);
   }
   void exit(int p, const Vec3& o, const double* w) override { deposit(p, inclination(o), azimuth(o) - phi_i_, w); }
-  // W points' exits and residuals (integrate_lanes). Each exit's bin as
-  // BinGrid::theta_bin / phi_bin would give it: the closed-form index per
-  // lane (xsimd's asin and atan2), and where a lane lies within 1e-9 of a
-  // bin's width of an edge, BinGrid's own rule on that lane's angles; each
-  // live lane deposited as exit() does.
-  void lanes(const huang_lanes::Exits& e, const double (*u)[huang_lanes::kWidth]) {
-    using huang_lanes::B;
-    using huang_lanes::M;
-    constexpr int W = huang_lanes::kWidth;
+  // W points' exits and residuals (integrate_lanes), each point's weight
+  // `share` times its Exits weight (summed in double). Each exit's bin as
+  // BinGrid::theta_bin / phi_bin gives it for the lane's angles: the
+  // closed-form index per lane (xsimd's asin and atan2, in the lanes'
+  // arithmetic), and where a lane lies within near_edge() of an edge,
+  // BinGrid's own rule on that lane's angles; each live lane deposited as
+  // exit() does.
+  template <class B>
+  void lanes(const huang_lanes::ExitsT<B>& e, const double (*u)[B::size], double share) {
+    using T = typename B::value_type;
+    using M = typename B::batch_bool_type;
+    constexpr int W = static_cast<int>(B::size);
     const int nt = grid_.n_theta(), np = grid_.n_phi();
     const bool uniform = grid_.theta_binning == ThetaBinning::Uniform;
-    alignas(64) double at[W], ai[W], aj[W], w[kMaxChannels][W];
-    // floor(g) clamped to [0, n - 1] into out; the lanes within 1e-9 of an integer.
-    auto index = [](const B& g, int n, double* out) {
+    alignas(64) T at[W], ai[W], aj[W], w[kMaxChannels][W];
+    // floor(g) clamped to [0, n - 1] into out (0 for a dead lane's NaN: its
+    // offset below is computed, not used); the lanes near an integer.
+    auto index = [](const B& g, int n, T* out) {
       const B f = xsimd::floor(g), r = g - f;
-      xsimd::min(B(n - 1.0), xsimd::max(B(0.0), f)).store_aligned(out);
-      return (r < B(1e-9)) | (r > B(1.0 - 1e-9));
+      xsimd::select(f >= B(0.0), xsimd::min(B(n - 1.0), f), B(0.0)).store_aligned(out);
+      const B tol(near_edge<T>(n));
+      return (r < tol) | (r > B(1.0) - tol);
     };
     for (int p = 0; p < kResidualP; ++p) {
       unsigned bits = lane_bits(e.live[p]);
       if (bits == 0) continue;
-      const huang_lanes::V3& o = e.dir[p];
+      const huang_lanes::V3T<B>& o = e.dir[p];
       const B x = xsimd::min(B(1.0), xsimd::max(B(-1.0), o.x));
       M near;
       if (uniform) {
@@ -662,38 +707,55 @@ class BinSink : public Sink {
       const B f = xsimd::atan2(o.z, o.y) - B(phi_i_);
       near = near | index((wrap(f) + B(kPi)) * B(np / kTwoPi), np, aj);
       unsigned settle = lane_bits(near);
-      alignas(64) double phi[W];
+      alignas(64) T phi[W];
       if (settle & bits) f.store_aligned(phi);
-      const double s = scale_[p];
-      for (int c = 0; c < C_; ++c) (B(s) * e.w[p][c]).store_aligned(w[c]);
+      // The lanes' weights in double and their bins' offsets in out_, for
+      // all lanes at once (vectorised loops), then the live lanes deposited.
+      const double s = scale_[p] * share;
+      alignas(64) double wd[kMaxChannels][W];
+      for (int c = 0; c < C_; ++c) {
+        e.w[p][c].store_aligned(w[c]);
+        for (int l = 0; l < W; ++l) wd[c][l] = s * static_cast<double>(w[c][l]);
+      }
       const int lobe = lobe_index(p, L_);
-      // The bins' offsets in out_ (exact in doubles).
-      alignas(64) double offset[W];
-      ((B(static_cast<double>(lobe) * nt) + B::load_aligned(ai)) * B(static_cast<double>(np) * C_) +
-       B::load_aligned(aj) * B(C_))
-          .store_aligned(offset);
+      alignas(64) std::int64_t offset[W];
+      const std::int64_t first = static_cast<std::int64_t>(lobe) * nt * np;
+      for (int l = 0; l < W; ++l)
+        offset[l] = (first + static_cast<std::int64_t>(ai[l]) * np + static_cast<std::int64_t>(aj[l])) * C_;
       for (; bits != 0; bits &= bits - 1) {
         const int l = std::countr_zero(bits);
-        double* b = settle >> l & 1 ? bin(lobe, grid_.theta_bin(uniform ? at[l] : std::asin(at[l])),
-                                         grid_.phi_bin(wrap_angle(phi[l])))
-                                    : &out_[static_cast<std::size_t>(offset[l])];
-        for (int c = 0; c < C_; ++c) b[c] += w[c][l];
+        double* b = &out_[static_cast<std::size_t>(offset[l])];
+        if (settle >> l & 1) {
+          const double angle = at[l];
+          b = bin(lobe, grid_.theta_bin(uniform ? angle : std::asin(angle)),
+                  grid_.phi_bin(wrap_angle(static_cast<double>(phi[l]))));
+        }
+        for (int c = 0; c < C_; ++c) b[c] += wd[c][l];
       }
     }
     if (v_ >= kMinExactResidualV) {
-      for (int c = 0; c < C_; ++c) residual_[c] += xsimd::hadd(e.residual[c]);
+      for (int c = 0; c < C_; ++c) residual_[c] += share * sum_lanes(e.residual[c]);
       return;
     }
     for (int c = 0; c < C_; ++c) e.residual[c].store_aligned(w[c]);
     for (int l = 0; l < W; ++l) {
       double wl[kMaxChannels];
-      for (int c = 0; c < C_; ++c) wl[c] = w[c][l];
+      for (int c = 0; c < C_; ++c) wl[c] = share * static_cast<double>(w[c][l]);
       residual(wl, u[7][l], u[8][l]);
     }
   }
+  // The distance to a bin edge, in bin widths, below which a lane's bin is
+  // settled by BinGrid's rule: for doubles, the ulps by which xsimd's asin
+  // and atan2 may differ from the C library's; for floats, the rounding of
+  // the index g = (angle - lowest edge) n / range itself (a few float ulps
+  // of g <= n).
+  template <class T>
+  static double near_edge(int n) {
+    return std::is_same_v<T, float> ? 1e-6 * (n + 8) : 1e-9;
+  }
   // wrap_angle() per lane: to [-pi, pi).
-  static huang_lanes::B wrap(const huang_lanes::B& a) {
-    using huang_lanes::B;
+  template <class B>
+  static B wrap(const B& a) {
     const B x = a + B(kPi);
     const B w = x - B(kTwoPi) * xsimd::floor(x * B(1.0 / kTwoPi)) - B(kPi);
     return xsimd::select(w >= B(kPi), B(-kPi), w);
@@ -709,6 +771,11 @@ class BinSink : public Sink {
   }
   void lost(bool, const double*) override {}
   void incident(double) override {}
+  // Adds another block's bins and residual (the same grid and model).
+  void add(const BinSink& other) {
+    for (std::size_t k = 0; k < out_.size(); ++k) out_[k] += other.out_[k];
+    for (std::size_t k = 0; k < residual_.size(); ++k) residual_[k] += other.residual_[k];
+  }
   // Spreads the residual (call once, after the points).
   void finish() {
     const int np = grid_.n_phi(), nt = grid_.n_theta();
@@ -749,6 +816,16 @@ class BinSink : public Sink {
   std::vector<double> residual_;  // per theta bin (sampled spread) or in row 0 (the total)
 };
 
+// to += from, term by term (the same model and channels).
+void add_energies(HuangEnergies& to, const HuangEnergies& from) {
+  for (std::size_t k = 0; k < to.lobe.size(); ++k) to.lobe[k] += from.lobe[k];
+  for (std::size_t c = 0; c < to.masked.size(); ++c) {
+    to.masked[c] += from.masked[c];
+    to.stopped[c] += from.stopped[c];
+  }
+  to.incident += from.incident;
+}
+
 class EnergySink : public Sink {
  public:
   EnergySink(const Paths& paths, HuangEnergies& e) : paths_(paths), e_(e), C_(paths.channels()) {
@@ -763,21 +840,24 @@ class EnergySink : public Sink {
     for (int c = 0; c < C_; ++c) (masked ? e_.masked : e_.stopped)[c] += w[c];
   }
   void incident(double w) override { e_.incident += w; }
-  // W points' paths (integrate_lanes): the same sums.
-  void lanes(const huang_lanes::Exits& x) {
-    for (int p = 0; p < kResidualP; ++p) add_lanes(p, x.w[p], paths_.scale(p));
-    add_lanes(kResidualP, x.residual, 1.0);
+  // W points' paths (integrate_lanes), each point's weight `share` times
+  // its Exits weight: the same sums, in double.
+  template <class B>
+  void lanes(const huang_lanes::ExitsT<B>& x, double share) {
+    for (int p = 0; p < kResidualP; ++p) add_lanes(p, x.w[p], paths_.scale(p) * share);
+    add_lanes(kResidualP, x.residual, share);
     for (int c = 0; c < C_; ++c) {
-      e_.masked[c] += xsimd::hadd(x.masked[c]);
-      e_.stopped[c] += xsimd::hadd(x.stopped[c]);
+      e_.masked[c] += share * sum_lanes(x.masked[c]);
+      e_.stopped[c] += share * sum_lanes(x.stopped[c]);
     }
-    e_.incident += xsimd::hadd(x.incident);
+    e_.incident += share * sum_lanes(x.incident);
   }
 
  private:
-  void add_lanes(int p, const huang_lanes::B* w, double s) {
+  template <class B>
+  void add_lanes(int p, const B* w, double s) {
     double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
-    for (int c = 0; c < C_; ++c) l[c] += s * xsimd::hadd(w[c]);
+    for (int c = 0; c < C_; ++c) l[c] += s * sum_lanes(w[c]);
   }
   void add(int p, const double* w, double s) {
     double* l = &e_.lobe[static_cast<std::size_t>(lobe_index(p, paths_.params().lobes)) * C_];
@@ -868,13 +948,23 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
   const Paths paths(params_, theta_i, phi_i);
   BinSink sink(paths, grid, theta_i, phi_i, out);
-  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
-    integrate(paths, params_.quadrature_points, sink);
-  } else {
-    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
-    integrate_lanes(tracer, params_.quadrature_points,
-                    [&](const huang_lanes::Exits& e, const double(*u)[huang_lanes::kWidth]) { sink.lanes(e, u); });
-  }
+  const long n = params_.quadrature_points;
+  auto run = [&](const auto& tracer) {
+    // Block 0 deposits into out (sink), block b > 0 into block_out[b - 1].
+    std::vector<std::vector<double>> block_out(kPointBlocks - 1, std::vector<double>(out.size(), 0.0));
+    std::deque<BinSink> sinks;
+    for (std::vector<double>& o : block_out) sinks.emplace_back(paths, grid, theta_i, phi_i, o);
+    integrate_blocks(tracer, n, [&](int b, const auto& e, const auto* u) {
+      (b == 0 ? sink : sinks[b - 1]).lanes(e, u, 1.0 / static_cast<double>(n));
+    });
+    for (const BinSink& s : sinks) sink.add(s);
+  };
+  if (paths_ == HuangPaths::Scalar || !huang_lanes::FloatTracer::supports(params_))
+    integrate(paths, n, sink);
+  else if (paths_ == HuangPaths::DoubleLanes)
+    run(huang_lanes::DoubleTracer(params_, theta_i, phi_i));
+  else
+    run(huang_lanes::FloatTracer(params_, theta_i, phi_i));
   sink.finish();
   return out;
 }
@@ -883,13 +973,23 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   HuangEnergies e;
   const Paths paths(params_, theta_i, phi_i);
   EnergySink sink(paths, e);
-  if (scalar_paths_ || !huang_lanes::Tracer::supports(params_)) {
-    integrate(paths, params_.quadrature_points, sink);
-  } else {
-    const huang_lanes::Tracer tracer(params_, theta_i, phi_i);
-    integrate_lanes(tracer, params_.quadrature_points,
-                    [&](const huang_lanes::Exits& x, const double(*)[huang_lanes::kWidth]) { sink.lanes(x); });
-  }
+  const long n = params_.quadrature_points;
+  auto run = [&](const auto& tracer) {
+    // Block 0 sums into e (sink), block b > 0 into block_e[b - 1].
+    std::vector<HuangEnergies> block_e(kPointBlocks - 1);
+    std::deque<EnergySink> sinks;
+    for (HuangEnergies& x : block_e) sinks.emplace_back(paths, x);
+    integrate_blocks(tracer, n, [&](int b, const auto& x, const auto*) {
+      (b == 0 ? sink : sinks[b - 1]).lanes(x, 1.0 / static_cast<double>(n));
+    });
+    for (const HuangEnergies& x : block_e) add_energies(e, x);
+  };
+  if (paths_ == HuangPaths::Scalar || !huang_lanes::FloatTracer::supports(params_))
+    integrate(paths, n, sink);
+  else if (paths_ == HuangPaths::DoubleLanes)
+    run(huang_lanes::DoubleTracer(params_, theta_i, phi_i));
+  else
+    run(huang_lanes::FloatTracer(params_, theta_i, phi_i));
   return e;
 }
 

@@ -127,9 +127,12 @@
 // the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
 // smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
 // `quadrature_points` (2^23 by default); bin_probabilities() and energies()
-// trace 8 points at a time in SIMD lanes (4 without AVX-512;
+// trace 16 points at a time in float SIMD lanes (8 without AVX-512;
 // huang2022_lanes.h, the same transport as the scalar paths that density()
-// uses). The quadrature error of R, TT and TRT falls about 4x per 4x
+// uses, in float arithmetic: ~1e-7 relative rounding per path, the weights
+// summed in double), in 16 fixed blocks of the point set run on OpenMP
+// threads (unless called inside a parallel region) and summed in block
+// order: the same bits for any number of threads. The quadrature error of R, TT and TRT falls about 4x per 4x
 // points (a push-forward of a fixed point set into bins converges like an
 // estimate from as many independent paths, a little better; the error
 // comes from the facet normals' coordinates, not from h: an
@@ -164,6 +167,9 @@ enum class HuangResidual { Sampler, CyclesEval };
 // eval() as shipped (its inner mesonormal cosine ratios, its exit-side
 // tests; see huang2022.cpp, Paths).
 enum class HuangForm { Paper, CyclesEval };
+
+// The evaluation of bin_probabilities() and energies() (Huang2022::set_paths).
+enum class HuangPaths { FloatLanes, DoubleLanes, Scalar };
 
 // The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
 // `--set` keys to these fields).
@@ -218,15 +224,15 @@ class Huang2022 : public Model {
   const Huang2022Params& params() const { return params_; }
   // Points of density()'s set for the interfaces before the last (tests).
   void set_density_points(long n) { density_points_ = n; }
-  // bin_probabilities() and energies() by the scalar paths (the ones
-  // density() uses) instead of the SIMD lanes' (huang2022_lanes.h): tests
-  // compare the two.
-  void set_scalar_paths(bool scalar) { scalar_paths_ = scalar; }
+  // Which paths bin_probabilities() and energies() take: the float SIMD
+  // lanes (the default), the same lanes in double, or the scalar paths that
+  // density() uses (huang2022_lanes.h): tests compare them.
+  void set_paths(HuangPaths paths) { paths_ = paths; }
 
  private:
   Huang2022Params params_;
   long density_points_ = 1L << 16;
-  bool scalar_paths_ = false;
+  HuangPaths paths_ = HuangPaths::FloatLanes;
 };
 
 std::unique_ptr<Model> make_huang2022(const Huang2022Params& params);

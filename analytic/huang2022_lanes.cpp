@@ -11,39 +11,52 @@ namespace fiberlab::analytic::huang_lanes {
 
 namespace {
 
-V3 operator+(const V3& a, const V3& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-V3 operator-(const V3& a, const V3& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
-V3 operator-(const V3& a) { return {-a.x, -a.y, -a.z}; }
-V3 operator*(const B& s, const V3& a) { return {s * a.x, s * a.y, s * a.z}; }
-B dot(const V3& a, const V3& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
-V3 cross(const V3& a, const V3& b) {
+template <class B>
+V3T<B> operator+(const V3T<B>& a, const V3T<B>& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+template <class B>
+V3T<B> operator-(const V3T<B>& a, const V3T<B>& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+template <class B>
+V3T<B> operator-(const V3T<B>& a) { return {-a.x, -a.y, -a.z}; }
+template <class B>
+V3T<B> operator*(const B& s, const V3T<B>& a) { return {s * a.x, s * a.y, s * a.z}; }
+template <class B>
+B dot(const V3T<B>& a, const V3T<B>& b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+template <class B>
+V3T<B> cross(const V3T<B>& a, const V3T<B>& b) {
   return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
 }
-V3 normalized(const V3& a) { return (B(1.0) / xsimd::sqrt(dot(a, a))) * a; }
-V3 reflect(const V3& d, const V3& m) { return d - (B(2.0) * dot(d, m)) * m; }
-B zero_unless(const M& m, const B& x) { return xsimd::select(m, x, B(0.0)); }
+template <class B>
+V3T<B> normalized(const V3T<B>& a) { return (B(1.0) / xsimd::sqrt(dot(a, a))) * a; }
+template <class B>
+V3T<B> reflect(const V3T<B>& d, const V3T<B>& m) { return d - (B(2.0) * dot(d, m)) * m; }
+template <class B>
+B zero_unless(const typename B::batch_bool_type& m, const B& x) { return xsimd::select(m, x, B(0.0)); }
 
 // Snell about m for a travel direction d with d.m = -cos_i < 0, given the
 // refraction cosine cos_t (fresnel_reflectance's) and 1 / eta_rel.
-V3 refract(const V3& d, const V3& m, const B& cos_i, const B& cos_t, double inv_eta_rel) {
-  return B(inv_eta_rel) * d + (cos_i * inv_eta_rel - cos_t) * m;
+template <class B>
+V3T<B> refract(const V3T<B>& d, const V3T<B>& m, const B& cos_i, const B& cos_t, double inv_eta_rel) {
+  return B(inv_eta_rel) * d + (cos_i * B(inv_eta_rel) - cos_t) * m;
 }
 
 // Adds x to acc where m (per channel).
-void add_where(B* acc, const M& m, const B* x, int C) {
+template <class B>
+void add_where(B* acc, const typename B::batch_bool_type& m, const B* x, int C) {
   for (int c = 0; c < C; ++c) acc[c] += zero_unless(m, x[c]);
 }
 
 }  // namespace
 
-bool Tracer::supports(const Huang2022Params& p) {
+template <class B>
+bool TracerT<B>::supports(const Huang2022Params& p) {
   // Every field of Huang2022Params that changes the transport: the form, the
   // masking, the flux, the residual (each value), tilt, eccentricity, roughness,
   // sigma_a (up to kMaxChannels), lobe_scale (the TRT gate).
   return static_cast<int>(p.sigma_a.size()) <= kMaxChannels;
 }
 
-Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
+template <class B>
+TracerT<B>::TracerT(const Huang2022Params& p, double theta_i, double phi_i)
     : eta_(p.eta), inv_eta_(1.0 / p.eta), alpha_(p.roughness), ct_(std::cos(p.tilt)), st_(std::sin(p.tilt)),
       C_(static_cast<int>(p.sigma_a.size())), masking_(p.masking), mesonormal_flux_(p.mesonormal_flux),
       cycles_residual_(p.residual == HuangResidual::CyclesEval),
@@ -66,7 +79,8 @@ Tracer::Tracer(const Huang2022Params& p, double theta_i, double phi_i)
   cycles_scale_ = 2.0 / (std::cos(theta_i) * width);
 }
 
-inline Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
+template <class B>
+inline typename TracerT<B>::Hit TracerT<B>::hit(const B& pv, const B& pw) const {
   Hit h{pv, pw, normalized(V3{B(0.0), pv * irv2_, pw * irw2_}), V3{}};
   h.ns = V3{B(-st_), B(ct_) * h.n0.y, B(ct_) * h.n0.z};
   return h;
@@ -75,13 +89,15 @@ inline Tracer::Hit Tracer::hit(const B& pv, const B& pw) const {
 // Smith's Lambda (Surface::lambda) through 1 + 2 Lambda = q / c with
 // q = sqrt(c^2 + alpha^2 (1 - c^2)), c = min(1, |cos|), so that each
 // masking factor below takes one division.
-inline B Tracer::lambda_root(const B& c) const {
+template <class B>
+inline B TracerT<B>::lambda_root(const B& c) const {
   return xsimd::sqrt(c * c + B(alpha_ * alpha_) * (B(1.0) - c * c));
 }
 
 // Surface::leaving: separable G1(o) = 1 / (1 + L_o) = 2 c_o / (c_o + q_o);
 // correlated (1 + L_i) / (1 + L_i + L_o) = c_o (c_i + q_i) / (q_i c_o + q_o c_i).
-inline B Tracer::leaving(const B& cos_in, const B& cos_out) const {
+template <class B>
+inline B TracerT<B>::leaving(const B& cos_in, const B& cos_out) const {
   if (masking_ == HuangMasking::None || alpha_ == 0.0) return B(1.0);
   const B co = xsimd::min(B(1.0), xsimd::abs(cos_out)), qo = lambda_root(co);
   if (masking_ == HuangMasking::Separable) return B(2.0) * co / (co + qo);
@@ -95,7 +111,8 @@ inline B Tracer::leaving(const B& cos_in, const B& cos_out) const {
 // ns = (-sin tilt, cos tilt n0) and n0 _|_ u, u - (u.nf) nf normalised is
 // x = (cos tilt, sin tilt n0) and nf x x = side (0, n0_w, -n0_v): no
 // square root.
-inline V3 Tracer::normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const {
+template <class B>
+inline typename TracerT<B>::V3 TracerT<B>::normal(const Hit& h, double side, const V3& w, const B& u1, const B& u2) const {
   const V3 nf = B(side) * h.ns;
   if (alpha_ == 0.0) return nf;
   const B a(alpha_);
@@ -117,7 +134,8 @@ inline V3 Tracer::normal(const Hit& h, double side, const V3& w, const B& u1, co
   return ml.x * x + ml.y * y + ml.z * nf;
 }
 
-void Tracer::trace(const B* u, const B& base, Exits& out) const {
+template <class B>
+void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
   for (int c = 0; c < C_; ++c) {
     out.residual[c] = out.masked[c] = out.stopped[c] = B(0.0);
     for (int p = 0; p < 3; ++p) out.w[p][c] = B(0.0);
@@ -131,7 +149,8 @@ void Tracer::trace(const B* u, const B& base, Exits& out) const {
   const Hit h = hit(B(rv_) * (-sg * gw_ - cg * gv_), B(rw_) * (sg * gv_ - cg * gw_));
   const V3 wi{B(wi_[0]), B(wi_[1]), B(wi_[2])};
   const B macro = dot(wi, h.n0), meso = dot(wi, h.ns);
-  B w0 = base * B(0.5 * kPi) * cg;
+  // (cos g >= 0: a float g can round past pi / 2.)
+  B w0 = base * B(0.5 * kPi) * xsimd::max(B(0.0), cg);
   if (mesonormal_flux_) w0 = w0 * xsimd::max(B(0.0), meso) / macro;
   out.incident = w0;
   M alive = (macro > B(0.0)) & (w0 != B(0.0));
@@ -190,7 +209,8 @@ void Tracer::trace(const B* u, const B& base, Exits& out) const {
 // the exit of order k and the internal reflection; after interface 3 the
 // residual (Cycles' sampler's geometric series, or with residual=cycles_eval
 // Cycles' eval()'s at interface 2 and nothing from interface 3).
-void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_in, const B* w_in,
+template <class B>
+void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_in, const B* w_in,
                     const B& t1, const B& cycles_weight, Exits& out) const {
   const int C = C_;
   M alive = alive_in;
@@ -260,7 +280,7 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
       const B t_avg = xsimd::max(B(1.0) - F, B(1e-5));
       for (int c = 0; c < C; ++c)
         out.residual[c] += zero_unless(
-            alive, cycles_weight * t1 * F * F * t_avg * a[c] * a[c] * a[c] / (B(1.0) - a[c] * (B(1.0) - t_avg)));
+            alive, cycles_weight * t1 * F * F * t_avg * a[c] * a[c] * a[c] / ((B(1.0) - a[c]) + a[c] * t_avg));
     }
     const V3 r = reflect(d, m);
     const B on = -dot(r, at.ns), om = -dot(r, at.n0);
@@ -279,7 +299,9 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
       const B t_avg = xsimd::max(B(1e-5), B(0.5) * (t2 + (B(1.0) - F)));
       for (int c = 0; c < C; ++c) {
         const B a_avg = sigma_[c] == 0.0 ? B(1.0) : xsimd::sqrt(a1[c] * a[c]);
-        out.residual[c] += zero_unless(alive, w[c] * a_avg * t_avg / (B(1.0) - a_avg * (B(1.0) - t_avg)));
+        // 1 - A (1 - T) as (1 - A) + A T (Paths::inside): exact for white
+        // fibers as T -> 1e-5, where float's 1 - (1 - T) loses ~1e-3.
+        out.residual[c] += zero_unless(alive, w[c] * a_avg * t_avg / ((B(1.0) - a_avg) + a_avg * t_avg));
       }
       return;
     }
@@ -289,5 +311,8 @@ void Tracer::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_
     if (!xsimd::any(alive)) return;
   }
 }
+
+template class TracerT<xsimd::batch<float>>;
+template class TracerT<xsimd::batch<double>>;
 
 }  // namespace fiberlab::analytic::huang_lanes

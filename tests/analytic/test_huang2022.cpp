@@ -149,9 +149,14 @@ TEST(Huang2022, SmoothLimitPhiBinsAreTheExactCylinders) {
 // loss is `stopped` (paths leaving on the wrong side of a normal), which is
 // small and vanishes with the roughness; with the masking on, the loss
 // grows with the roughness (the paper's G1: energy <= 1).
+// The identity holds to double rounding (1e-11) in the double lanes; the
+// float lanes (the quadrature's default, huang2022_lanes.h) round each
+// path's split by ~1e-7 relative, which averages over the 2^16 paths to
+// well below 1e-9 (measured 1.4e-11).
 // Mutations caught: refraction weight F instead of 1 - F (ledger off);
 // eta instead of 1/eta at the inner interfaces.
 TEST(Huang2022, WhiteFurnaceLosesOnlyToMaskingAndStoppedPaths) {
+  for (HuangPaths paths : {HuangPaths::DoubleLanes, HuangPaths::FloatLanes})
   for (double e : {1.0, 0.7}) {
     double previous_loss = 0.0;
     for (double alpha : {0.05, 0.2, 0.5}) {
@@ -159,10 +164,13 @@ TEST(Huang2022, WhiteFurnaceLosesOnlyToMaskingAndStoppedPaths) {
         Huang2022Params p = fiber(alpha);
         p.eccentricity = e;
         p.masking = mk;
-        const HuangEnergies en = Huang2022(p).energies(deg_to_rad(40.0), deg_to_rad(30.0));
+        Huang2022 model(p);
+        model.set_paths(paths);
+        const HuangEnergies en = model.energies(deg_to_rad(40.0), deg_to_rad(30.0));
         const double out = sum(en.lobe);
-        EXPECT_NEAR(en.incident, 1.0, 1e-9);
-        EXPECT_NEAR(out + en.masked[0] + en.stopped[0], en.incident, 1e-11) << e << " " << alpha;
+        const bool doubles = paths == HuangPaths::DoubleLanes;
+        EXPECT_NEAR(en.incident, 1.0, doubles ? 1e-9 : 1e-7);
+        EXPECT_NEAR(out + en.masked[0] + en.stopped[0], en.incident, doubles ? 1e-11 : 1e-9) << e << " " << alpha;
         EXPECT_LE(out, 1.0);
         if (mk == HuangMasking::None) {
           EXPECT_EQ(en.masked[0], 0.0);
@@ -186,9 +194,10 @@ TEST(Huang2022, MesonormalFluxIsCosTiltAtNormalIncidence) {
   for (double tilt_deg : {3.0, 10.0}) {
     Huang2022Params p = fiber(0.2);
     p.tilt = deg_to_rad(tilt_deg);
-    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, std::cos(p.tilt), 2e-9);
+    // The float lanes' flux sums to ~1e-7 relative (measured 2.4e-8).
+    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, std::cos(p.tilt), 1e-7);
     p.mesonormal_flux = false;
-    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, 1.0, 1e-9);
+    EXPECT_NEAR(Huang2022(p).energies(0.0, 0.0).incident, 1.0, 1e-7);
   }
 }
 

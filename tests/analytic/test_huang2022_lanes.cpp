@@ -1,6 +1,6 @@
-// huang2022's SIMD paths (analytic/huang2022_lanes.h) against its scalar
-// paths (huang2022.cpp's Paths, the ones density() uses): the same point set
-// through both must give the same lobe energies, losses and bins up to
+// huang2022's SIMD paths (analytic/huang2022_lanes.h) in double against its
+// scalar paths (huang2022.cpp's Paths, the ones density() uses): the same
+// point set through both must give the same lobe energies, losses and bins up to
 // rounding, in every mode of the model (roughness 0 and > 0, each masking,
 // both fluxes, both residuals, tilt, ellipse, absorbing channels, 2 to 4
 // lobes, a point count that is not a multiple of the lane width,
@@ -12,6 +12,8 @@
 // residual; the residual's A_avg = A_1 A_2 without the square root; the last
 // lane group's padding points given weight.
 #include <gtest/gtest.h>
+
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -95,7 +97,8 @@ void expect_close(const std::vector<double>& a, const std::vector<double>& b, do
 TEST(Huang2022, LanesEqualTheScalarPathsInEnergy) {
   for (const Case& k : cases()) {
     Huang2022 lanes(k.p), scalar(k.p);
-    scalar.set_scalar_paths(true);
+    lanes.set_paths(HuangPaths::DoubleLanes);
+    scalar.set_paths(HuangPaths::Scalar);
     const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
     const HuangEnergies a = lanes.energies(ti, pi), b = scalar.energies(ti, pi);
     expect_close(a.lobe, b.lobe, 1e-12, k.name + " lobe");
@@ -114,9 +117,78 @@ TEST(Huang2022, LanesEqualTheScalarPathsInBins) {
        {BinGrid::make(24, 36, ThetaBinning::Uniform), BinGrid::make(17, 35, ThetaBinning::EqualArea)})
     for (const Case& k : cases()) {
       Huang2022 lanes(k.p), scalar(k.p);
-      scalar.set_scalar_paths(true);
+      lanes.set_paths(HuangPaths::DoubleLanes);
+      scalar.set_paths(HuangPaths::Scalar);
       const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
       expect_close(lanes.bin_probabilities(g, ti, pi), scalar.bin_probabilities(g, ti, pi), 1e-13,
                    k.name + " " + std::to_string(g.n_theta()));
     }
+}
+
+// The quadrature's points run in a fixed number of blocks summed in block
+// order: 1, 2 or 3 threads give the same bits (the atlas's bit-identity
+// across threads, ranks and resumes rests on it). Mutation caught: the
+// blocks summed as their threads finish (a per-thread accumulator).
+TEST(Huang2022, BinsAndEnergiesAreTheSameOnAnyNumberOfThreads) {
+  const int threads = omp_get_max_threads();
+  const BinGrid g = BinGrid::make(18, 36, ThetaBinning::Uniform);
+  for (const Case& k : cases()) {
+    const Huang2022 model(k.p);
+    const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
+    omp_set_num_threads(1);
+    const std::vector<double> bins1 = model.bin_probabilities(g, ti, pi);
+    const HuangEnergies e1 = model.energies(ti, pi);
+    for (int n : {2, 3}) {
+      omp_set_num_threads(n);
+      EXPECT_EQ(model.bin_probabilities(g, ti, pi), bins1) << k.name << ", " << n << " threads";
+      const HuangEnergies en = model.energies(ti, pi);
+      EXPECT_EQ(en.lobe, e1.lobe) << k.name << ", " << n << " threads";
+      EXPECT_EQ(en.masked, e1.masked) << k.name;
+      EXPECT_EQ(en.stopped, e1.stopped) << k.name;
+      EXPECT_EQ(en.incident, e1.incident) << k.name;
+    }
+  }
+  omp_set_num_threads(threads);
+}
+
+// The float lanes (the quadrature's) against the double lanes on the same
+// points. Float arithmetic rounds each path's weight and exit direction by
+// a few 1e-7 relative; the quadrature's own error is ~1e-3 of a lobe at
+// 2^18 points and 0.1 standard error of the atlas's bins at its default
+// (analytic/huang2022.h). Per lobe and channel the energies must agree to
+// 1e-5 relative (measured up to 3.1e-6: cycles_eval's residual, whose
+// 1 - R2 cancels in float as R2 -> 1) and the bins to 1e-4 of the lobe's
+// energy in L1 (measured up to 1.7e-5: exits within float rounding of a bin
+// edge, ~1e-7 rad, land in the neighbouring bin). The theta grid has 25 bins
+// so that no case's specular cone theta_r = -theta_i is a bin edge (a
+// smooth fiber puts its whole R lobe on that cone, where rounding alone
+// decides the bin, in double as in float). Mutation caught: the residual's
+// denominator as 1 - A (1 - T) in the float lanes (1.1e-3 on white fibers).
+TEST(Huang2022, FloatLanesAreTheDoubleLanesToRounding) {
+  const BinGrid g = BinGrid::make(25, 36, ThetaBinning::Uniform);
+  for (Case k : cases()) {
+    k.p.quadrature_points = 1 << 18;
+    Huang2022 f(k.p), d(k.p);
+    d.set_paths(HuangPaths::DoubleLanes);
+    const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
+    const HuangEnergies ef = f.energies(ti, pi), ed = d.energies(ti, pi);
+    const std::vector<double> bf = f.bin_probabilities(g, ti, pi), bd = d.bin_probabilities(g, ti, pi);
+    const int C = static_cast<int>(k.p.sigma_a.size()), L = k.p.lobes;
+    const std::size_t per_lobe = static_cast<std::size_t>(g.n_theta()) * g.n_phi() * C;
+    for (int l = 0; l < L; ++l)
+      for (int c = 0; c < C; ++c) {
+        const double x = ed.lobe[l * C + c];
+        if (x < 1e-6) continue;
+        double l1 = 0.0;
+        for (std::size_t b = l * per_lobe + c; b < (l + 1) * per_lobe; b += C) l1 += std::abs(bf[b] - bd[b]);
+        std::printf("%s, lobe %d channel %d: energy %.2g, bins (L1) %.2g relative\n", k.name.c_str(), l, c,
+                    std::abs(ef.lobe[l * C + c] - x) / x, l1 / x);
+        EXPECT_NEAR(ef.lobe[l * C + c], x, 1e-5 * x) << k.name << " lobe " << l << " channel " << c;
+        EXPECT_LT(l1, 1e-4 * x) << k.name << " lobe " << l << " channel " << c;
+      }
+    for (int c = 0; c < C; ++c) {
+      EXPECT_NEAR(ef.masked[c], ed.masked[c], 1e-6) << k.name;
+      EXPECT_NEAR(ef.stopped[c], ed.stopped[c], 1e-6) << k.name;
+    }
+  }
 }
