@@ -85,6 +85,11 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
   return xsimd::select(w >= Batch(kPi), Batch(-kPi), w);
 }
 
+// How many rows ahead of the one being scored expected-value scoring asks
+// for a row's tally cells: about as many cache lines in flight as a core
+// keeps, each arriving before its row is reached.
+constexpr int kRowsAhead = 16;
+
 }  // namespace
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
@@ -165,8 +170,11 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     const int lobe = f.scattered[i] ? last_lobe_ + 1 : std::min(f.segments[i], last_lobe_);
     bin[i] = tally.bin_index(lobe, static_cast<int>(theta_bin[i]),
                              static_cast<int>(phi_bin[i]));
-    tally.prefetch(bin[i]);
+    // (Expected-value rows are fetched a few rows ahead as they are scored:
+    // a block of them holds twice the analog estimator's rows, too many to
+    // have in flight at once.)
     if (expected_value_) lobe_[i] = lobe;
+    else tally.prefetch(bin[i]);
   }
   if (expected_value_) {
     score_rows_expected_value(f, bin, tally);
@@ -208,8 +216,12 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   const int channels = static_cast<int>(sigma_a_.size());
   double* weight = one_photon_.data();
   reserve_slots(f);
+  for (int i = 0; i < std::min(kRowsAhead, f.n); ++i)
+    if (f.exited[i]) tally.prefetch_all(bin[i], lobe_[i]);
   std::size_t j = 0;  // the next of f.losses (in row order)
   for (int i = 0; i < f.n; ++i) {
+    const int ahead = i + kRowsAhead;
+    if (ahead < f.n && f.exited[ahead]) tally.prefetch_all(bin[ahead], lobe_[ahead]);
     const std::uint32_t slot = f.slot[i];
     if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
     if (f.exited[i]) {
