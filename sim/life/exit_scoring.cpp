@@ -116,13 +116,16 @@ void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, s
     settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges, theta_closed_form_)
         .store_aligned(theta_bin + i);
     Batch::batch_bool_type in_range;
-    const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
+    const Batch relative = Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i);
+    const Batch phi = wrapped(relative, in_range);
     settled_bin(phi, uniform_fraction(phi, kPi, kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
         .store_aligned(phi_bin + i);
-    // Lanes out of the vector wrap's range take the scalar one. Photons that
-    // did not exit (truncated) have no direction (NaN): their bins are never
-    // read, and a NaN must not reach phi_bin's conversion to int.
-    if (!xsimd::all(in_range))
+    // Lanes out of the vector wrap's range take the scalar one. Rows that
+    // did not exit may have no direction (NaN: a truncated photon, an
+    // expected-value row of Russian roulette alone): their bins are never
+    // read, settled_bin gives them 0 as it does their theta, and a NaN must
+    // not reach phi_bin's conversion to int.
+    if (!xsimd::all(in_range | xsimd::isnan(relative)))
       for (int k = i; k < std::min(i + W, f.n); ++k)
         phi_bin[k] = f.exited[k] ? grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k])) : 0;
   }
@@ -216,12 +219,10 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   const int channels = static_cast<int>(sigma_a_.size());
   double* weight = one_photon_.data();
   reserve_slots(f);
-  for (int i = 0; i < std::min(kRowsAhead, f.n); ++i)
-    if (f.exited[i]) tally.prefetch_all(bin[i], lobe_[i]);
+  for (int i = 0; i < std::min(kRowsAhead, f.n); ++i) prefetch_row(f, i, bin, tally);
   std::size_t j = 0;  // the next of f.losses (in row order)
   for (int i = 0; i < f.n; ++i) {
-    const int ahead = i + kRowsAhead;
-    if (ahead < f.n && f.exited[ahead]) tally.prefetch_all(bin[ahead], lobe_[ahead]);
+    if (i + kRowsAhead < f.n) prefetch_row(f, i + kRowsAhead, bin, tally);
     const std::uint32_t slot = f.slot[i];
     if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
     if (f.exited[i]) {
@@ -244,6 +245,24 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
     }
     end_photon(slot);
   }
+}
+
+// Asks for what scoring row i reads and writes: its tally cells (an exit)
+// and its photon's numbers so far (the block's stream of cells evicts them
+// from the first-level cache between a photon's rows).
+[[gnu::always_inline]] inline void ExitScorer::prefetch_row(const FinishedPhotons& f, int i,
+                                                          const std::size_t* bin,
+                                                          const Tally& tally) const {
+  const std::size_t at = static_cast<std::size_t>(f.slot[i]) * sigma_a_.size();
+  __builtin_prefetch(booked_.data() + at, 1);
+  __builtin_prefetch(created_.data() + at);
+  if (!f.exited[i]) return;
+  tally.prefetch_all(bin[i], lobe_[i]);
+  const Run& run = runs_[f.slot[i]];
+  __builtin_prefetch(&run, 1);
+  __builtin_prefetch(lobe_total_.data() + at, 1);
+  __builtin_prefetch(run.bins.data(), 1);
+  __builtin_prefetch(run.totals.data(), 1);
 }
 
 // Room for every slot the block uses (once: slots are the tracer's, a
@@ -276,7 +295,8 @@ void ExitScorer::end_photon(std::uint32_t slot) {
 // leave the ledger's absorbed (the complement) a few units below 0. More
 // than rounding (Tally::kRoundingAllowance) is a booking error: an internal
 // error, never clamped.
-void ExitScorer::book(const double* weight, std::size_t stride, std::uint32_t slot) {
+[[gnu::always_inline]] inline void ExitScorer::book(const double* weight, std::size_t stride,
+                                                    std::uint32_t slot) {
   const std::size_t channels = sigma_a_.size(), at = slot * channels;
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
