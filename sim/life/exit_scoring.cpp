@@ -226,9 +226,11 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
     const std::uint32_t slot = f.slot[i];
     if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
     if (f.exited[i]) {
-      score_scored_exit(f, i, bin[i], tally);
+      // (The common three channels unrolled, their numbers in registers.)
+      if (channels == 3) score_scored_exit<3>(f, i, bin[i], tally);
+      else score_scored_exit<0>(f, i, bin[i], tally);
     } else if (f.last[i] && !f.lost[i] && !f.ended[i]) {
-      book(weights_.data() + i, kCap, slot);
+      book(weights_.data() + i, kCap, slot, fixed_.data());
       tally.score_truncated_fixed(fixed_.data());
     }
     if (!f.last[i]) continue;
@@ -295,9 +297,10 @@ void ExitScorer::end_photon(std::uint32_t slot) {
 // leave the ledger's absorbed (the complement) a few units below 0. More
 // than rounding (Tally::kRoundingAllowance) is a booking error: an internal
 // error, never clamped.
+template <int kChannels>
 [[gnu::always_inline]] inline void ExitScorer::book(const double* weight, std::size_t stride,
-                                                    std::uint32_t slot) {
-  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+                                                    std::uint32_t slot, Tally::Fixed* fixed) {
+  const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
     const Tally::Fixed room = Tally::kOne + created_[at + c] - booked_[at + c];
@@ -308,7 +311,7 @@ void ExitScorer::end_photon(std::uint32_t slot) {
       w = room;
     }
     booked_[at + c] += w;
-    fixed_[c] = w;
+    fixed[c] = w;
   }
 }
 
@@ -327,7 +330,7 @@ void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
       created_[at + c] += fixed_[c];
     }
   } else {
-    book(growth_.data(), 1, f.slot[i]);
+    book(growth_.data(), 1, f.slot[i], fixed_.data());
     for (std::size_t c = 0; c < channels; ++c) fixed_[c] = -fixed_[c];
   }
   tally.score_roulette_fixed(fixed_.data());
@@ -336,12 +339,21 @@ void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
 // Row i's exit in `bin`: the bin's S2 grows by (t + w)^2 - t^2 = w (2 t + w)
 // with t the photon's total in the bin so far, so that it ends with the
 // square of the photon's total (SPEC section 6); the lobe's likewise.
+// kChannels: the number of channels, or 0 for sigma_a's (any number).
+template <int kChannels>
 void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally) {
   constexpr int kCap = FinishedPhotons::kCapacity;
   const std::uint32_t slot = f.slot[i];
-  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   const double* weight = weights_.data() + i;
-  book(weight, kCap, slot);
+  // One row's numbers: fixed, growth and lobe_growth (channels of them).
+  constexpr std::size_t kLocal = kChannels > 0 ? kChannels : 1;
+  Tally::Fixed fixed_local[kLocal];
+  double growth_local[kLocal], lobe_growth_local[kLocal];
+  Tally::Fixed* fixed = kChannels > 0 ? fixed_local : fixed_.data();
+  double* growth = kChannels > 0 ? growth_local : growth_.data();
+  double* lobe_growth = kChannels > 0 ? lobe_growth_local : lobe_growth_.data();
+  book<kChannels>(weight, kCap, slot, fixed);
   Run& run = runs_[slot];
   double* lobe_total = lobe_total_.data() + at;
   // (A new lobe's total starts from 0 without being stored first: a store
@@ -355,7 +367,7 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
     const double t = new_lobe ? 0.0 : lobe_total[c];
-    lobe_growth_[c] = w * (2.0 * t + w);
+    lobe_growth[c] = w * (2.0 * t + w);
     lobe_total[c] = t + w;
   }
   for (std::size_t e = 0; e < run.bins.size(); ++e) {
@@ -363,19 +375,19 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
     double* total = run.totals.data() + e * channels;
     for (std::size_t c = 0; c < channels; ++c) {
       const double w = weight[c * kCap];
-      growth_[c] = w * (2.0 * total[c] + w);
+      growth[c] = w * (2.0 * total[c] + w);
       total[c] += w;
     }
-    tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), false);
+    tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, false);
     return;
   }
   run.bins.push_back(bin);
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
-    growth_[c] = w * w;
+    growth[c] = w * w;
     run.totals.push_back(w);
   }
-  tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), true);
+  tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, true);
 }
 
 }  // namespace fiberlab::sim

@@ -65,7 +65,9 @@ class ExitScorer {
   std::vector<double> growth_;        // [channel]: one row's bin S2 growth
   std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
   void reserve_slots(const FinishedPhotons& f);
-  void book(const double* weight, std::size_t stride, std::uint32_t slot);
+  template <int kChannels = 0>
+  void book(const double* weight, std::size_t stride, std::uint32_t slot, Tally::Fixed* fixed);
+  template <int kChannels>
   void score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally);
   void score_roulette(const FinishedPhotons& f, int i, Tally& tally);
   void end_photon(std::uint32_t slot);

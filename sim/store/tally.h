@@ -69,15 +69,18 @@ class Tally {
   // error needs the sum over photons of the square of its total there, not
   // the sum of its bins' S2; the analog estimator books none: there each
   // photon leaves once and the lobe's S2 is its bins' S2).
+  // kChannels: channels(), when the caller knows it at compile time (0: not).
+  template <int kChannels = 0>
   void score_exit_fixed(std::size_t bin, int lobe_of_bin, const Fixed* s1, const double* s2_growth,
                         const double* lobe_growth, bool first) {
+    const int channels = kChannels > 0 ? kChannels : channels_;
     touched_[bin / kPageBins] = 1;
-    Fixed* cell = cells() + bin * block();
+    Fixed* cell = cells() + bin * (2 * static_cast<std::size_t>(channels) + 1);
     cell[0] += first ? 1 : 0;
-    Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels_;
-    for (int c = 0; c < channels_; ++c) {
+    Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels;
+    for (int c = 0; c < channels; ++c) {
       cell[1 + c] += s1[c];
-      cell[1 + channels_ + c] += to_fixed(s2_growth[c]);
+      cell[1 + channels + c] += to_fixed(s2_growth[c]);
       lobe[c] += to_fixed(lobe_growth[c]);
     }
   }
