@@ -86,8 +86,9 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
 }
 
 // How many rows ahead of the one being scored expected-value scoring asks
-// for a row's tally cells: about as many cache lines in flight as a core
-// keeps, each arriving before its row is reached.
+// for a row's tally cells and photon numbers: far enough that they arrive
+// before the row is reached (a row takes tens of nanoseconds), near enough
+// that the first-level cache still holds them then.
 constexpr int kRowsAhead = 16;
 
 }  // namespace

@@ -75,7 +75,7 @@ class Tally {
                         const double* lobe_growth, bool first) {
     const int channels = kChannels > 0 ? kChannels : channels_;
     touched_[bin / kPageBins] = 1;
-    Fixed* cell = cells() + bin * (2 * static_cast<std::size_t>(channels) + 1);
+    Fixed* cell = cells() + bin * block_of(channels);
     cell[0] += first ? 1 : 0;
     Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels;
     for (int c = 0; c < channels; ++c) {
@@ -115,8 +115,8 @@ class Tally {
   // The same for every cache line of the bin's cells (a 3-channel bin is
   // 112 bytes: half of them straddle three lines, whose middle one the two
   // ends miss) and of its lobe's sum of squares (score_exit_fixed).
-  // Always inline: out of line, GCC 12 finds it free of side effects and
-  // drops the call.
+  // Always inline: GCC 12 removes an out-of-line call to it (prefetches are
+  // no effect it counts).
   [[gnu::always_inline]] void prefetch_all(std::size_t bin, int lobe_of_bin) const {
     const char* first = reinterpret_cast<const char*>(cells() + bin * block());
     const char* last = reinterpret_cast<const char*>(cells() + (bin + 1) * block()) - 1;
@@ -185,7 +185,8 @@ class Tally {
   static std::vector<double> to_double(const std::vector<Fixed>& v);
   // One bin's numbers sit together (count, S1 per channel, S2 per channel) so
   // that scoring a photon touches one or two cache lines, not three arrays.
-  std::size_t block() const { return 2 * static_cast<std::size_t>(channels_) + 1; }
+  static constexpr std::size_t block_of(int channels) { return 2 * static_cast<std::size_t>(channels) + 1; }
+  std::size_t block() const { return block_of(channels_); }
   std::vector<double> column(int offset) const;  // S1 (offset 1) or S2 (1 + C)
   void copy_lobe(int l, std::uint64_t* count, ExactTally::Word* s1, ExactTally::Word* s2) const;
 
