@@ -11,7 +11,8 @@
 //  (k) the same with `beckmann` alpha 0.19;
 //  (m) case c's geometry, white, `ggx` alpha 0.3 with `masking: smith_g1`.
 // One thread, so the rate is per core. Counters: photons/s, interface events
-// and candidate normals per photon. `trace` is the batched SIMD tracer that
+// and candidate normals per photon. `trace_expected_value` runs b and c with
+// `estimator: expected_value` (docs/PHYSICS.md "Estimator"), scoring included. `trace` is the batched SIMD tracer that
 // `fiberlab run` uses for unpolarised light (binning and tally included);
 // `trace_reference` the scalar reference tracer (tracing only).
 //
@@ -76,8 +77,11 @@ Settings bench_case(char which) {
 // call ends with its lane pool draining; `run` makes one call per thread and
 // round, fed runs of chunks of 4096 (sim/life/photon_feed.h), so it drains less
 // often than here; trace_per_chunk shows one chunk per call.
-void trace(benchmark::State& state, char which, std::uint64_t batch = 0) {
-  const Simulation sim(bench_case(which));
+void trace(benchmark::State& state, char which, std::uint64_t batch = 0,
+           Estimator estimator = Estimator::Analog) {
+  Settings settings = bench_case(which);
+  settings.estimator = estimator;
+  const Simulation sim(settings);
   if (batch == 0) batch = which == 'd' ? 2048 : 65536;
   Tally tally(8, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
   TracerCounters counters;
@@ -120,6 +124,11 @@ BENCHMARK_CAPTURE(trace, d_steep_tilt, 'd')->Unit(benchmark::kMillisecond)->MinT
 BENCHMARK_CAPTURE(trace, g_ggx_ellipse, 'g')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, k_beckmann_ellipse, 'k')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, m_ggx_smith_g1_white, 'm')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+void trace_expected_value(benchmark::State& state, char which) {
+  trace(state, which, 0, Estimator::ExpectedValue);
+}
+BENCHMARK_CAPTURE(trace_expected_value, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace_expected_value, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_per_chunk, 'b', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_per_chunk, 'c', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 

@@ -85,6 +85,12 @@ Batch wrapped(const Batch& a, Batch::batch_bool_type& in_range) {
   return xsimd::select(w >= Batch(kPi), Batch(-kPi), w);
 }
 
+// How many rows ahead of the one being scored expected-value scoring asks
+// for a row's tally cells and photon numbers: far enough that they arrive
+// before the row is reached (a row takes tens of nanoseconds), near enough
+// that the first-level cache still holds them then.
+constexpr int kRowsAhead = 16;
+
 }  // namespace
 
 ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lobes,
@@ -111,13 +117,16 @@ void ExitScorer::block_bins(const FinishedPhotons& f, std::int64_t* theta_bin, s
     settled_bin(theta, theta_fraction, n_theta, grid_.theta_edges, theta_closed_form_)
         .store_aligned(theta_bin + i);
     Batch::batch_bool_type in_range;
-    const Batch phi = wrapped(Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i), in_range);
+    const Batch relative = Batch::load_aligned(f.phi + i) - Batch::load_aligned(f.phi_i + i);
+    const Batch phi = wrapped(relative, in_range);
     settled_bin(phi, uniform_fraction(phi, kPi, kTwoPi), n_phi, grid_.phi_edges, phi_closed_form_)
         .store_aligned(phi_bin + i);
-    // Lanes out of the vector wrap's range take the scalar one. Photons that
-    // did not exit (truncated) have no direction (NaN): their bins are never
-    // read, and a NaN must not reach phi_bin's conversion to int.
-    if (!xsimd::all(in_range))
+    // Lanes out of the vector wrap's range take the scalar one. Rows that
+    // did not exit may have no direction (NaN: a truncated photon, an
+    // expected-value row of Russian roulette alone): their bins are never
+    // read, settled_bin gives them 0 as it does their theta, and a NaN must
+    // not reach phi_bin's conversion to int.
+    if (!xsimd::all(in_range | xsimd::isnan(relative)))
       for (int k = i; k < std::min(i + W, f.n); ++k)
         phi_bin[k] = f.exited[k] ? grid_.phi_bin(wrap_angle(f.phi[k] - f.phi_i[k])) : 0;
   }
@@ -165,8 +174,11 @@ void ExitScorer::score(const FinishedPhotons& f, Tally& tally) {
     const int lobe = f.scattered[i] ? last_lobe_ + 1 : std::min(f.segments[i], last_lobe_);
     bin[i] = tally.bin_index(lobe, static_cast<int>(theta_bin[i]),
                              static_cast<int>(phi_bin[i]));
-    tally.prefetch(bin[i]);
+    // (Expected-value rows are fetched a few rows ahead as they are scored:
+    // a block of them holds twice the analog estimator's rows, too many to
+    // have in flight at once.)
     if (expected_value_) lobe_[i] = lobe;
+    else tally.prefetch(bin[i]);
   }
   if (expected_value_) {
     score_rows_expected_value(f, bin, tally);
@@ -208,14 +220,18 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   const int channels = static_cast<int>(sigma_a_.size());
   double* weight = one_photon_.data();
   reserve_slots(f);
+  for (int i = 0; i < std::min(kRowsAhead, f.n); ++i) prefetch_row(f, i, bin, tally);
   std::size_t j = 0;  // the next of f.losses (in row order)
   for (int i = 0; i < f.n; ++i) {
+    if (i + kRowsAhead < f.n) prefetch_row(f, i + kRowsAhead, bin, tally);
     const std::uint32_t slot = f.slot[i];
     if (f.roulette[i] != 0.0) score_roulette(f, i, tally);
     if (f.exited[i]) {
-      score_scored_exit(f, i, bin[i], tally);
+      // (The common three channels unrolled, their numbers in registers.)
+      if (channels == 3) score_scored_exit<3>(f, i, bin[i], tally);
+      else score_scored_exit<0>(f, i, bin[i], tally);
     } else if (f.last[i] && !f.lost[i] && !f.ended[i]) {
-      book(weights_.data() + i, kCap, slot);
+      book(weights_.data() + i, kCap, slot, fixed_.data());
       tally.score_truncated_fixed(fixed_.data());
     }
     if (!f.last[i]) continue;
@@ -232,6 +248,24 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
     }
     end_photon(slot);
   }
+}
+
+// Asks for what scoring row i reads and writes: its tally cells (an exit)
+// and its photon's numbers so far (the block's stream of cells evicts them
+// from the first-level cache between a photon's rows).
+[[gnu::always_inline]] inline void ExitScorer::prefetch_row(const FinishedPhotons& f, int i,
+                                                          const std::size_t* bin,
+                                                          const Tally& tally) const {
+  const std::size_t at = static_cast<std::size_t>(f.slot[i]) * sigma_a_.size();
+  __builtin_prefetch(booked_.data() + at, 1);
+  __builtin_prefetch(created_.data() + at);
+  if (!f.exited[i]) return;
+  tally.prefetch_all(bin[i], lobe_[i]);
+  const Run& run = runs_[f.slot[i]];
+  __builtin_prefetch(&run, 1);
+  __builtin_prefetch(lobe_total_.data() + at, 1);
+  __builtin_prefetch(run.bins.data(), 1);
+  __builtin_prefetch(run.totals.data(), 1);
 }
 
 // Room for every slot the block uses (once: slots are the tracer's, a
@@ -264,8 +298,10 @@ void ExitScorer::end_photon(std::uint32_t slot) {
 // leave the ledger's absorbed (the complement) a few units below 0. More
 // than rounding (Tally::kRoundingAllowance) is a booking error: an internal
 // error, never clamped.
-void ExitScorer::book(const double* weight, std::size_t stride, std::uint32_t slot) {
-  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+template <int kChannels>
+[[gnu::always_inline]] inline void ExitScorer::book(const double* weight, std::size_t stride,
+                                                    std::uint32_t slot, Tally::Fixed* fixed) {
+  const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
     const Tally::Fixed room = Tally::kOne + created_[at + c] - booked_[at + c];
@@ -276,7 +312,7 @@ void ExitScorer::book(const double* weight, std::size_t stride, std::uint32_t sl
       w = room;
     }
     booked_[at + c] += w;
-    fixed_[c] = w;
+    fixed[c] = w;
   }
 }
 
@@ -295,7 +331,7 @@ void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
       created_[at + c] += fixed_[c];
     }
   } else {
-    book(growth_.data(), 1, f.slot[i]);
+    book(growth_.data(), 1, f.slot[i], fixed_.data());
     for (std::size_t c = 0; c < channels; ++c) fixed_[c] = -fixed_[c];
   }
   tally.score_roulette_fixed(fixed_.data());
@@ -304,12 +340,21 @@ void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
 // Row i's exit in `bin`: the bin's S2 grows by (t + w)^2 - t^2 = w (2 t + w)
 // with t the photon's total in the bin so far, so that it ends with the
 // square of the photon's total (SPEC section 6); the lobe's likewise.
+// kChannels: the number of channels, or 0 for sigma_a's (any number).
+template <int kChannels>
 void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally) {
   constexpr int kCap = FinishedPhotons::kCapacity;
   const std::uint32_t slot = f.slot[i];
-  const std::size_t channels = sigma_a_.size(), at = slot * channels;
+  const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   const double* weight = weights_.data() + i;
-  book(weight, kCap, slot);
+  // One row's numbers: fixed, growth and lobe_growth (channels of them).
+  constexpr std::size_t kLocal = kChannels > 0 ? kChannels : 1;
+  Tally::Fixed fixed_local[kLocal];
+  double growth_local[kLocal], lobe_growth_local[kLocal];
+  Tally::Fixed* fixed = kChannels > 0 ? fixed_local : fixed_.data();
+  double* growth = kChannels > 0 ? growth_local : growth_.data();
+  double* lobe_growth = kChannels > 0 ? lobe_growth_local : lobe_growth_.data();
+  book<kChannels>(weight, kCap, slot, fixed);
   Run& run = runs_[slot];
   double* lobe_total = lobe_total_.data() + at;
   // (A new lobe's total starts from 0 without being stored first: a store
@@ -323,7 +368,7 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
     const double t = new_lobe ? 0.0 : lobe_total[c];
-    lobe_growth_[c] = w * (2.0 * t + w);
+    lobe_growth[c] = w * (2.0 * t + w);
     lobe_total[c] = t + w;
   }
   for (std::size_t e = 0; e < run.bins.size(); ++e) {
@@ -331,19 +376,19 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
     double* total = run.totals.data() + e * channels;
     for (std::size_t c = 0; c < channels; ++c) {
       const double w = weight[c * kCap];
-      growth_[c] = w * (2.0 * total[c] + w);
+      growth[c] = w * (2.0 * total[c] + w);
       total[c] += w;
     }
-    tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), false);
+    tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, false);
     return;
   }
   run.bins.push_back(bin);
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
-    growth_[c] = w * w;
+    growth[c] = w * w;
     run.totals.push_back(w);
   }
-  tally.score_exit_fixed(bin, lobe_[i], fixed_.data(), growth_.data(), lobe_growth_.data(), true);
+  tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, true);
 }
 
 }  // namespace fiberlab::sim

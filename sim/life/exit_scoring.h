@@ -65,10 +65,13 @@ class ExitScorer {
   std::vector<double> growth_;        // [channel]: one row's bin S2 growth
   std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
   void reserve_slots(const FinishedPhotons& f);
-  void book(const double* weight, std::size_t stride, std::uint32_t slot);
+  template <int kChannels = 0>
+  void book(const double* weight, std::size_t stride, std::uint32_t slot, Tally::Fixed* fixed);
+  template <int kChannels>
   void score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally);
   void score_roulette(const FinishedPhotons& f, int i, Tally& tally);
   void end_photon(std::uint32_t slot);
+  void prefetch_row(const FinishedPhotons& f, int i, const std::size_t* bin, const Tally& tally) const;
   void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within
   // a margin), so that most vectors of bins need no settling on the edges.

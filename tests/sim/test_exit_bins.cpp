@@ -69,30 +69,35 @@ TEST(ExitBins, VectorLookupEqualsTheGridsAtEveryEdge) {
   }
 }
 
-// A truncated photon has no direction (NaN theta and phi) and shares its
-// block with exited ones; an incident azimuth far outside [-pi, pi) sends the
-// block to the scalar wrap. The exited photons' bins are still the grid's,
-// and no NaN reaches a conversion to int (undefined behaviour: the
-// sanitizer job, which runs this test, reports it; it found the scalar wrap
-// converting truncated photons' NaN).
+// A truncated photon (or an expected-value row of Russian roulette alone)
+// has no direction (NaN theta and phi) and shares its block with exited
+// ones. An incident azimuth far outside [-pi, pi) sends the block's exited
+// photons to the scalar wrap; one inside keeps the NaN rows on the vector
+// path (block_bins leaves them to settled_bin, as their theta). The exited
+// photons' bins are still the grid's, and no NaN reaches a conversion to
+// int (undefined behaviour: the sanitizer job, which runs this test,
+// reports it; it found the scalar wrap converting truncated photons' NaN).
+// Mutation caught: the scalar fallback skipped for a whole vector once it
+// holds a NaN (exited lanes of phi_i -20 land in wrong bins).
 TEST(ExitBins, TruncatedPhotonsInABlockAreSkipped) {
-  const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
-  ExitScorer scorer(grid, {0.0}, 4);
-  FinishedPhotons f;
-  alignas(64) std::int64_t theta_bin[FinishedPhotons::kCapacity], phi_bin[FinishedPhotons::kCapacity];
-  const double phi_i = -20.0;
-  f.n = 64;
-  for (int i = 0; i < f.n; ++i) {
-    f.exited[i] = i % 3 != 0;
-    f.theta[i] = f.exited[i] ? -1.5 + 0.04 * i : std::nan("");
-    f.phi[i] = f.exited[i] ? -3.1 + 0.09 * i : std::nan("");
-    f.phi_i[i] = phi_i;
-  }
-  scorer.block_bins(f, theta_bin, phi_bin);
-  for (int i = 0; i < f.n; ++i) {
-    if (!f.exited[i]) continue;
-    EXPECT_EQ(theta_bin[i], grid.theta_bin(f.theta[i]));
-    EXPECT_EQ(phi_bin[i], grid.phi_bin(wrap_angle(f.phi[i] - phi_i)));
+  for (const double phi_i : {-20.0, 0.3}) {
+    const BinGrid grid = BinGrid::make(90, 180, ThetaBinning::Uniform);
+    ExitScorer scorer(grid, {0.0}, 4);
+    FinishedPhotons f;
+    alignas(64) std::int64_t theta_bin[FinishedPhotons::kCapacity], phi_bin[FinishedPhotons::kCapacity];
+    f.n = 64;
+    for (int i = 0; i < f.n; ++i) {
+      f.exited[i] = i % 3 != 0;
+      f.theta[i] = f.exited[i] ? -1.5 + 0.04 * i : std::nan("");
+      f.phi[i] = f.exited[i] ? -3.1 + 0.09 * i : std::nan("");
+      f.phi_i[i] = phi_i;
+    }
+    scorer.block_bins(f, theta_bin, phi_bin);
+    for (int i = 0; i < f.n; ++i) {
+      if (!f.exited[i]) continue;
+      EXPECT_EQ(theta_bin[i], grid.theta_bin(f.theta[i]));
+      EXPECT_EQ(phi_bin[i], grid.phi_bin(wrap_angle(f.phi[i] - phi_i))) << "phi_i " << phi_i;
+    }
   }
 }
 
