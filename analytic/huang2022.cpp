@@ -943,6 +943,24 @@ double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
 
 }  // namespace
 
+namespace {
+
+// Runs `scalar()` on the scalar Paths, or `lanes(tracer)` on the double or
+// float lanes, as `choice` says (the float lanes unless told otherwise, and
+// the scalar Paths where the lanes do not support p).
+template <class Scalar, class Lanes>
+void on_paths(HuangPaths choice, const Huang2022Params& p, double theta_i, double phi_i, Scalar&& scalar,
+              Lanes&& lanes) {
+  if (choice == HuangPaths::Scalar || !huang_lanes::FloatTracer::supports(p))
+    scalar();
+  else if (choice == HuangPaths::DoubleLanes)
+    lanes(huang_lanes::DoubleTracer(p, theta_i, phi_i));
+  else
+    lanes(huang_lanes::FloatTracer(p, theta_i, phi_i));
+}
+
+}  // namespace
+
 std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double theta_i, double phi_i) const {
   const int C = static_cast<int>(params_.sigma_a.size());
   std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
@@ -959,12 +977,7 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
     });
     for (const BinSink& s : sinks) sink.add(s);
   };
-  if (paths_ == HuangPaths::Scalar || !huang_lanes::FloatTracer::supports(params_))
-    integrate(paths, n, sink);
-  else if (paths_ == HuangPaths::DoubleLanes)
-    run(huang_lanes::DoubleTracer(params_, theta_i, phi_i));
-  else
-    run(huang_lanes::FloatTracer(params_, theta_i, phi_i));
+  on_paths(paths_, params_, theta_i, phi_i, [&] { integrate(paths, n, sink); }, run);
   sink.finish();
   return out;
 }
@@ -984,12 +997,7 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
     });
     for (const HuangEnergies& x : block_e) add_energies(e, x);
   };
-  if (paths_ == HuangPaths::Scalar || !huang_lanes::FloatTracer::supports(params_))
-    integrate(paths, n, sink);
-  else if (paths_ == HuangPaths::DoubleLanes)
-    run(huang_lanes::DoubleTracer(params_, theta_i, phi_i));
-  else
-    run(huang_lanes::FloatTracer(params_, theta_i, phi_i));
+  on_paths(paths_, params_, theta_i, phi_i, [&] { integrate(paths, n, sink); }, run);
   return e;
 }
 
