@@ -941,10 +941,6 @@ double r_lobe(const Paths& paths, const Vec3& wi, const Vec3& wr) {
   return sum / (fb.projected_width(wi.y(), wi.z()) * cos_i);
 }
 
-}  // namespace
-
-namespace {
-
 // Runs `scalar()` on the scalar Paths, or `lanes(tracer)` on the double or
 // float lanes, as `choice` says (the float lanes unless told otherwise, and
 // the scalar Paths where the lanes do not support p).
