@@ -32,6 +32,7 @@ constexpr double kMinDensityRoughness = 1e-3;  // density(): Cycles' clamp of th
 constexpr int kArcNodes = 4096;            // density(): midpoint nodes over the arc (R)
 constexpr double kDeltaV = 1e-10;          // residual: v below this is a delta in theta_r
 constexpr double kCyclesEvalMaxImpact = 0.999;  // form=cycles_eval: Cycles' eval() clamps |h| / r to this
+constexpr long kMaxQuadraturePoints = 1L << 30;
 
 // ---- The point set ---------------------------------------------------------------
 // Halton's point set: coordinate k of point i is the radical inverse of i in
@@ -500,24 +501,31 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
+// Points [first, end) of the set whose coordinate 0 is offset by half a
+// cell of `cells` points (the midpoints of a `cells`-point set: a fixed
+// quadrature_points = n is [0, n) with cells n).
+struct PointRange {
+  long first, end, cells;
+};
+
 // The same points W at a time through the lanes' paths (huang2022_lanes.h),
-// lane groups [first, end) of the ceil(n / W) groups (point i0 = W g starts
-// group g): deposit(exits, u) takes each group's exits (per unit share,
-// the lanes' number type) and coordinates (double). The last group's lanes
-// past point n - 1 carry weight 0 (their paths end at the entry).
+// lane groups [first, end) of the range (point i0 = W g starts group g;
+// r.first a multiple of W): deposit(exits, u) takes each group's exits (per
+// unit share, the lanes' number type) and coordinates (double). The last
+// group's lanes past point r.end - 1 carry weight 0 (their paths end at the entry).
 template <class Tracer, class Deposit>
-void integrate_lanes(const Tracer& tracer, long n, long first, long end, Deposit&& deposit) {
+void integrate_lanes(const Tracer& tracer, const PointRange& r, long first, long end, Deposit&& deposit) {
   using B = typename Tracer::Batch;
   using T = typename B::value_type;
   constexpr int W = Tracer::kWidth;
-  Halton set(static_cast<std::uint64_t>(first) * W, n, static_cast<std::uint64_t>(n) + W);
+  Halton set(static_cast<std::uint64_t>(first) * W, r.cells, static_cast<std::uint64_t>(r.end) + W);
   alignas(64) double u[kDims][W];
   alignas(64) T ut[kDims][W], share[W];
   B ub[kDims];
   typename Tracer::Exits exits;
   for (long i0 = first * W; i0 < end * W; i0 += W) {
     set.get_lanes<W>(u);
-    for (int l = 0; l < W; ++l) share[l] = i0 + l < n ? T(1) : T(0);
+    for (int l = 0; l < W; ++l) share[l] = i0 + l < r.end ? T(1) : T(0);
     for (int k = 0; k < kDims; ++k) {
       for (int l = 0; l < W; ++l) ut[k][l] = static_cast<T>(u[k][l]);
       ub[k] = B::load_aligned(ut[k]);
@@ -527,7 +535,7 @@ void integrate_lanes(const Tracer& tracer, long n, long first, long end, Deposit
   }
 }
 
-// The point set in kPointBlocks contiguous blocks of lane groups, block b's
+// The range in kPointBlocks contiguous blocks of lane groups, block b's
 // exits handed to deposit(b, exits, u) for an accumulator of its own, which
 // the caller sums in block order afterwards: the same numbers for any number of threads, which the
 // atlas's bit-identity across threads, ranks and resumes needs. The blocks
@@ -536,11 +544,12 @@ void integrate_lanes(const Tracer& tracer, long n, long first, long end, Deposit
 // nested team then).
 constexpr int kPointBlocks = 16;
 template <class Tracer, class Deposit>
-void integrate_blocks(const Tracer& tracer, long n, Deposit&& deposit) {
-  const long groups = (n + Tracer::kWidth - 1) / Tracer::kWidth;
+void integrate_blocks(const Tracer& tracer, const PointRange& r, Deposit&& deposit) {
+  constexpr long W = Tracer::kWidth;
+  const long g0 = r.first / W, groups = (r.end + W - 1) / W - g0;
 #pragma omp parallel for schedule(dynamic) if (!omp_in_parallel())
   for (int b = 0; b < kPointBlocks; ++b)
-    integrate_lanes(tracer, n, groups * b / kPointBlocks, groups * (b + 1) / kPointBlocks,
+    integrate_lanes(tracer, r, g0 + groups * b / kPointBlocks, g0 + groups * (b + 1) / kPointBlocks,
                     [&](const auto& e, const auto* u) { deposit(b, e, u); });
 }
 
@@ -615,8 +624,11 @@ Huang2022::Huang2022(Huang2022Params params) : params_(std::move(params)) {
   if (p.lobe_scale.empty()) bad("lobe_scale needs at least one value");
   for (double s : p.lobe_scale)
     if (!(s >= 0.0) || !std::isfinite(s)) bad(fmt::format("lobe_scale = {} must be finite and >= 0", s));
-  if (p.quadrature_points < 1024 || p.quadrature_points > (1L << 30))
-    bad(fmt::format("quadrature_points = {} must be in [1024, 2^30]", p.quadrature_points));
+  if (p.quadrature_points != kAutoQuadraturePoints &&
+      (p.quadrature_points < 1024 || p.quadrature_points > kMaxQuadraturePoints))
+    bad(fmt::format("quadrature_points = {} must be auto or in [1024, 2^30]", p.quadrature_points));
+  if (!(p.quadrature_photons >= 1.0) || !std::isfinite(p.quadrature_photons))
+    bad(fmt::format("quadrature_photons = {} must be finite and >= 1", p.quadrature_photons));
 }
 
 namespace {
@@ -826,6 +838,14 @@ void add_energies(HuangEnergies& to, const HuangEnergies& from) {
   to.incident += from.incident;
 }
 
+// Every term of e times f.
+void scale_energies(HuangEnergies& e, double f) {
+  for (double& x : e.lobe) x *= f;
+  for (double& x : e.masked) x *= f;
+  for (double& x : e.stopped) x *= f;
+  e.incident *= f;
+}
+
 class EnergySink : public Sink {
  public:
   EnergySink(const Paths& paths, HuangEnergies& e) : paths_(paths), e_(e), C_(paths.channels()) {
@@ -955,45 +975,169 @@ void on_paths(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
     lanes(huang_lanes::FloatTracer(p, theta_i, phi_i));
 }
 
+// The lanes of `choice` (the double lanes where the scalar paths are chosen):
+// the pilot of quadrature_points=auto needs the point set in blocks.
+template <class Lanes>
+void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, double phi_i, Lanes&& lanes) {
+  on_paths(choice == HuangPaths::Scalar ? HuangPaths::DoubleLanes : choice, p, theta_i, phi_i, [] {}, lanes);
+}
+
+// ---- quadrature_points = auto ----------------------------------------------------
+// The quadrature's error is measured as scripts/huang2022_quadrature_error.py
+// and the atlas's bound do: per lobe and channel, the RMS over the bins with at
+// least 10 expected photons of (error / SE), SE^2 = p / N the variance of a bin
+// of probability p in an N-photon simulation (N = quadrature_photons). A pilot
+// of the set's first 2^18 points, in the 16 blocks of integrate_blocks(),
+// estimates it: block k's sum times 16 is one replicate of the pilot, so the
+// spread of the 16 gives each bin's variance at 2^18 points. The blocks are
+// segments of one Halton set, not independent replicates, and each is a worse
+// point set than the whole, so the spread overstates the error rather than
+// understating it: on the 32 fibers x 3 directions of configs/atlas.yaml the
+// true RMS error (against 2^25 points) at 2^21 and 2^22 points was 0.44 to
+// 0.91 of the estimate's projection. The error falls as 1/sqrt(points) (a
+// little faster: huang2022.h), so the points are the smallest multiple of
+// 2^18 whose projected error is at most a tenth of a standard error in every
+// lobe and channel; the pilot's points are the first of them (the set's
+// coordinate 0 offset by half a cell of 2^18 points, whatever the total).
+constexpr long kPilotPoints = 1L << 18;
+constexpr double kTargetErrorSE = 0.1;
+constexpr double kMinExpectedPhotons = 10.0;
+
+// The points quadrature_points=auto takes, from the pilot's kPointBlocks
+// block sums (each point's weight 1, the pilot's estimate their sum over
+// kPilotPoints; block k's times kPointBlocks a replicate of it): entry m of
+// every block belongs to group group(m) of `groups` (a lobe and channel), or
+// none (-1).
+template <class Group>
+long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, double photons) {
+  constexpr double K = kPointBlocks, kShare = 1.0 / kPilotPoints;
+  std::vector<double> sum(groups, 0.0);
+  std::vector<int> count(groups, 0);
+  for (std::size_t m = 0; m < blocks[0].size(); ++m) {
+    const int g = group(m);
+    if (g < 0) continue;
+    double mean = 0.0;
+    for (const std::vector<double>& b : blocks) mean += b[m] * kShare;
+    if (!(mean * photons >= kMinExpectedPhotons)) continue;
+    double ss = 0.0;
+    for (const std::vector<double>& b : blocks) ss += (K * b[m] * kShare - mean) * (K * b[m] * kShare - mean);
+    sum[g] += ss / (K * (K - 1.0)) / (mean / photons);  // (error / SE)^2 at the pilot
+    ++count[g];
+  }
+  double worst = 0.0;  // the largest mean squared error in SE^2 at the pilot
+  for (int g = 0; g < groups; ++g)
+    if (count[g] > 0) worst = std::max(worst, sum[g] / count[g]);
+  const double needed = static_cast<double>(kPilotPoints) * worst / (kTargetErrorSE * kTargetErrorSE);
+  const double pilots = std::max(1.0, std::ceil(needed / static_cast<double>(kPilotPoints)));
+  if (pilots * kPilotPoints > static_cast<double>(kMaxQuadraturePoints))
+    throw Error(fmt::format(
+        "huang2022: quadrature_points=auto would need about {:.3g} points (at most 2^30) for a tenth of the standard "
+        "error of {:g} photons; set quadrature_points to a number (error then above that bound) or a smaller "
+        "quadrature_photons",
+        needed, photons));
+  return static_cast<long>(pilots) * kPilotPoints;
+}
+
+// Entry m += the same entry of each block, in block order.
+std::vector<double> sum_blocks(const std::vector<std::vector<double>>& blocks) {
+  std::vector<double> out(blocks[0].size(), 0.0);
+  for (const std::vector<double>& b : blocks)
+    for (std::size_t m = 0; m < out.size(); ++m) out[m] += b[m];
+  return out;
+}
+
 }  // namespace
 
 std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double theta_i, double phi_i) const {
   const int C = static_cast<int>(params_.sigma_a.size());
-  std::vector<double> out(static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C, 0.0);
+  const std::size_t size = static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C;
   const Paths paths(params_, theta_i, phi_i);
-  BinSink sink(paths, grid, theta_i, phi_i, out);
-  const long n = params_.quadrature_points;
-  auto run = [&](const auto& tracer) {
-    // Block 0 deposits into out (sink), block b > 0 into block_out[b - 1].
-    std::vector<std::vector<double>> block_out(kPointBlocks - 1, std::vector<double>(out.size(), 0.0));
+  // Points `r` into kPointBlocks outputs, each point's weight `share`, each
+  // block finished (mirror, residual spread) on its own (`apart`), or the
+  // blocks summed into block 0 in block order and that finished.
+  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share, bool apart) {
+    std::vector<std::vector<double>> blocks(kPointBlocks, std::vector<double>(size, 0.0));
     std::deque<BinSink> sinks;
-    for (std::vector<double>& o : block_out) sinks.emplace_back(paths, grid, theta_i, phi_i, o);
-    integrate_blocks(tracer, n, [&](int b, const auto& e, const auto* u) {
-      (b == 0 ? sink : sinks[b - 1]).lanes(e, u, 1.0 / static_cast<double>(n));
-    });
-    for (const BinSink& s : sinks) sink.add(s);
+    for (std::vector<double>& o : blocks) sinks.emplace_back(paths, grid, theta_i, phi_i, o);
+    integrate_blocks(tracer, r, [&](int b, const auto& e, const auto* u) { sinks[b].lanes(e, u, share); });
+    if (!apart)
+      for (int b = 1; b < kPointBlocks; ++b) sinks[0].add(sinks[b]);
+    for (int b = 0; b < (apart ? kPointBlocks : 1); ++b) sinks[b].finish();
+    return blocks;
   };
-  on_paths(paths_, params_, theta_i, phi_i, [&] { integrate(paths, n, sink); }, run);
-  sink.finish();
+  const long n = params_.quadrature_points;
+  std::vector<double> out;
+  if (n != kAutoQuadraturePoints) {
+    on_paths(
+        paths_, params_, theta_i, phi_i,
+        [&] {
+          out.assign(size, 0.0);
+          BinSink sink(paths, grid, theta_i, phi_i, out);
+          integrate(paths, n, sink);
+          sink.finish();
+        },
+        [&](const auto& tracer) { out = std::move(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n), false)[0]); });
+    return out;
+  }
+  // auto: the pilot's blocks finished one by one, the points it asks for
+  // after them (the same set), each point's weight 1 / points in the end.
+  on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
+    const std::vector<std::vector<double>> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true);
+    const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;
+    const long points = auto_points(
+        pilot, params_.lobes * C,
+        [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
+        params_.quadrature_photons);
+    out = sum_blocks(pilot);
+    if (points > kPilotPoints) {
+      const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false)[0];
+      for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
+    }
+    for (double& x : out) x /= static_cast<double>(points);
+  });
   return out;
 }
 
 HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
-  HuangEnergies e;
   const Paths paths(params_, theta_i, phi_i);
-  EnergySink sink(paths, e);
-  const long n = params_.quadrature_points;
-  auto run = [&](const auto& tracer) {
-    // Block 0 sums into e (sink), block b > 0 into block_e[b - 1].
-    std::vector<HuangEnergies> block_e(kPointBlocks - 1);
+  // Points `r` into kPointBlocks sums, each point's weight `share`.
+  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share) {
+    std::vector<HuangEnergies> blocks(kPointBlocks);
     std::deque<EnergySink> sinks;
-    for (HuangEnergies& x : block_e) sinks.emplace_back(paths, x);
-    integrate_blocks(tracer, n, [&](int b, const auto& x, const auto*) {
-      (b == 0 ? sink : sinks[b - 1]).lanes(x, 1.0 / static_cast<double>(n));
-    });
-    for (const HuangEnergies& x : block_e) add_energies(e, x);
+    for (HuangEnergies& x : blocks) sinks.emplace_back(paths, x);
+    integrate_blocks(tracer, r, [&](int b, const auto& x, const auto*) { sinks[b].lanes(x, share); });
+    return blocks;
   };
-  on_paths(paths_, params_, theta_i, phi_i, [&] { integrate(paths, n, sink); }, run);
+  // Block 0 plus the others, in block order.
+  auto sum = [](const std::vector<HuangEnergies>& blocks) {
+    HuangEnergies e = blocks[0];
+    for (int b = 1; b < kPointBlocks; ++b) add_energies(e, blocks[b]);
+    return e;
+  };
+  const long n = params_.quadrature_points;
+  HuangEnergies e;
+  if (n != kAutoQuadraturePoints) {
+    on_paths(
+        paths_, params_, theta_i, phi_i,
+        [&] {
+          EnergySink sink(paths, e);
+          integrate(paths, n, sink);
+        },
+        [&](const auto& tracer) { e = sum(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n))); });
+    return e;
+  }
+  // auto: the lobe energies as one bin each (SE^2 = E / N), then as bin_probabilities().
+  on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
+    const std::vector<HuangEnergies> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0);
+    std::vector<std::vector<double>> lobes;
+    for (const HuangEnergies& x : pilot) lobes.push_back(x.lobe);
+    const long points = auto_points(
+        lobes, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
+        params_.quadrature_photons);
+    e = sum(pilot);
+    if (points > kPilotPoints) add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0)));
+    scale_energies(e, 1.0 / static_cast<double>(points));
+  });
   return e;
 }
 
@@ -1118,12 +1262,48 @@ double huang_roughness(const PhysicalFiber& f, FiberMapping& mapping) {
 }
 
 // The rule from a simulated fiber (physical_defaults.h): eccentricity and
-// tilt themselves, the roughness by huang_roughness() unless --set.
+// tilt themselves, the roughness by huang_roughness() unless --set, the
+// quadrature sized for the simulation's photons.
 void huang2022_from_fiber(const PhysicalFiber& f, Huang2022Params& p, FiberMapping& mapping) {
   apply_fiber_basics(f, p);
   p.eccentricity = f.eccentricity;
   p.tilt = f.scale_tilt;
   if (!mapping.user_sets("roughness")) p.roughness = huang_roughness(f, mapping);
+  if (f.photons > 0 && !mapping.user_sets("quadrature_photons")) p.quadrature_photons = static_cast<double>(f.photons);
+}
+
+// quadrature_points: "auto" or an integer in [1024, 2^30] (a number in files,
+// the text "auto" for auto).
+ParamSpec quadrature_points_param() {
+  using P = Huang2022Params;
+  const std::string key = "quadrature_points", allowed = "auto or an integer in [1024, 1073741824]";
+  ParamSpec s = param_detail::blank_spec(
+      key,
+      "points of the Halton quadrature (bins, energies); auto: as many as make its estimated error a tenth of the "
+      "standard error of quadrature_photons photons (a multiple of 2^18, per incident direction, from a pilot of 2^18)",
+      "integer", "auto", allowed);
+  auto ok = [](double x) { return x == std::floor(x) && x >= 1024.0 && x <= static_cast<double>(kMaxQuadraturePoints); };
+  s.set = [key, allowed, ok](ModelParameters& p, const std::string& value) {
+    double x;
+    if (param_detail::trim(value) == "auto")
+      p.as<P>().quadrature_points = kAutoQuadraturePoints;
+    else if (param_detail::parse_double(value, x) && ok(x))
+      p.as<P>().quadrature_points = static_cast<long>(x);
+    else
+      param_detail::fail(key, value, allowed);
+  };
+  auto is_auto = [](const ModelParameters& p) { return p.as<P>().quadrature_points == kAutoQuadraturePoints; };
+  s.show = [is_auto](const ModelParameters& p) {
+    return is_auto(p) ? std::string("auto") : std::to_string(p.as<P>().quadrature_points);
+  };
+  s.in_range = [is_auto, ok](const ModelParameters& p) {
+    return is_auto(p) || ok(static_cast<double>(p.as<P>().quadrature_points));
+  };
+  s.attribute = [key, is_auto](const ModelParameters& p) {
+    if (is_auto(p)) return ParamAttribute{key, true, "auto", {}};
+    return ParamAttribute{key, false, "", {static_cast<double>(p.as<P>().quadrature_points)}};
+  };
+  return s;
 }
 
 }  // namespace
@@ -1184,15 +1364,17 @@ ModelInfo huang2022_info() {
       "p >= 3: sampler (Cycles' sampler: the series from the TRT path's third interface) or cycles_eval (Cycles' "
       "eval(): T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)) from the second interface, uniform over the arc angle)",
       "sampler", {"sampler", "cycles_eval"}, &P::residual);
-  ParamSpec points = number_param("quadrature_points", "points of the Halton quadrature (bins, energies)",
-                                  "integer", "8388608", "an integer in [1024, 1073741824]",
-                                  &P::quadrature_points, [](double x) {
-                                    return x == std::floor(x) && x >= 1024.0 && x <= 1073741824.0;
-                                  });
+  ParamSpec points = quadrature_points_param();
+  ParamSpec photons = number_param(
+      "quadrature_photons",
+      "the photons whose standard error quadrature_points=auto sizes the quadrature for (a tenth of it)", "", "300000",
+      "a number >= 1", &P::quadrature_photons, [](double x) { return x >= 1.0 && x <= 1e15; });
+  photons.from_fiber = "photons (the simulation's, per incident direction)";
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param<P>(), sigma_a_param<P>(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),
               ecc,            scale,              form,               masking,
-              flux,           residual,           lobes_param<P>(), points};
+              flux,           residual,           lobes_param<P>(), points,
+              photons};
   m.make = [](const P& p) { return make_huang2022(p); };
   m.approximations = huang_approximations;
   m.from_fiber = huang2022_from_fiber;

@@ -125,8 +125,8 @@
 // sampled by two more coordinates of the point set). Each lobe's total is
 // therefore the model's energy up to the quadrature error, and alpha = 0 is
 // the smooth tilted elliptical fiber (with tilt 0 and e = 1 exactly the
-// smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in
-// `quadrature_points` (2^23 by default); bin_probabilities() and energies()
+// smooth cylinder of SPEC s7, orders p <= 2). The cost is linear in the
+// points; bin_probabilities() and energies()
 // trace 16 points at a time in float SIMD lanes (8 without AVX-512;
 // huang2022_lanes.h, the same transport as the scalar paths that density()
 // uses, in float arithmetic: ~1e-7 relative rounding per path, the weights
@@ -142,14 +142,17 @@
 // error over the simulated bin's variance is about N_photons / N_points
 // times 0.10-0.26 for TT and TRT on mirror-symmetric fibers (every fiber of
 // configs/atlas.yaml: `scripts/huang2022_quadrature_error.py
-// configs/atlas.yaml --white`), about twice that without the mirror. At the
-// default 2^23 points, over the 32 fibers and 3 directions of
-// configs/atlas.yaml, the RMS bin error of a fiber is at most 0.011
-// standard errors for R, 0.071 for TT, 0.083 for TRT and 0.002 for p >= 3,
-// single bins up to 0.06, 0.30, 0.31 and 0.004
-// (`scripts/huang2022_quadrature_error.py configs/atlas.yaml --points
-// 8388608 --reference 33554432`; the reference's own error included). Lower
-// it for quick looks, raise it for long simulations.
+// configs/atlas.yaml --white`), about twice that without the mirror, and
+// less on absorbing fibers. So `quadrature_points` is `auto` by default:
+// per incident direction, a pilot of 2^18 points estimates the error and
+// the quadrature takes as many points (a multiple of 2^18, the pilot's
+// included) as make it a tenth of the standard error of a simulation of
+// `quadrature_photons` photons (the simulation's own photons when the
+// parameters come from one; huang2022.cpp says how, and how conservative
+// the estimate is). On configs/atlas.yaml (300k photons) that is 8-11 M
+// points per direction on its white fibers and 2-5.5 M on its brown ones.
+// A number instead fixes the points (fits do: a fixed set keeps the
+// objective smooth in the parameters).
 #include <memory>
 #include <vector>
 
@@ -171,6 +174,9 @@ enum class HuangForm { Paper, CyclesEval };
 // The evaluation of bin_probabilities() and energies() (Huang2022::set_paths).
 enum class HuangPaths { FloatLanes, DoubleLanes, Scalar };
 
+// Huang2022Params::quadrature_points = auto.
+constexpr long kAutoQuadraturePoints = 0;
+
 // The model's parameters (its table, huang2022_info() in huang2022.cpp, binds
 // `--set` keys to these fields).
 struct Huang2022Params {
@@ -191,7 +197,12 @@ struct Huang2022Params {
   bool mesonormal_flux = true;
   HuangResidual residual = HuangResidual::Sampler;
   int lobes = 4;                           // 1..4 (p >= 3 is one residual lobe)
-  long quadrature_points = 1L << 23;       // in [1024, 2^30]
+  // Points of the quadrature of bin_probabilities() and energies(): a number in
+  // [1024, 2^30], or kAutoQuadraturePoints: as many as make the quadrature's
+  // error a tenth of the standard error of a simulation of
+  // `quadrature_photons` photons (see below).
+  long quadrature_points = kAutoQuadraturePoints;
+  double quadrature_photons = 300000.0;    // >= 1; the simulation's photons when read from one
 };
 
 // The energy a path integration gives, per channel c: lobe energies

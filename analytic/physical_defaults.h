@@ -25,6 +25,7 @@
 // `predict` and `compare`); a fiber a model cannot represent is refused
 // (fiberlab::Error naming the field and what the model allows) unless the
 // user sets the parameter concerned with --set.
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -36,6 +37,7 @@ namespace fiberlab::analytic {
 // number of lobes its tally separates.
 struct PhysicalFiber : Fiber {
   int lobes = 4;
+  std::uint64_t photons = 0;  // the simulation's, per incident direction (0: not known)
 
   // "ggx alpha = [0.3, 0.1]": the roughness as the config gives it, for notes and errors.
   std::string roughness_text() const { return roughness::text(roughness); }

@@ -45,6 +45,7 @@ analytic::PhysicalFiber physical_fiber(const sim::Settings& s) {
   analytic::PhysicalFiber f;
   static_cast<Fiber&>(f) = s.fiber;
   f.lobes = s.tally.lobes;
+  f.photons = s.photons;
   return f;
 }
 

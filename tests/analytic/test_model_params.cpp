@@ -34,7 +34,7 @@ TEST(ModelParams, EveryTableKeyParses) {
       {"huang2022 form", "cycles_eval"},
       {"huang2022 masking", "correlated"}, {"huang2022 flux", "macro"},
       {"huang2022 residual", "cycles_eval"},
-      {"huang2022 quadrature_points", "65536"}};
+      {"huang2022 quadrature_points", "65536"}, {"huang2022 quadrature_photons", "1e+06"}};
   for (const ModelInfo& m : registered_models()) {
     ModelParameters p = default_params(m.name);
     for (const ParamSpec& spec : m.params) {

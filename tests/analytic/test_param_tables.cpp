@@ -35,7 +35,7 @@ const std::map<std::string, std::string> kOtherValue{
     {"delta_h_m", "0.25"},   {"lobes", "5"},                 {"quadrature_order", "50"},
     {"max_order", "30"},     {"beta_m", "0.4"},              {"beta_n", "0.6"},
     {"roughness", "0.2"},    {"tilt", "3"},                  {"lobe_scale", "1,0.5,2"},
-    {"quadrature_points", "65536"}};
+    {"quadrature_points", "65536"},  {"quadrature_photons", "1e+06"}};
 
 // chiang2016's `alpha` is one tilt, not a list.
 std::string other_value(const std::string& model, const ParamSpec& spec) {
