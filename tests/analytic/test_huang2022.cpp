@@ -357,6 +357,12 @@ TEST(Huang2022, ParameterTable) {
   EXPECT_THROW(apply_setting("huang2022", p, "roughness=1.5"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "eccentricity=0"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "quadrature_points=100"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "quadrature_points=automatic"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "quadrature_photons=0"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "quadrature_photons=nan"), Error);
+  apply_setting("huang2022", p, "quadrature_points=auto");
+  EXPECT_EQ(h.quadrature_points, kAutoQuadraturePoints);
+  apply_setting("huang2022", p, "quadrature_points=4096");
   EXPECT_THROW(apply_setting("huang2022", p, "beta_m=0.3"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "form=cycles"), Error);
   p.as<Huang2022Params>().sigma_a = {0.1, 0.2, 0.3};
@@ -756,4 +762,51 @@ TEST(Huang2022, CyclesEvalIntegratesOverItsClampedWidth) {
   p.form = HuangForm::CyclesEval;
   Huang2022(p).density(0, 0.0, 0.0, 0.0, deg_to_rad(170.0), cycles);
   EXPECT_LT(cycles[0], 0.95 * paper[0]);
+}
+
+// quadrature_points=auto refuses, naming both keys, a simulation whose
+// standard error would need more than 2^30 points (here 1e13 photons), in
+// bin_probabilities() and energies() alike; a number is not refused.
+TEST(Huang2022, AutoQuadratureRefusesMoreThanItsMostPoints) {
+  Huang2022Params p = fiber(0.3, kAutoQuadraturePoints);
+  p.quadrature_photons = 1e13;
+  const Huang2022 m(p);
+  const BinGrid grid = BinGrid::make(12, 18, ThetaBinning::Uniform);
+  for (int call = 0; call < 2; ++call) {
+    try {
+      if (call == 0)
+        m.bin_probabilities(grid, deg_to_rad(30.0), 0.0);
+      else
+        m.energies(deg_to_rad(30.0), 0.0);
+      ADD_FAILURE() << "call " << call << " was not refused";
+    } catch (const Error& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find("quadrature_points=auto would need"), std::string::npos) << msg;
+      EXPECT_NE(msg.find("quadrature_photons"), std::string::npos) << msg;
+      EXPECT_EQ(msg.find('\n'), std::string::npos) << msg;
+    }
+  }
+  p.quadrature_points = 4096;
+  EXPECT_NO_THROW(Huang2022(p).bin_probabilities(grid, deg_to_rad(30.0), 0.0));
+}
+
+// energies() with quadrature_points=auto: the white furnace closes (every
+// path's weight is a lobe's, masked or stopped; 1e-9 for the float lanes,
+// as FloatLanesAreTheDoubleLanesToRounding says), and each lobe's energy is
+// within 3 x its target (0.1 of the 300k-photon standard error sqrt(E / N)
+// of a lobe energy: auto sizes the lobe totals so) of 2^25 points'.
+TEST(Huang2022, AutoQuadratureEnergiesCloseTheFurnaceAndMeetTheirTarget) {
+  Huang2022Params p = fiber(0.3, kAutoQuadraturePoints);
+  p.eccentricity = 0.85;
+  p.tilt = deg_to_rad(3.0);
+  Huang2022Params reference = p;
+  reference.quadrature_points = 1L << 25;
+  const double ti = deg_to_rad(45.0), photons = 300000.0;
+  const HuangEnergies e = Huang2022(p).energies(ti, 0.0), r = Huang2022(reference).energies(ti, 0.0);
+  EXPECT_NEAR(sum(e.lobe) + e.masked[0] + e.stopped[0], e.incident, 1e-9);
+  for (std::size_t l = 0; l < 4; ++l) {
+    std::printf("lobe %zu: auto %.7f, 2^25 points %.7f, target %.2g\n", l, e.lobe[l], r.lobe[l],
+                0.1 * std::sqrt(r.lobe[l] / photons));
+    EXPECT_LT(std::abs(e.lobe[l] - r.lobe[l]), 3.0 * 0.1 * std::sqrt(r.lobe[l] / photons)) << "lobe " << l;
+  }
 }
