@@ -992,9 +992,8 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 // spread of the 16 gives each bin's variance at 2^18 points. The blocks are
 // segments of one Halton set, not independent replicates, and each is a worse
 // point set than the whole, so the spread overstates the error rather than
-// understating it: on the 32 fibers x 3 directions of configs/atlas.yaml the
-// true RMS error (against 2^25 points) at 2^21 and 2^22 points was 0.44 to
-// 0.91 of the estimate's projection. The error falls as 1/sqrt(points) (a
+// understating it (what auto's points give on the atlas's fibers:
+// huang2022.h). The error falls as 1/sqrt(points) (a
 // little faster: huang2022.h), so the points are the smallest multiple of
 // 2^18 whose projected error is at most a tenth of a standard error in every
 // lobe and channel; the pilot's points are the first of them (the set's

@@ -10,8 +10,11 @@ lobe, over the bins with at least 10 expected photons: the mean of
 in the config's N-photon simulation), its square root (the RMS error in
 standard errors) and the largest |error| / SE.
 
+With `--points auto` the prediction is huang2022's default, sized for the
+config's photons (docs/MODELS.md).
+
 Usage: scripts/huang2022_quadrature_error.py CONFIG [--fiberlab BIN]
-         [--points N [N ...]] [--reference N] [--white] [--workdir DIR]
+         [--points N|auto [...]] [--reference N] [--white] [--workdir DIR]
 """
 import argparse
 import itertools
@@ -40,6 +43,19 @@ def fibers(cfg, white):
                "tally": cfg["tally"]}
 
 
+def points_arg(text):
+    """A point count (an integer >= 1024) or `auto` (huang2022's default)."""
+    if text == "auto":
+        return text
+    try:
+        n = int(text)
+    except ValueError:
+        n = 0
+    if n < 1024:
+        raise argparse.ArgumentTypeError(f"{text!r}: give an integer >= 1024 or auto")
+    return n
+
+
 def predict(fiberlab, config, points, out):
     subprocess.run([fiberlab, "predict", config, "--model", "huang2022", "--set",
                     f"quadrature_points={points}", "-o", out], check=True, stdout=subprocess.DEVNULL)
@@ -51,8 +67,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("config")
     ap.add_argument("--fiberlab", default="build/cli/fiberlab")
-    ap.add_argument("--points", type=int, nargs="+", default=[1 << 18],
-                    help="one or more point counts to measure (one reference each fiber)")
+    ap.add_argument("--points", type=points_arg, nargs="+", default=[1 << 18],
+                    help="one or more point counts to measure, or auto (one reference each fiber)")
     ap.add_argument("--reference", type=int, default=1 << 22)
     ap.add_argument("--white", action="store_true", help="only the sweep's sigma_a 0 fibers")
     ap.add_argument("--workdir", default=None)
