@@ -127,12 +127,20 @@ TEST(Huang2022, LanesEqualTheScalarPathsInBins) {
 
 // The quadrature's points run in a fixed number of blocks summed in block
 // order: 1, 2 or 3 threads give the same bits (the atlas's bit-identity
-// across threads, ranks and resumes rests on it). Mutation caught: the
-// blocks summed as their threads finish (a per-thread accumulator).
+// across threads, ranks and resumes rests on it), at the cases' fixed points
+// and at quadrature_points=auto (its pilot, its choice and its points).
+// Mutation caught: the blocks summed as their threads finish (a per-thread
+// accumulator).
 TEST(Huang2022, BinsAndEnergiesAreTheSameOnAnyNumberOfThreads) {
   const int threads = omp_get_max_threads();
   const BinGrid g = BinGrid::make(18, 36, ThetaBinning::Uniform);
-  for (const Case& k : cases()) {
+  std::vector<Case> all = cases();
+  Case automatic = all.front();
+  automatic.name += " (auto, 30k photons)";
+  automatic.p.quadrature_points = kAutoQuadraturePoints;
+  automatic.p.quadrature_photons = 30000.0;  // a few pilots' worth of points
+  all.push_back(automatic);
+  for (const Case& k : all) {
     const Huang2022 model(k.p);
     const double ti = deg_to_rad(k.theta_deg), pi = deg_to_rad(k.phi_deg);
     omp_set_num_threads(1);
