@@ -1007,20 +1007,23 @@ constexpr double kMinExpectedPhotons = 10.0;
 // kPilotPoints; block k's times kPointBlocks a replicate of it): entry m of
 // every block belongs to group group(m) of `groups` (a lobe and channel), or
 // none (-1).
-template <class Group>
-long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, double photons) {
+template <class Group, class Unabsorbed>
+long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, Unabsorbed&& unabsorbed,
+                 double photons) {
   constexpr double K = kPointBlocks, kShare = 1.0 / kPilotPoints;
   std::vector<double> sum(groups, 0.0);
   std::vector<int> count(groups, 0);
   for (std::size_t m = 0; m < blocks[0].size(); ++m) {
     const int g = group(m);
-    if (g < 0) continue;
+    const double p0 = unabsorbed(m) * kShare;
+    if (g < 0 || !(p0 * photons >= kMinExpectedPhotons)) continue;
     double mean = 0.0;
     for (const std::vector<double>& b : blocks) mean += b[m] * kShare;
-    if (!(mean * photons >= kMinExpectedPhotons)) continue;
+    if (!(mean > 0.0)) continue;
     double ss = 0.0;
     for (const std::vector<double>& b : blocks) ss += (K * b[m] * kShare - mean) * (K * b[m] * kShare - mean);
-    sum[g] += ss / (K * (K - 1.0)) / (mean / photons);  // (error / SE)^2 at the pilot
+    const double se2 = mean * mean / (p0 * photons);
+    sum[g] += ss / (K * (K - 1.0)) / se2;  // (error / SE)^2 at the pilot
     ++count[g];
   }
   double worst = 0.0;  // the largest mean squared error in SE^2 at the pilot
@@ -1037,6 +1040,19 @@ long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Gro
   return static_cast<long>(pilots) * kPilotPoints;
 }
 
+// A channel without absorption (its bins are the unabsorbed ones), or -1.
+int clear_channel(const Huang2022Params& p) {
+  for (std::size_t c = 0; c < p.sigma_a.size(); ++c)
+    if (p.sigma_a[c] == 0.0) return static_cast<int>(c);
+  return -1;
+}
+
+// `p` with one channel and no absorption.
+Huang2022Params without_absorption(Huang2022Params p) {
+  p.sigma_a = {0.0};
+  return p;
+}
+
 // Entry m += the same entry of each block, in block order.
 std::vector<double> sum_blocks(const std::vector<std::vector<double>>& blocks) {
   std::vector<double> out(blocks[0].size(), 0.0);
@@ -1051,13 +1067,15 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   const int C = static_cast<int>(params_.sigma_a.size());
   const std::size_t size = static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi() * C;
   const Paths paths(params_, theta_i, phi_i);
-  // Points `r` into kPointBlocks outputs, each point's weight `share`, each
-  // block finished (mirror, residual spread) on its own (`apart`), or the
-  // blocks summed into block 0 in block order and that finished.
-  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share, bool apart) {
-    std::vector<std::vector<double>> blocks(kPointBlocks, std::vector<double>(size, 0.0));
+  // Points `r` of `on`'s paths into kPointBlocks outputs, each point's weight
+  // `share`, each block finished (mirror, residual spread) on its own
+  // (`apart`), or the blocks summed into block 0 in block order and that finished.
+  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share, bool apart, const Paths& on) {
+    const std::size_t n_out = static_cast<std::size_t>(on.params().lobes) * grid.n_theta() * grid.n_phi() *
+                              on.params().sigma_a.size();
+    std::vector<std::vector<double>> blocks(kPointBlocks, std::vector<double>(n_out, 0.0));
     std::deque<BinSink> sinks;
-    for (std::vector<double>& o : blocks) sinks.emplace_back(paths, grid, theta_i, phi_i, o);
+    for (std::vector<double>& o : blocks) sinks.emplace_back(on, grid, theta_i, phi_i, o);
     integrate_blocks(tracer, r, [&](int b, const auto& e, const auto* u) { sinks[b].lanes(e, u, share); });
     if (!apart)
       for (int b = 1; b < kPointBlocks; ++b) sinks[0].add(sinks[b]);
@@ -1075,21 +1093,38 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
           integrate(paths, n, sink);
           sink.finish();
         },
-        [&](const auto& tracer) { out = std::move(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n), false)[0]); });
+        [&](const auto& tracer) {
+          out = std::move(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n), false, paths)[0]);
+        });
     return out;
   }
   // auto: the pilot's blocks finished one by one, the points it asks for
   // after them (the same set), each point's weight 1 / points in the end.
+  // The standard errors need each bin's probability without absorption: a
+  // channel with sigma_a 0, or the pilot's points once more without it.
+  const std::size_t bins = static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi();
+  const int clear = clear_channel(params_);
+  std::vector<double> unabsorbed(bins);
+  if (clear < 0) {
+    const Huang2022Params q = without_absorption(params_);
+    const Paths clear_paths(q, theta_i, phi_i);
+    on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
+      unabsorbed = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, clear_paths)[0];
+    });
+  }
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
-    const std::vector<std::vector<double>> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true);
+    const std::vector<std::vector<double>> pilot =
+        blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths);
+    out = sum_blocks(pilot);
+    if (clear >= 0)
+      for (std::size_t b = 0; b < bins; ++b) unabsorbed[b] = out[b * C + clear];
     const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;
     const long points = auto_points(
         pilot, params_.lobes * C,
         [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
-        params_.quadrature_photons);
-    out = sum_blocks(pilot);
+        [&](std::size_t m) { return unabsorbed[m / C]; }, params_.quadrature_photons);
     if (points > kPilotPoints) {
-      const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false)[0];
+      const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false, paths)[0];
       for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
     }
     for (double& x : out) x /= static_cast<double>(points);
@@ -1099,11 +1134,11 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
 
 HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
   const Paths paths(params_, theta_i, phi_i);
-  // Points `r` into kPointBlocks sums, each point's weight `share`.
-  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share) {
+  // Points `r` of `on`'s paths into kPointBlocks sums, each point's weight `share`.
+  auto blocks_of = [&](const auto& tracer, const PointRange& r, double share, const Paths& on) {
     std::vector<HuangEnergies> blocks(kPointBlocks);
     std::deque<EnergySink> sinks;
-    for (HuangEnergies& x : blocks) sinks.emplace_back(paths, x);
+    for (HuangEnergies& x : blocks) sinks.emplace_back(on, x);
     integrate_blocks(tracer, r, [&](int b, const auto& x, const auto*) { sinks[b].lanes(x, share); });
     return blocks;
   };
@@ -1122,19 +1157,31 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
           EnergySink sink(paths, e);
           integrate(paths, n, sink);
         },
-        [&](const auto& tracer) { e = sum(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n))); });
+        [&](const auto& tracer) { e = sum(blocks_of(tracer, {0, n, n}, 1.0 / static_cast<double>(n), paths)); });
     return e;
   }
-  // auto: the lobe energies as one bin each (SE^2 = E / N), then as bin_probabilities().
+  // auto: the lobe energies as one bin each, then as bin_probabilities().
+  const int C = static_cast<int>(params_.sigma_a.size()), clear = clear_channel(params_);
+  std::vector<double> unabsorbed(params_.lobes);
+  if (clear < 0) {
+    const Huang2022Params q = without_absorption(params_);
+    const Paths clear_paths(q, theta_i, phi_i);
+    on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
+      unabsorbed = sum(blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, clear_paths)).lobe;
+    });
+  }
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
-    const std::vector<HuangEnergies> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0);
+    const std::vector<HuangEnergies> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, paths);
+    e = sum(pilot);
+    if (clear >= 0)
+      for (int l = 0; l < params_.lobes; ++l) unabsorbed[l] = e.lobe[static_cast<std::size_t>(l) * C + clear];
     std::vector<std::vector<double>> lobes;
     for (const HuangEnergies& x : pilot) lobes.push_back(x.lobe);
     const long points = auto_points(
         lobes, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
-        params_.quadrature_photons);
-    e = sum(pilot);
-    if (points > kPilotPoints) add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0)));
+        [&](std::size_t m) { return unabsorbed[m / C]; }, params_.quadrature_photons);
+    if (points > kPilotPoints)
+      add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, paths)));
     scale_energies(e, 1.0 / static_cast<double>(points));
   });
   return e;

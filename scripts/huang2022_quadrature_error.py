@@ -5,10 +5,14 @@ errors of the atlas's own simulations.
 For each fiber of the atlas config's sweep (white fibers only with --white),
 predicts huang2022's bins at --points and at --reference points (the same
 model, its quadrature's error falling as 1/sqrt(points)), and prints per
-lobe, over the bins with at least 10 expected photons: the mean of
-(error / SE)^2 with SE^2 = p / N (the variance of a bin of probability p
-in the config's N-photon simulation), its square root (the RMS error in
-standard errors) and the largest |error| / SE.
+lobe, over the bins with at least 10 expected photons (p0 N >= 10) and for
+the worst colour channel: the mean of (error / SE)^2, its square root (the
+RMS error in standard errors) and the largest |error| / SE. SE^2 = p^2 /
+(p0 N) is the variance of a bin of probability p in the config's N-photon
+simulation (SPEC s5: the photons carry their attenuation as weight), to
+first order: p0 is the bin's probability without absorption (the
+fiber predicted with sigma_a 0), p / p0 the mean weight of its photons;
+for a white fiber SE^2 = p / N.
 
 With `--points auto` the prediction is huang2022's default, sized for the
 config's photons (docs/MODELS.md).
@@ -56,9 +60,10 @@ def points_arg(text):
     return n
 
 
-def predict(fiberlab, config, points, out):
-    subprocess.run([fiberlab, "predict", config, "--model", "huang2022", "--set",
-                    f"quadrature_points={points}", "-o", out], check=True, stdout=subprocess.DEVNULL)
+def predict(fiberlab, config, points, out, settings=()):
+    sets = [x for kv in [f"quadrature_points={points}", *settings] for x in ("--set", kv)]
+    subprocess.run([fiberlab, "predict", config, "--model", "huang2022", *sets, "-o", out], check=True,
+                   stdout=subprocess.DEVNULL)
     with h5py.File(out) as f:
         return f["prediction/probability"][()]
 
@@ -84,17 +89,25 @@ def main():
         with open(path, "w") as f:
             yaml.safe_dump(fc, f)
         ref = predict(a.fiberlab, path, a.reference, os.path.join(work, f"fiber{k}_ref.h5"))
+        # [direction, lobe, theta, phi, channel]; without absorption: one channel.
+        p0 = ref if fc["fiber"].get("sigma_a") == 0.0 else predict(
+            a.fiberlab, path, a.reference // 8, os.path.join(work, f"fiber{k}_clear.h5"), ["sigma_a=0"])
         for points in a.points:
             x = predict(a.fiberlab, path, points, os.path.join(work, f"fiber{k}_test.h5"))
             row = []
             for l, name in enumerate(LOBES[:ref.shape[1]]):
-                r, y = ref[:, l], x[:, l]
-                m = r * n >= 10
-                if not m.any():
+                ms, mx, any_bin = 0.0, 0.0, False
+                for c in range(ref.shape[-1]):
+                    r, y, q = ref[:, l, ..., c], x[:, l, ..., c], p0[:, l, ..., 0]
+                    m = (q * n >= 10) & (r > 0)
+                    if not m.any():
+                        continue
+                    any_bin = True
+                    z = (y - r)[m] / np.sqrt(r[m] ** 2 / (q[m] * n))
+                    ms, mx = max(ms, float(np.mean(z ** 2))), max(mx, float(np.max(np.abs(z))))
+                if not any_bin:
                     row.append(f"{name} -")
                     continue
-                z = (y - r)[m] / np.sqrt(r[m] / n)
-                ms, mx = float(np.mean(z ** 2)), float(np.max(np.abs(z)))
                 w = worst[(points, name)]
                 w[0], w[1], w[2] = max(w[0], ms), max(w[1], np.sqrt(ms)), max(w[2], mx)
                 row.append(f"{name} {ms:.3f}/{np.sqrt(ms):.3f}/{mx:.3f}")

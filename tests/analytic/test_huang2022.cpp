@@ -794,7 +794,7 @@ TEST(Huang2022, AutoQuadratureRefusesMoreThanItsMostPoints) {
 // path's weight is a lobe's, masked or stopped; 1e-9 for the float lanes,
 // as FloatLanesAreTheDoubleLanesToRounding says), and each lobe's energy is
 // within 3 x its target (0.1 of the 300k-photon standard error sqrt(E / N)
-// of a lobe energy: auto sizes the lobe totals so) of 2^25 points'.
+// of a white lobe's energy: auto sizes the lobe totals so) of 2^25 points'.
 TEST(Huang2022, AutoQuadratureEnergiesCloseTheFurnaceAndMeetTheirTarget) {
   Huang2022Params p = fiber(0.3, kAutoQuadraturePoints);
   p.eccentricity = 0.85;
