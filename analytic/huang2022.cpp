@@ -984,9 +984,15 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 
 // ---- quadrature_points = auto ----------------------------------------------------
 // The quadrature's error is measured as scripts/huang2022_quadrature_error.py
-// and the atlas's bound do: per lobe and channel, the RMS over the bins with at
-// least 10 expected photons of (error / SE), SE^2 = p / N the variance of a bin
-// of probability p in an N-photon simulation (N = quadrature_photons). A pilot
+// and the atlas's bound do: per lobe and channel, the RMS over the bins
+// holding at least 10 photons' weight of (error / SE), with SE^2 = (p2 -
+// p^2) / N the variance of a bin of probability p in an N-photon simulation
+// (N = quadrature_photons) whose photons carry their attenuation as weight
+// (SPEC s5): p2, the mean of their squared weights, is the bin's probability
+// at twice the absorption (the attenuation squared), which the pilot's
+// points traced once more give; on a white fiber p2 = p. (p / N, the
+// variance of unweighted photons, would overstate an absorbing fiber's
+// standard errors by up to p / p2.) A pilot
 // of the set's first 2^18 points, in the 16 blocks of integrate_blocks(),
 // estimates it: block k's sum times 16 is one replicate of the pilot, so the
 // spread of the 16 gives each bin's variance at 2^18 points. The blocks are
@@ -1007,22 +1013,21 @@ constexpr double kMinExpectedPhotons = 10.0;
 // kPilotPoints; block k's times kPointBlocks a replicate of it): entry m of
 // every block belongs to group group(m) of `groups` (a lobe and channel), or
 // none (-1).
-template <class Group, class Unabsorbed>
-long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, Unabsorbed&& unabsorbed,
+template <class Group, class Squares>
+long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, Squares&& squares,
                  double photons) {
   constexpr double K = kPointBlocks, kShare = 1.0 / kPilotPoints;
   std::vector<double> sum(groups, 0.0);
   std::vector<int> count(groups, 0);
   for (std::size_t m = 0; m < blocks[0].size(); ++m) {
     const int g = group(m);
-    const double p0 = unabsorbed(m) * kShare;
-    if (g < 0 || !(p0 * photons >= kMinExpectedPhotons)) continue;
+    if (g < 0) continue;
     double mean = 0.0;
     for (const std::vector<double>& b : blocks) mean += b[m] * kShare;
-    if (!(mean > 0.0)) continue;
+    const double se2 = (squares(m) * kShare - mean * mean) / photons;
+    if (!(mean * photons >= kMinExpectedPhotons) || !(se2 > 0.0)) continue;
     double ss = 0.0;
     for (const std::vector<double>& b : blocks) ss += (K * b[m] * kShare - mean) * (K * b[m] * kShare - mean);
-    const double se2 = mean * mean / (p0 * photons);
     sum[g] += ss / (K * (K - 1.0)) / se2;  // (error / SE)^2 at the pilot
     ++count[g];
   }
@@ -1040,16 +1045,17 @@ long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Gro
   return static_cast<long>(pilots) * kPilotPoints;
 }
 
-// A channel without absorption (its bins are the unabsorbed ones), or -1.
-int clear_channel(const Huang2022Params& p) {
-  for (std::size_t c = 0; c < p.sigma_a.size(); ++c)
-    if (p.sigma_a[c] == 0.0) return static_cast<int>(c);
-  return -1;
+// Whether any channel absorbs.
+bool absorbs(const Huang2022Params& p) {
+  for (double s : p.sigma_a)
+    if (s != 0.0) return true;
+  return false;
 }
 
-// `p` with one channel and no absorption.
-Huang2022Params without_absorption(Huang2022Params p) {
-  p.sigma_a = {0.0};
+// `p` at twice its absorption: its bins are the second moments of the
+// simulated photons' weights (the attenuation squared).
+Huang2022Params doubly_absorbing(Huang2022Params p) {
+  for (double& s : p.sigma_a) s *= 2.0;
   return p;
 }
 
@@ -1100,29 +1106,26 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   }
   // auto: the pilot's blocks finished one by one, the points it asks for
   // after them (the same set), each point's weight 1 / points in the end.
-  // The standard errors need each bin's probability without absorption: a
-  // channel with sigma_a 0, or the pilot's points once more without it.
-  const std::size_t bins = static_cast<std::size_t>(params_.lobes) * grid.n_theta() * grid.n_phi();
-  const int clear = clear_channel(params_);
-  std::vector<double> unabsorbed(bins);
-  if (clear < 0) {
-    const Huang2022Params q = without_absorption(params_);
-    const Paths clear_paths(q, theta_i, phi_i);
+  // The standard errors need the second moment of the simulated photons'
+  // weights in each bin: the pilot's points once more at twice the absorption.
+  std::vector<double> squares;
+  if (absorbs(params_)) {
+    const Huang2022Params q = doubly_absorbing(params_);
+    const Paths squares_paths(q, theta_i, phi_i);
     on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
-      unabsorbed = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, clear_paths)[0];
+      squares = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, squares_paths)[0];
     });
   }
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
     const std::vector<std::vector<double>> pilot =
         blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths);
     out = sum_blocks(pilot);
-    if (clear >= 0)
-      for (std::size_t b = 0; b < bins; ++b) unabsorbed[b] = out[b * C + clear];
+    if (squares.empty()) squares = out;  // no absorption: weights 0 or 1
     const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;
     const long points = auto_points(
         pilot, params_.lobes * C,
         [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
-        [&](std::size_t m) { return unabsorbed[m / C]; }, params_.quadrature_photons);
+        [&](std::size_t m) { return squares[m]; }, params_.quadrature_photons);
     if (points > kPilotPoints) {
       const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false, paths)[0];
       for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
@@ -1161,25 +1164,23 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
     return e;
   }
   // auto: the lobe energies as one bin each, then as bin_probabilities().
-  const int C = static_cast<int>(params_.sigma_a.size()), clear = clear_channel(params_);
-  std::vector<double> unabsorbed(params_.lobes);
-  if (clear < 0) {
-    const Huang2022Params q = without_absorption(params_);
-    const Paths clear_paths(q, theta_i, phi_i);
+  std::vector<double> squares;
+  if (absorbs(params_)) {
+    const Huang2022Params q = doubly_absorbing(params_);
+    const Paths squares_paths(q, theta_i, phi_i);
     on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
-      unabsorbed = sum(blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, clear_paths)).lobe;
+      squares = sum(blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, squares_paths)).lobe;
     });
   }
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
     const std::vector<HuangEnergies> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, paths);
     e = sum(pilot);
-    if (clear >= 0)
-      for (int l = 0; l < params_.lobes; ++l) unabsorbed[l] = e.lobe[static_cast<std::size_t>(l) * C + clear];
+    if (squares.empty()) squares = e.lobe;  // no absorption: weights 0 or 1
     std::vector<std::vector<double>> lobes;
     for (const HuangEnergies& x : pilot) lobes.push_back(x.lobe);
     const long points = auto_points(
         lobes, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
-        [&](std::size_t m) { return unabsorbed[m / C]; }, params_.quadrature_photons);
+        [&](std::size_t m) { return squares[m]; }, params_.quadrature_photons);
     if (points > kPilotPoints)
       add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, paths)));
     scale_energies(e, 1.0 / static_cast<double>(points));

@@ -143,17 +143,18 @@
 // times 0.10-0.26 for TT and TRT on mirror-symmetric fibers (every fiber of
 // configs/atlas.yaml: `scripts/huang2022_quadrature_error.py
 // configs/atlas.yaml --white`), about twice that without the mirror, and
-// less on absorbing fibers. So `quadrature_points` is `auto` by default:
+// about the same on absorbing fibers in their simulations' own (smaller)
+// standard errors. So `quadrature_points` is `auto` by default:
 // per incident direction, a pilot of 2^18 points estimates the error and
 // the quadrature takes as many points (a multiple of 2^18, the pilot's
 // included) as make it a tenth of the standard error of a simulation of
 // `quadrature_photons` photons (the simulation's own photons when the
 // parameters come from one; huang2022.cpp says how). On configs/atlas.yaml
-// (300k photons) a fiber's RMS bin error is then at most 0.028, 0.069,
+// (300k photons) a fiber's RMS bin error is then at most 0.015, 0.069,
 // 0.076 and 0.002 standard errors for R, TT, TRT and p >= 3
 // (`scripts/huang2022_quadrature_error.py configs/atlas.yaml --points auto
-// --reference 33554432`), with fewer points on absorbing fibers than on
-// white ones.
+// --reference 33554432`), in the simulation's own standard errors, whose
+// photons carry their attenuation (huang2022.cpp).
 // A number instead fixes the points (fits do: a fixed set keeps the
 // objective smooth in the parameters).
 #include <memory>

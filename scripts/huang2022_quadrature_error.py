@@ -5,14 +5,14 @@ errors of the atlas's own simulations.
 For each fiber of the atlas config's sweep (white fibers only with --white),
 predicts huang2022's bins at --points and at --reference points (the same
 model, its quadrature's error falling as 1/sqrt(points)), and prints per
-lobe, over the bins with at least 10 expected photons (p0 N >= 10) and for
-the worst colour channel: the mean of (error / SE)^2, its square root (the
-RMS error in standard errors) and the largest |error| / SE. SE^2 = p^2 /
-(p0 N) is the variance of a bin of probability p in the config's N-photon
-simulation (SPEC s5: the photons carry their attenuation as weight), to
-first order: p0 is the bin's probability without absorption (the
-fiber predicted with sigma_a 0), p / p0 the mean weight of its photons;
-for a white fiber SE^2 = p / N.
+lobe, over the bins holding at least 10 photons' weight (p N >= 10) and
+for the worst colour channel: the mean of (error / SE)^2, its square root
+(the RMS error in standard errors) and the largest |error| / SE. SE^2 =
+(p2 - p^2) / N is the variance of a bin of probability p in the config's
+N-photon simulation, whose photons carry their attenuation as weight (SPEC
+s5): p2, the mean of their squared weights, is the bin's probability at
+twice the absorption (the fiber predicted with sigma_a doubled); for a
+white fiber p2 = p.
 
 With `--points auto` the prediction is huang2022's default, sized for the
 config's photons (docs/MODELS.md).
@@ -89,21 +89,24 @@ def main():
         with open(path, "w") as f:
             yaml.safe_dump(fc, f)
         ref = predict(a.fiberlab, path, a.reference, os.path.join(work, f"fiber{k}_ref.h5"))
-        # [direction, lobe, theta, phi, channel]; without absorption: one channel.
-        p0 = ref if fc["fiber"].get("sigma_a") == 0.0 else predict(
-            a.fiberlab, path, a.reference // 8, os.path.join(work, f"fiber{k}_clear.h5"), ["sigma_a=0"])
+        # [direction, lobe, theta, phi, channel]; the second moments at twice the absorption.
+        with h5py.File(os.path.join(work, f"fiber{k}_ref.h5")) as f:
+            sigma_a = np.atleast_1d(f["prediction"].attrs["sigma_a"])
+        doubled = ",".join(f"{2 * x:.17g}" for x in sigma_a)
+        p2 = ref if not sigma_a.any() else predict(
+            a.fiberlab, path, a.reference // 8, os.path.join(work, f"fiber{k}_squares.h5"), [f"sigma_a={doubled}"])
         for points in a.points:
             x = predict(a.fiberlab, path, points, os.path.join(work, f"fiber{k}_test.h5"))
             row = []
             for l, name in enumerate(LOBES[:ref.shape[1]]):
                 ms, mx, any_bin = 0.0, 0.0, False
                 for c in range(ref.shape[-1]):
-                    r, y, q = ref[:, l, ..., c], x[:, l, ..., c], p0[:, l, ..., 0]
-                    m = (q * n >= 10) & (r > 0)
+                    r, y, q = ref[:, l, ..., c], x[:, l, ..., c], p2[:, l, ..., c]
+                    m = (r * n >= 10) & (q > r * r)
                     if not m.any():
                         continue
                     any_bin = True
-                    z = (y - r)[m] / np.sqrt(r[m] ** 2 / (q[m] * n))
+                    z = (y - r)[m] / np.sqrt((q[m] - r[m] ** 2) / n)
                     ms, mx = max(ms, float(np.mean(z ** 2))), max(mx, float(np.max(np.abs(z))))
                 if not any_bin:
                     row.append(f"{name} -")
