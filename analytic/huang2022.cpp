@@ -990,7 +990,10 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 // (N = quadrature_photons) whose photons carry their attenuation as weight
 // (SPEC s5): p2, the mean of their squared weights, is the bin's probability
 // at twice the absorption (the attenuation squared), which the pilot's
-// points traced once more give; on a white fiber p2 = p. (p / N, the
+// points traced once more give; on a white fiber p2 = p. Masking (smith_g1)
+// weights the photons, so p2 exceeds their mean squared weight by about the
+// masking factor (tests/compare/test_huang2022_vs_simulation.cpp: the
+// simulation's own variances are 0.89-0.95 of (p2 - p^2) / N). (p / N, the
 // variance of unweighted photons, would overstate an absorbing fiber's
 // standard errors by up to p / p2.) A pilot
 // of the set's first 2^18 points, in the 16 blocks of integrate_blocks(),
