@@ -1062,6 +1062,19 @@ Huang2022Params doubly_absorbing(Huang2022Params p) {
   return p;
 }
 
+// pilot(tracer, paths) for the fiber at twice its absorption, on the lanes
+// of `choice`; nothing where no channel absorbs (p2 = p there).
+template <class Pilot>
+std::vector<double> at_twice_the_absorption(HuangPaths choice, const Huang2022Params& p, double theta_i,
+                                            double phi_i, Pilot&& pilot) {
+  std::vector<double> out;
+  if (!absorbs(p)) return out;
+  const Huang2022Params q = doubly_absorbing(p);
+  const Paths paths(q, theta_i, phi_i);
+  on_lanes(choice, q, theta_i, phi_i, [&](const auto& tracer) { out = pilot(tracer, paths); });
+  return out;
+}
+
 // Entry m += the same entry of each block, in block order.
 std::vector<double> sum_blocks(const std::vector<std::vector<double>>& blocks) {
   std::vector<double> out(blocks[0].size(), 0.0);
@@ -1111,14 +1124,10 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   // after them (the same set), each point's weight 1 / points in the end.
   // The standard errors need the second moment of the simulated photons'
   // weights in each bin: the pilot's points once more at twice the absorption.
-  std::vector<double> squares;
-  if (absorbs(params_)) {
-    const Huang2022Params q = doubly_absorbing(params_);
-    const Paths squares_paths(q, theta_i, phi_i);
-    on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
-      squares = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, squares_paths)[0];
-    });
-  }
+  std::vector<double> squares =
+      at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
+        return blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, on)[0];
+      });
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
     const std::vector<std::vector<double>> pilot =
         blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths);
@@ -1167,14 +1176,10 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
     return e;
   }
   // auto: the lobe energies as one bin each, then as bin_probabilities().
-  std::vector<double> squares;
-  if (absorbs(params_)) {
-    const Huang2022Params q = doubly_absorbing(params_);
-    const Paths squares_paths(q, theta_i, phi_i);
-    on_lanes(paths_, q, theta_i, phi_i, [&](const auto& tracer) {
-      squares = sum(blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, squares_paths)).lobe;
-    });
-  }
+  std::vector<double> squares =
+      at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
+        return sum(blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, on)).lobe;
+      });
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
     const std::vector<HuangEnergies> pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, paths);
     e = sum(pilot);
