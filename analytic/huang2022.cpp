@@ -988,7 +988,7 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 // holding at least 10 photons' weight of (error / SE), with SE^2 = (p2 -
 // p^2) / N the variance of a bin of probability p in an N-photon simulation
 // (N = quadrature_photons) whose photons carry their attenuation as weight
-// (SPEC s5): p2, the mean of their squared weights, is the bin's probability
+// (SPEC s4; S2, s6): p2, the mean of their squared weights, is the bin's probability
 // at twice the absorption (the attenuation squared), which the pilot's
 // points traced once more give; on a white fiber p2 = p. Masking (smith_g1)
 // weights the photons, so p2 exceeds their mean squared weight by about the
@@ -1009,26 +1009,25 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 // coordinate 0 offset by half a cell of 2^18 points, whatever the total).
 constexpr long kPilotPoints = 1L << 18;
 constexpr double kTargetErrorSE = 0.1;
-constexpr double kMinExpectedPhotons = 10.0;
+constexpr double kMinPhotonsWeight = 10.0;  // bins holding at least this many photons' weight
 
 // The points quadrature_points=auto takes, from the pilot's kPointBlocks
 // block sums (each point's weight 1, the pilot's estimate their sum over
-// kPilotPoints; block k's times kPointBlocks a replicate of it): entry m of
-// every block belongs to group group(m) of `groups` (a lobe and channel), or
-// none (-1).
-template <class Group, class Squares>
-long auto_points(const std::vector<std::vector<double>>& blocks, int groups, Group&& group, Squares&& squares,
-                 double photons) {
+// kPilotPoints; block k's times kPointBlocks a replicate of it) and the
+// pilot's sums at twice the absorption (`squares`, the same entries): entry
+// m belongs to group group(m) of `groups` (a lobe and channel).
+template <class Group>
+long auto_points(const std::vector<std::vector<double>>& blocks, const std::vector<double>& squares, int groups,
+                 Group&& group, double photons) {
   constexpr double K = kPointBlocks, kShare = 1.0 / kPilotPoints;
   std::vector<double> sum(groups, 0.0);
   std::vector<int> count(groups, 0);
   for (std::size_t m = 0; m < blocks[0].size(); ++m) {
-    const int g = group(m);
-    if (g < 0) continue;
     double mean = 0.0;
     for (const std::vector<double>& b : blocks) mean += b[m] * kShare;
-    const double se2 = (squares(m) * kShare - mean * mean) / photons;
-    if (!(mean * photons >= kMinExpectedPhotons) || !(se2 > 0.0)) continue;
+    const double se2 = (squares[m] * kShare - mean * mean) / photons;
+    if (!(mean * photons >= kMinPhotonsWeight) || !(se2 > 0.0)) continue;
+    const int g = group(m);
     double ss = 0.0;
     for (const std::vector<double>& b : blocks) ss += (K * b[m] * kShare - mean) * (K * b[m] * kShare - mean);
     sum[g] += ss / (K * (K - 1.0)) / se2;  // (error / SE)^2 at the pilot
@@ -1135,9 +1134,9 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
     if (squares.empty()) squares = out;  // no absorption: weights 0 or 1
     const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;
     const long points = auto_points(
-        pilot, params_.lobes * C,
+        pilot, squares, params_.lobes * C,
         [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
-        [&](std::size_t m) { return squares[m]; }, params_.quadrature_photons);
+        params_.quadrature_photons);
     if (points > kPilotPoints) {
       const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false, paths)[0];
       for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
@@ -1187,8 +1186,8 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
     std::vector<std::vector<double>> lobes;
     for (const HuangEnergies& x : pilot) lobes.push_back(x.lobe);
     const long points = auto_points(
-        lobes, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
-        [&](std::size_t m) { return squares[m]; }, params_.quadrature_photons);
+        lobes, squares, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
+        params_.quadrature_photons);
     if (points > kPilotPoints)
       add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, paths)));
     scale_energies(e, 1.0 / static_cast<double>(points));
@@ -1423,7 +1422,7 @@ ModelInfo huang2022_info() {
   ParamSpec photons = number_param(
       "quadrature_photons",
       "the photons whose standard error quadrature_points=auto sizes the quadrature for (a tenth of it)", "", "300000",
-      "a number >= 1", &P::quadrature_photons, [](double x) { return x >= 1.0 && x <= 1e15; });
+      "a finite number >= 1", &P::quadrature_photons, [](double x) { return std::isfinite(x) && x >= 1.0; });
   photons.from_fiber = "photons (the simulation's, per incident direction)";
   // Free parameters (what `fiberlab atlas` fits): the roughness and the tilt, in their ranges.
   m.params = {eta_param<P>(), sigma_a_param<P>(), fittable(roughness, 0.0, 1.0), fittable(tilt, -45.0 + 1e-6, 45.0 - 1e-6),

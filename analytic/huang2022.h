@@ -241,7 +241,9 @@ class Huang2022 : public Model {
   void set_density_points(long n) { density_points_ = n; }
   // Which paths bin_probabilities() and energies() take: the float SIMD
   // lanes (the default), the same lanes in double, or the scalar paths that
-  // density() uses (huang2022_lanes.h): tests compare them.
+  // density() uses (huang2022_lanes.h): tests compare them. The scalar
+  // paths serve a fixed quadrature_points only; auto's pilot runs in the
+  // lanes' blocks, so with Scalar it takes the double lanes.
   void set_paths(HuangPaths paths) { paths_ = paths; }
 
  private:

@@ -10,7 +10,7 @@ for the worst colour channel: the mean of (error / SE)^2, its square root
 (the RMS error in standard errors) and the largest |error| / SE. SE^2 =
 (p2 - p^2) / N is the variance of a bin of probability p in the config's
 N-photon simulation, whose photons carry their attenuation as weight (SPEC
-s5): p2, the mean of their squared weights, is the bin's probability at
+s4): p2, the mean of their squared weights, is the bin's probability at
 twice the absorption (the fiber predicted with sigma_a doubled); for a
 white fiber p2 = p.
 

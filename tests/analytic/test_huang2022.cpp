@@ -360,6 +360,7 @@ TEST(Huang2022, ParameterTable) {
   EXPECT_THROW(apply_setting("huang2022", p, "quadrature_points=automatic"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "quadrature_photons=0"), Error);
   EXPECT_THROW(apply_setting("huang2022", p, "quadrature_photons=nan"), Error);
+  EXPECT_THROW(apply_setting("huang2022", p, "quadrature_photons=inf"), Error);
   apply_setting("huang2022", p, "quadrature_points=auto");
   EXPECT_EQ(h.quadrature_points, kAutoQuadraturePoints);
   apply_setting("huang2022", p, "quadrature_points=4096");

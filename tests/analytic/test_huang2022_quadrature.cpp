@@ -4,7 +4,7 @@
 // one (sigma_a 1 and 2 per radius), at theta_i 45 deg, against 2^25
 // points (at least 3x what auto takes here), the mean over bins with p N >=
 // 10 of (bin error)^2 / ((p2 - p^2) / N), the simulated bin's variance (its
-// photons carry their attenuation as weight, SPEC s5; p2, the second moment
+// photons carry their attenuation as weight, SPEC s4; p2, the second moment
 // of their weights, is the bin at twice the absorption; p on the white
 // fiber), is below 0.01 for R, TT
 // and TRT (an RMS error below 0.1 standard errors, auto's target; the

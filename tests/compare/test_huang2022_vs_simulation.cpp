@@ -65,7 +65,7 @@ TEST(Huang2022VsSimulation, TiltedEllipseNeedsTheProjectedWidthsFlux) {
 // quadrature_points=auto sizes huang2022's quadrature for a simulation's
 // standard errors, predicting each bin's variance as (p2 - p^2) / N: p2, the
 // second moment of the photons' weights (they carry their attenuation, SPEC
-// s5), is the bin at twice the absorption. Checked against the simulator's
+// s4), is the bin at twice the absorption. Checked against the simulator's
 // own variances (its S2) on the fiber the model describes (ggx 0.3 with
 // smith_g1, untilted circle: Huang's ground truth), brown-like (sigma_a 0.4
 // and 1.2), theta_i 45 deg, 300k photons: over the R and TT bins holding >=
