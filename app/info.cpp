@@ -32,9 +32,12 @@ FileDescription result_info(const std::string& path) {
                    s.fiber.eccentricity, rad_to_deg(s.fiber.scale_tilt), fmt::join(s.fiber.sigma_a, ", "));
   t += fmt::format("roughness: {}\n", roughness::describe(s.fiber.roughness));
   t += fmt::format("tally: {} x {} bins ({} theta), {} lobes, {} channels; max_segments {}, polarization {}, "
-                   "estimator {}\n",
+                   "estimator {}{}\n",
                    r.grid.n_theta(), r.grid.n_phi(), to_string(r.grid.theta_binning), r.lobes, r.channels,
-                   s.max_segments, sim::to_string(s.polarization), sim::to_string(s.estimator));
+                   s.max_segments, sim::to_string(s.polarization), sim::to_string(s.estimator),
+                   s.estimator == sim::Estimator::ExpectedValue
+                       ? fmt::format(" (exit_normals {})", fmt::join(s.exit_normals, ", "))
+                       : std::string());
   return d;
 }
 

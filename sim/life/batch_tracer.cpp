@@ -207,6 +207,42 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   f.n = n + k;
 }
 
+// One extra normal's exits of a split (direction d, weight w) for the lanes
+// `lanes`: rows on the photons' way, like their scored exit's but for the
+// direction, the weight and no roulette term.
+template <class Light>
+void hand_over_split_exits(const life::PhotonState<Lanes, Light>& s, const life::Vec3Of<Lanes>& d, const Lanes& w,
+                           const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
+                           const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+  using life::pack_store;
+  if (lanes == 0) return;
+  const int n = f.n, k = std::popcount(lanes);
+  pack_store(d.x, lanes, f.dx + n);
+  pack_store(d.y, lanes, f.dy + n);
+  pack_store(d.z, lanes, f.dz + n);
+  pack_store(s.scored.path, lanes, f.path + n);
+  pack_store(w, lanes, f.weight + n);
+  pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
+  const std::uint64_t scattered = life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
+  pack_store(phi_i, lanes, f.phi_i + n);
+  pack_store(photon, lanes, f.photon + n);
+  alignas(64) std::uint64_t slots[W];
+  pack_store(slot, lanes, slots);
+  alignas(64) double segments[W];
+  pack_store(s.scored.segments, lanes, segments);
+  for (int j = 0; j < k; ++j) {
+    f.segments[n + j] = static_cast<int>(segments[j]);
+    f.roulette[n + j] = 0.0;
+    f.exited[n + j] = true;
+    f.lost[n + j] = false;
+    f.ended[n + j] = false;
+    f.last[n + j] = false;
+    f.scattered[n + j] = (scattered >> j) & 1;
+    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
+  }
+  f.n = n + k;
+}
+
 // The exits that the lanes `lanes` scored by expected value this step, and
 // the weight Russian roulette created or destroyed there (PhotonState::scored),
 // appended to the block f (sim/life/finished_photons.h): rows on the
@@ -215,18 +251,30 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
 // exit direction draws
 // from the stream scored_exit_stream derives (sim/life/tracer.h), as the
 // reference Tracer does.
+// With exit splitting (sim/life/exit_splitting.h) the extra normals' exits
+// come first, a row per lane that has one, then every lane's row for the
+// event's own normal (with the roulette term, and the end of a photon that
+// roulette ended), as the reference Tracer lists them. Returns where those
+// last rows start.
 template <class Model, class Light>
-void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>& s,
-                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
-                      const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+int hand_over_scored(const life::LifeConfig& c, const Model& model, const life::PhotonState<Lanes, Light>& s,
+                     const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
+                     const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
   if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
+  life::SplitExits<W> split;
+  life::split_scored_exits(c, model, s.scored, s.rng, split);
+  for (int e = 1; e < split.n; ++e) {
+    const Lanes w = load<Lanes>(split.weight[e]);
+    hand_over_split_exits(s, {load<Lanes>(split.dx[e]), load<Lanes>(split.dy[e]), load<Lanes>(split.dz[e])}, w,
+                          phi_i, photon, slot, lanes & life::lane_bits(w > Lanes(0.0)), f);
+  }
   const int n = f.n, k = std::popcount(lanes);
   pack_store(s.scored.d.x, lanes, f.dx + n);
   pack_store(s.scored.d.y, lanes, f.dy + n);
   pack_store(s.scored.d.z, lanes, f.dz + n);
   pack_store(s.scored.path, lanes, f.path + n);
-  pack_store(s.scored.weight, lanes, f.weight + n);
+  pack_store(load<Lanes>(split.weight[0]), lanes, f.weight + n);
   pack_store(s.scored.roulette, lanes, f.roulette + n);
   const std::uint64_t exited =
       life::pack_bits(life::lane_bits(s.scored.weight > Lanes(0.0)), lanes);
@@ -255,6 +303,7 @@ void hand_over_scored(const Model& model, const life::PhotonState<Lanes, Light>&
       return scored_exit_stream(a, b, c, d);
     });
   f.n = n + k;
+  return n;
 }
 
 // The losses of the photons of a vector whose lanes `lanes` finished this
@@ -386,6 +435,8 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
                                   ? FinishedPhotons::kCapacity - 2 * (kPoolLanes + W)
                                   : FinishedPhotons::kCapacity / 2 - (kPoolLanes + W);
   static_assert(kFlushAbove >= kPoolLanes - W, "blocks of at least about a pool of photons");
+  static_assert((kMaxExitNormals + 2) * W <= FinishedPhotons::kCapacity,
+                "a vector's split exits, ends and scratch fit in an empty block");
 
   // Photons [next, end) of the current run are still to launch.
   std::uint64_t next = 0, end = 0;
@@ -428,6 +479,11 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
     // tallies are exact integer sums.
     int kept = 0;
     for (int o = 0; o < n_active; o += W) {
+      // Exit splitting hands over up to most_exit_normals rows per lane:
+      // room for them, the photons' ends and a vector of scratch.
+      if (config_.most_exit_normals > 1 &&
+          done->n + (config_.most_exit_normals + 2) * W > FinishedPhotons::kCapacity)
+        flush();
       const MaskOf<Lanes> live = (iota + Lanes(o)) < Lanes(n_active);
       auto s = pool.load_state<Lanes, Light>(o);
       if constexpr (kLosses) s.losses = {load<Lanes>(pool.col[Pool::kLossList] + o), pool.loss_lists};
@@ -449,8 +505,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         const std::uint64_t ended = life::lane_bits(live & (s.code == Lanes(double(life::kEnded))));
         end_rows = finished & ~ended;
         if (scored != 0) {
-          const int n_before = done->n;
-          hand_over_scored(model, s, phi_lanes, photon, slot, scored, *done);
+          const int n_before = hand_over_scored(config_, model, s, phi_lanes, photon, slot, scored, *done);
           if constexpr (kLosses)
             if (ended != 0) hand_over_losses_of_ended(s.losses.slot, scored, ended, n_before, pool, *done);
         }

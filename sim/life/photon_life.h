@@ -18,6 +18,7 @@
 // life returns the total internal path length and the scorer turns it into a
 // Beer-Lambert weight per channel; `weight` is the model's throughput factor
 // (1 unless a roughness model's event_weight says otherwise).
+#include <algorithm>
 #include <type_traits>
 
 #include "sim/life/ellipse_cross_section.h"
@@ -65,7 +66,12 @@ struct LifeConfig {
       : ellipse(s.fiber.eccentricity), eta(s.fiber.eta), cos_tilt(std::cos(s.fiber.scale_tilt)),
         sin_tilt(std::sin(s.fiber.scale_tilt)), max_segments(s.max_segments),
         max_events(s.max_events_per_point), medulla(medulla_config(s)),
-        expected_value(s.estimator == Estimator::ExpectedValue) {}
+        expected_value(s.estimator == Estimator::ExpectedValue) {
+    for (int p = 0; p < kExitNormalsLobes; ++p) {
+      exit_normals[p] = expected_value ? s.exit_normals_for(p) : 1;
+      most_exit_normals = std::max(most_exit_normals, exit_normals[p]);
+    }
+  }
   EllipseCrossSection ellipse;
   double eta;
   double cos_tilt, sin_tilt;  // cuticle tilt towards the root (SPEC section 2)
@@ -79,6 +85,11 @@ struct LifeConfig {
     return {e.r_v(), e.r_w(), m.radius, m.sigma_s, m.g, s.fiber.eta, m.eta, s.max_segments};
   }
   bool expected_value;  // expected-value scoring of exits, with Russian roulette (kRouletteBelow)
+  // Settings::exit_normals by lobe p (the last for every larger p), and the
+  // largest (1: no exit splitting; sim/life/exit_splitting.h).
+  static constexpr int kExitNormalsLobes = static_cast<int>(kMaxExitNormalsEntries);
+  int exit_normals[kExitNormalsLobes];
+  int most_exit_normals = 1;
 };
 
 // The exit a photon scored at its last interface event by expected value
@@ -95,6 +106,13 @@ struct ScoredExit {
   T medulla_path;  // 3D path length inside the medulla so far
   T scatters;      // scattering events in the medulla so far
   T roulette;      // signed weight of this step's Russian roulette, before absorption
+  // The event that scored it, for exit splitting (sim/life/exit_splitting.h):
+  // the photon's direction before it, the boundary point, its side (1
+  // inside), and the scored branch's share of the weight (its leaving
+  // probability times its masking factor; 0 where none was scored).
+  Vec3Of<T> d_in;
+  T px, py, inside;
+  T share;
 };
 
 template <class T, class Light>
@@ -122,7 +140,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          zero, zero, {zero, d, zero, zero, zero, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -145,20 +163,44 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
                           const BoundaryFrame<T>& frame, const Vec3Of<T>& m,
                           const MaskOf<T>& inside) {
   T exit_weight = select(r.scored, s.weight * r.p_leave, T(0.0));
+  T share = select(r.scored, r.p_leave, T(0.0));
   if constexpr (HasEventWeight<Model, T>) {
     // The leaving branch refracts when the photon is inside.
     const EventWeight<T> w =
         model.event_weight(EventGeometry<T>{s.d, r.leave_direction, m, frame, inside}, r.scored, s.rng);
     s.losses.add(r.scored & (w.factor < T(1.0)), exit_weight * (T(1.0) - w.factor), s.path);
     exit_weight = select(r.scored, select(w.lost, T(0.0), exit_weight * w.factor), T(0.0));
+    share = select(r.scored, select(w.lost, T(0.0), share * w.factor), T(0.0));
   }
   s.scored.weight = exit_weight;
+  s.scored.share = share;
+  s.scored.d_in = s.d;
+  s.scored.px = s.px;
+  s.scored.py = s.py;
+  s.scored.inside = ones<T>(inside);
   s.scored.d = r.leave_direction;
   s.scored.path = s.path;
   s.scored.segments = s.segments;
   s.scored.medulla_path = s.medulla_path;
   s.scored.scatters = s.scatters;
   s.weight = select(r.scored, s.weight * (T(1.0) - r.p_leave), s.weight);
+}
+
+// The macro normals at a boundary point of untilted outward normal n0 as a
+// photon on the side `inside` sees them: the tilted normal
+// n_s = cos(alpha) n0 - sin(alpha) u, facing the photon.
+template <class T>
+BoundaryFrame<T> boundary_frame(const LifeConfig& c, const Vec3Of<T>& n0, const MaskOf<T>& inside) {
+  const T side = select(inside, T(-1.0), T(1.0));
+  const T sin_n = side * T(-c.sin_tilt);
+  return {Vec3Of<T>(sin_n, side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z), side * n0, sin_n,
+          T(c.cos_tilt)};
+}
+
+// The refractive indices across the boundary for a photon on the side `inside`.
+template <class T>
+InterfaceIndex<T> interface_index(const LifeConfig& c, const MaskOf<T>& inside) {
+  return {select(inside, T(1.0 / c.eta), T(c.eta)), select(inside, T(c.eta), T(1.0 / c.eta))};
 }
 
 // One interface event for the photons in `live` at a boundary point (SPEC
@@ -172,16 +214,10 @@ MaskOf<T> interface_event(const LifeConfig& c, const Model& model, PhotonState<T
                      const MaskOf<T>& live, LifeCounts<T>& counts, int rounds) {
   const MaskOf<T> inside = s.inside != T(0.0);
   const Vec3Of<T> n0 = c.ellipse.normal_at(s.px, s.py);
-  // The tilted normal n_s = cos(alpha) n0 - sin(alpha) u, on the photon's side.
-  const T side = select(inside, T(-1.0), T(1.0));
-  const T sin_n = side * T(-c.sin_tilt);
-  const BoundaryFrame<T> frame{
-      Vec3Of<T>(sin_n, side * T(c.cos_tilt) * n0.y, side * T(c.cos_tilt) * n0.z), side * n0,
-      sin_n, T(c.cos_tilt)};
+  const BoundaryFrame<T> frame = boundary_frame(c, n0, inside);
   const FacetDraw<T> f = model.draw_normal(s.d, frame, live, s.rng, s.tries, counts, rounds);
   const MaskOf<T> act = f.ready;  // never failed too (sim/roughness/roughness_model.h)
-  const InterfaceIndex<T> index{select(inside, T(1.0 / c.eta), T(c.eta)),
-                                select(inside, T(c.eta), T(1.0 / c.eta))};
+  const InterfaceIndex<T> index = interface_index<T>(c, inside);
   EventResult<T> r;
   if constexpr (kExpectedValue) {
     r = s.light.interact(s.d, f.m, index, act, s.rng, ExitScoring<T>{act, inside, n0});

@@ -35,7 +35,15 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
         PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
         d = exit_direction_of(model, d, p, blur);
       }
-      scored.push_back({d, p, s.scored.path, s.scored.weight, s.scored.medulla_path,
+      // Exit splitting: the extra normals' exits first, the event's own
+      // (with the roulette term) last, as the batched tracer hands them over.
+      life::SplitExits<1> split;
+      life::split_scored_exits(config_, model, s.scored, s.rng, split);
+      for (int k = 1; k < split.n; ++k)
+        if (split.weight[k][0] > 0.0)
+          scored.push_back({Vec3(split.dx[k][0], split.dy[k][0], split.dz[k][0]), p, s.scored.path,
+                            split.weight[k][0], s.scored.medulla_path, s.scored.scatters > 0.0, 0.0});
+      scored.push_back({d, p, s.scored.path, split.weight[0][0], s.scored.medulla_path,
                         s.scored.scatters > 0.0, s.scored.roulette});
     }
   }

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "common/fiber_frame.h"
+#include "sim/life/exit_splitting.h"
 #include "sim/life/photon_life.h"
 #include "sim/life/random.h"
 #include "sim/roughness/roughness_models.h"

@@ -126,6 +126,17 @@ void read_tally(const Reader& r, const YAML::Node& parent, TallySettings& t) {
   if (n["lobes"]) t.lobes = r.small_integer(n["lobes"], "tally.lobes", 1);
 }
 
+// exit_normals: an integer in [1, kMaxExitNormals], or a list of them by lobe p.
+std::vector<int> read_exit_normals(const Reader& r, const YAML::Node& n) {
+  const std::string rule = fmt::format("an integer in [1, {}], or a list of at most {} of them by lobe p",
+                                       kMaxExitNormals, kMaxExitNormalsEntries);
+  const Rule each{rule, [](double k) { return k >= 1 && k <= kMaxExitNormals && k == std::floor(k); }};
+  if (n.IsSequence() && (n.size() == 0 || n.size() > kMaxExitNormalsEntries))
+    r.bad("exit_normals", n, fmt::format("has {} entries", n.size()), rule);
+  const std::vector<double> k = r.numbers(n, "exit_normals", each, true);
+  return std::vector<int>(k.begin(), k.end());
+}
+
 void read_top_level(const Reader& r, const YAML::Node& n, Settings& s) {
   if (n["photons"]) s.photons = r.integer(n["photons"], "photons", 1, kU64Max);
   if (n["seed"]) s.seed = r.integer(n["seed"], "seed", 0, kU64Max);
@@ -137,6 +148,30 @@ void read_top_level(const Reader& r, const YAML::Node& n, Settings& s) {
     s.polarization = static_cast<Polarization>(r.word(n["polarization"], "polarization", kPolarizations));
   if (n["estimator"])
     s.estimator = static_cast<Estimator>(r.word(n["estimator"], "estimator", kEstimators));
+  if (n["exit_normals"]) s.exit_normals = read_exit_normals(r, n["exit_normals"]);
+}
+
+// Whether the fiber's roughness model draws a random normal at each event
+// (what exit_normals spreads a scored exit over).
+bool draws_random_normals(const Roughness& r) {
+  if (const auto* g = std::get_if<roughness::Gaussian>(&r)) return g->beta_long != 0.0 || g->beta_azim != 0.0;
+  return std::holds_alternative<roughness::Beckmann>(r) || std::holds_alternative<roughness::Ggx>(r);
+}
+
+// exit_normals > 1 spreads an exit scored by expected value over normals of
+// the event's roughness, with the scalar leaving probability F.
+void check_exit_normals(const Reader& r, const Settings& s) {
+  if (std::all_of(s.exit_normals.begin(), s.exit_normals.end(), [](int k) { return k == 1; })) return;
+  const std::string value = list_text(std::vector<double>(s.exit_normals.begin(), s.exit_normals.end()), number_text);
+  if (s.estimator != Estimator::ExpectedValue)
+    r.fail(fmt::format("exit_normals = {} needs estimator: expected_value (it spreads the exits that estimator "
+                       "scores; with estimator: {} every entry must be 1)", value, to_string(s.estimator)));
+  if (s.polarization != Polarization::Scalar)
+    r.fail(fmt::format("exit_normals = {} needs polarization: scalar (with stokes every entry must be 1)", value));
+  if (!draws_random_normals(s.fiber.roughness))
+    r.fail(fmt::format("exit_normals = {} needs a roughness whose normals are random (gaussian with beta > 0, "
+                       "beckmann or ggx; with roughness.model {} every entry must be 1)",
+                       value, roughness::name(s.fiber.roughness)));
 }
 
 // The tally holds S1 and S2 doubles for every incidence, lobe, bin and channel.
@@ -183,7 +218,7 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   const YAML::Node root =
       r.section(doc, "",
                 {"photons", "seed", "output", "fiber", "roughness", "source", "tally",
-                 "max_segments", "max_events_per_point", "polarization", "estimator"});
+                 "max_segments", "max_events_per_point", "polarization", "estimator", "exit_normals"});
   Settings s;
   s.output = default_output(origin);
   read_top_level(r, root, s);
@@ -192,6 +227,7 @@ Settings parse_settings_yaml(const std::string& yaml_text, const std::string& or
   read_tally(r, root, s.tally);
   check_tally_size(r, s);
   check_photon_total(r, s);
+  check_exit_normals(r, s);
   return s;
 }
 
@@ -252,13 +288,15 @@ std::string to_yaml(const Settings& s) {
       "max_segments: {}\n"
       "max_events_per_point: {}\n"
       "polarization: {}\n"
-      "estimator: {}\n",
+      "estimator: {}\n"
+      "exit_normals: {}\n",
       s.photons, s.seed, quoted(s.output), fiber_yaml(s.fiber),
       list_text(s.source.theta_i, degrees_text), phi_i, kHSampling[s.source.h_stratified ? 0 : 1],
       s.tally.n_theta, s.tally.n_phi,
       kThetaBins[s.tally.theta_bins == ThetaBinning::Uniform ? 0 : 1], s.tally.lobes,
       s.max_segments, s.max_events_per_point, to_string(s.polarization),
-      to_string(s.estimator));
+      to_string(s.estimator),
+      list_text(std::vector<double>(s.exit_normals.begin(), s.exit_normals.end()), number_text));
 }
 
 std::string to_string(Polarization p) { return kPolarizations[static_cast<int>(p)]; }

@@ -1,6 +1,7 @@
 #pragma once
 // What to run: the resolved simulation configuration (SPEC section 11).
 // All angles here are in radians; the YAML file has degrees.
+#include <algorithm>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -21,6 +22,12 @@ enum class Polarization { Scalar, Stokes };
 // (Russian roulette after an event once the weight is low:
 // life::kRouletteBelow, sim/life/photon_life.h).
 enum class Estimator { Analog, ExpectedValue };
+
+// Settings::exit_normals: at most this many normals per scored exit (the
+// batched tracer hands over a vector's split exits within one block:
+// sim/life/batch_tracer.cpp).
+inline constexpr int kMaxExitNormals = 32;
+inline constexpr std::size_t kMaxExitNormalsEntries = 16;  // entries, by lobe p
 
 struct SourceSettings {
   std::vector<double> theta_i{0.0};  // radians, each in (-pi/2, pi/2)
@@ -56,6 +63,15 @@ struct Settings {
   // analog: the one with more error per CPU second on bench/configs cases b
   // and c (bench/figure_of_merit.py; docs/PHYSICS.md "Estimator").
   Estimator estimator = Estimator::Analog;
+  // Exit splitting under `expected_value` (docs/PHYSICS.md "Estimator"):
+  // at an event whose leaving branch is scored, the number of microfacet
+  // normals (the event's own and exit_normals - 1 more) over which the
+  // scored weight is spread, by lobe p (the last entry for every larger p).
+  // {1}: no splitting.
+  std::vector<int> exit_normals{1};
+  int exit_normals_for(int p) const {
+    return exit_normals[std::min<std::size_t>(static_cast<std::size_t>(p), exit_normals.size() - 1)];
+  }
 
   // The incident configurations: every theta_i combined with every phi_i
   // (theta-major order). phi_i is NaN when uniform.

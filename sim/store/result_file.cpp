@@ -27,6 +27,7 @@ void write_parameters(h5::File& f, const Settings& s) {
   f.set_attr("/source", "max_segments", static_cast<std::int64_t>(s.max_segments));
   f.set_attr("/source", "polarization", to_string(s.polarization));
   f.set_attr("/source", "estimator", to_string(s.estimator));
+  f.set_attr("/source", "exit_normals", std::vector<double>(s.exit_normals.begin(), s.exit_normals.end()));
   f.set_attr("/source", "phi_i_uniform", static_cast<std::int64_t>(s.source.phi_i_uniform));
 }
 
