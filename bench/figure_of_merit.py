@@ -3,11 +3,14 @@
 
     /usr/bin/python3 bench/figure_of_merit.py [--before BIN] [--after BIN]
         [--cases b c ggx] [--repeats 3] [--threads 2] [--photons N]
+        [--exit-normals LIST [LIST ...]]
 
 For each case it runs, alternately and --repeats times over, the binary
 --before (its default estimator) and the binary --after with
 `estimator: analog` and with `estimator: expected_value` added to the
-config, and prints per lobe the figure of merit
+config (and, for each --exit-normals LIST such as "[16, 1]", with
+`estimator: expected_value` and `exit_normals: LIST`), and prints per lobe
+the figure of merit
 
     FOM = 1 / (sum over the lobe's bins and channels of SE_b^2  x  CPU seconds)
 
@@ -80,9 +83,14 @@ def main():
     ap.add_argument("--repeats", type=int, default=3)
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--photons", type=int, default=0, help="override each config's photons")
+    ap.add_argument("--exit-normals", nargs="+", default=[], metavar="LIST",
+                    help='expected_value variants with exit_normals: LIST (e.g. "[16, 1]" or 8)')
     args = ap.parse_args()
     variants = [("before", args.before, ""), ("analog", args.after, "estimator: analog\n"),
                 ("expected_value", args.after, "estimator: expected_value\n")]
+    for k in args.exit_normals:
+        variants.append(("ev " + k.replace(" ", ""), args.after,
+                         "estimator: expected_value\nexit_normals: %s\n" % k))
     with tempfile.TemporaryDirectory() as work:
         for case in args.cases:
             base = open(os.path.join(ROOT, "bench", "configs", "case_%s.yaml" % case)).read()
@@ -94,7 +102,7 @@ def main():
             print("case %s (%s photons, %d threads, median of %d alternating runs)"
                   % (case, int(results["before"][0][2]), args.threads, args.repeats))
             header = "%-8s" % "lobe" + "".join("%16s" % name for name, _, _ in variants) + \
-                "%12s%12s" % ("analog/b", "ev/before")
+                "".join("%12s" % (name.split()[-1][:11] + "/b") for name, _, _ in variants[1:])
             print(header)
             fom = {}
             for name, _, _ in variants:
@@ -104,7 +112,7 @@ def main():
                 row = "%-8s" % lobe_name(p, lobes)
                 row += "".join("%16.4g" % fom[name][p] for name, _, _ in variants)
                 b = fom["before"][p]
-                row += "%12.3g%12.3g" % (fom["analog"][p] / b, fom["expected_value"][p] / b)
+                row += "".join("%12.3g" % (fom[name][p] / b) for name, _, _ in variants[1:])
                 print(row)
             rate = {name: statistics.median(r[2] / r[0] / 1.0 for r in results[name])
                     for name, _, _ in variants}

@@ -225,7 +225,6 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   for (int l = 0; l < W; ++l) out.n = std::max(out.n, static_cast<int>(normals[l]));
   for (int k = 1; k < out.n; ++k)
     for (int l = 0; l < W; ++l) out.weight[k][l] = 0.0;
-  double extra[W] = {};  // each lane's extra shares, summed in the order of k
   ExtraNormalQueue<W> queue(normals);
   while (queue.template refill<T>(event, hash)) {
     const MaskOf<T> busy = queue.template busy<T>();
@@ -253,15 +252,18 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
       out.dy[k][l] = oy[j];
       out.dz[k][l] = oz[j];
       out.weight[k][l] = os[j];  // 0 where the draw gave up
-      extra[l] += os[j];
       queue.is_busy[j] = false;
     }
   }
-  // Normal k's weight w s_1 s_k / S (S >= s_1 > 0 where a lane scored); a
-  // lane with one normal keeps its weight as it is.
+  // Normal k's weight w s_1 s_k / S (S >= s_1 > 0 where a lane scored; the
+  // shares summed in the order of k, whatever order the pairs were drawn
+  // in, so that S does not depend on the photon's neighbours in the
+  // vector); a lane with one normal keeps its weight as it is.
   for (int l = 0; l < W; ++l) {
     if (normals[l] < 2.0) continue;
-    const double scale = out.weight[0][l] / (share[l] + extra[l]);
+    double extra = 0.0;
+    for (int k = 1; k < static_cast<int>(normals[l]); ++k) extra += out.weight[k][l];
+    const double scale = out.weight[0][l] / (share[l] + extra);
     out.weight[0][l] = scale * share[l];
     for (int k = 1; k < static_cast<int>(normals[l]); ++k) out.weight[k][l] *= scale;
   }
