@@ -18,7 +18,7 @@
 // - The photon's weight and path are those without splitting: the total it
 //   scores at the event is still w s_1, it goes on with w (1 - P_1) along
 //   its own normal, so the ledger closes per photon as before. The extra
-//   normals come from a stream derived from the photon's (split_stream), not
+//   normals come from streams derived from the photon's (extra_normal_stream), not
 //   from its own.
 // - What it buys: where an event's roughness spreads its exit over many
 //   bins, the variance of those bins falls by up to K; the cost is K - 1
