@@ -207,21 +207,24 @@ void hand_over(const Model& model, const life::PhotonState<Lanes, Light>& s, con
   f.n = n + k;
 }
 
-// One extra normal's exits of a split (direction d, weight w) for the lanes
-// `lanes`: rows on the photons' way, like their scored exit's but for the
-// direction, the weight and no roulette term.
+// Rows on the photons' way at the lanes `lanes`' scored event (ScoredExit:
+// its path, lobe and medulla numbers) with direction d, weight w (an exit
+// where w > 0) and the roulette term `roulette`, appended to the block f;
+// the lanes in `ended` (bits by lane) end there.
 template <class Light>
-void hand_over_split_exits(const life::PhotonState<Lanes, Light>& s, const life::Vec3Of<Lanes>& d, const Lanes& w,
-                           const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
-                           const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+void hand_over_event_rows(const life::PhotonState<Lanes, Light>& s, const life::Vec3Of<Lanes>& d, const Lanes& w,
+                          const Lanes& roulette, std::uint64_t ended, const Lanes& phi_i,
+                          const life::BitsOf<Lanes>& photon, const life::BitsOf<Lanes>& slot,
+                          std::uint64_t lanes, FinishedPhotons& f) {
   using life::pack_store;
-  if (lanes == 0) return;
   const int n = f.n, k = std::popcount(lanes);
   pack_store(d.x, lanes, f.dx + n);
   pack_store(d.y, lanes, f.dy + n);
   pack_store(d.z, lanes, f.dz + n);
   pack_store(s.scored.path, lanes, f.path + n);
   pack_store(w, lanes, f.weight + n);
+  pack_store(roulette, lanes, f.roulette + n);
+  const std::uint64_t exited = life::pack_bits(life::lane_bits(w > Lanes(0.0)), lanes);
   pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
   const std::uint64_t scattered = life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
   pack_store(phi_i, lanes, f.phi_i + n);
@@ -230,13 +233,13 @@ void hand_over_split_exits(const life::PhotonState<Lanes, Light>& s, const life:
   pack_store(slot, lanes, slots);
   alignas(64) double segments[W];
   pack_store(s.scored.segments, lanes, segments);
+  const std::uint64_t ended_rows = life::pack_bits(ended, lanes);
   for (int j = 0; j < k; ++j) {
     f.segments[n + j] = static_cast<int>(segments[j]);
-    f.roulette[n + j] = 0.0;
-    f.exited[n + j] = true;
+    f.exited[n + j] = (exited >> j) & 1;
     f.lost[n + j] = false;
-    f.ended[n + j] = false;
-    f.last[n + j] = false;
+    f.ended[n + j] = (ended_rows >> j) & 1;
+    f.last[n + j] = (ended_rows >> j) & 1;
     f.scattered[n + j] = (scattered >> j) & 1;
     f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
   }
@@ -260,49 +263,21 @@ template <class Model, class Light>
 int hand_over_scored(const life::LifeConfig& c, const Model& model, const life::PhotonState<Lanes, Light>& s,
                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
                      const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
-  using life::pack_store;
   if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
   life::SplitExits<W> split;
   life::split_scored_exits(c, model, s.scored, s.rng, split);
   for (int e = 1; e < split.n; ++e) {
     const Lanes w = load<Lanes>(split.weight[e]);
-    hand_over_split_exits(s, {load<Lanes>(split.dx[e]), load<Lanes>(split.dy[e]), load<Lanes>(split.dz[e])}, w,
-                          phi_i, photon, slot, lanes & life::lane_bits(w > Lanes(0.0)), f);
+    hand_over_event_rows(s, {load<Lanes>(split.dx[e]), load<Lanes>(split.dy[e]), load<Lanes>(split.dz[e])}, w,
+                         Lanes(0.0), 0, phi_i, photon, slot, lanes & life::lane_bits(w > Lanes(0.0)), f);
   }
   const int n = f.n, k = std::popcount(lanes);
-  pack_store(s.scored.d.x, lanes, f.dx + n);
-  pack_store(s.scored.d.y, lanes, f.dy + n);
-  pack_store(s.scored.d.z, lanes, f.dz + n);
-  pack_store(s.scored.path, lanes, f.path + n);
-  pack_store(load<Lanes>(split.weight[0]), lanes, f.weight + n);
-  pack_store(s.scored.roulette, lanes, f.roulette + n);
-  const std::uint64_t exited =
-      life::pack_bits(life::lane_bits(s.scored.weight > Lanes(0.0)), lanes);
-  pack_store(s.scored.medulla_path, lanes, f.medulla_path + n);
-  const std::uint64_t scattered =
-      life::pack_bits(life::lane_bits(s.scored.scatters > Lanes(0.0)), lanes);
-  pack_store(phi_i, lanes, f.phi_i + n);
-  pack_store(photon, lanes, f.photon + n);
-  alignas(64) std::uint64_t slots[W];
-  pack_store(slot, lanes, slots);
-  alignas(64) double segments[W];
-  pack_store(s.scored.segments, lanes, segments);
-  const std::uint64_t ended =
-      life::pack_bits(life::lane_bits(s.code == Lanes(double(life::kEnded))), lanes);
-  for (int j = 0; j < k; ++j) {
-    f.segments[n + j] = static_cast<int>(segments[j]);
-    f.exited[n + j] = (exited >> j) & 1;
-    f.lost[n + j] = false;
-    f.ended[n + j] = (ended >> j) & 1;
-    f.last[n + j] = (ended >> j) & 1;
-    f.scattered[n + j] = (scattered >> j) & 1;
-    f.slot[n + j] = static_cast<std::uint32_t>(slots[j]);
-  }
+  hand_over_event_rows(s, s.scored.d, load<Lanes>(split.weight[0]), s.scored.roulette,
+                       life::lane_bits(s.code == Lanes(double(life::kEnded))), phi_i, photon, slot, lanes, f);
   if constexpr (HasExitHook<Model>)
     apply_exit_hook(model, s, lanes, n, k, f, [](auto a, auto b, auto c, auto d) {
       return scored_exit_stream(a, b, c, d);
     });
-  f.n = n + k;
   return n;
 }
 

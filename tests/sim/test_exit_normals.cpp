@@ -74,7 +74,9 @@
 #include "sim/life/source.h"
 #include "sim/life/tracer.h"
 #include "tests/error_text.h"
+#include "tests/sim/scored_rows.h"
 #include "tests/sim/sim_test_support.h"
+#include "tests/sim/spread_over_seeds.h"
 
 namespace fiberlab::sim {
 namespace {
@@ -268,60 +270,9 @@ TEST(ExitNormals, SameExpectationAsAnalog) {
 
 // ---------------------------------------------------------------- errors
 
-// The spread of the estimates over M seeds against the mean reported SE^2
-// (tests/sim/test_estimator.cpp's expect_errors_match_spread and
-// expect_lobe_errors_match_spread, from one set of runs): per lobe, summed
-// over the bins with an effective sample size of at least 30 in every
-// seed; and each lobe's energy (lobe_energy).
-void expect_errors_match_spread(Settings s, const char* what) {
-  constexpr int kSeeds = 201;
-  const int lobes = s.tally.lobes, bins = s.tally.n_theta * s.tally.n_phi;
-  std::vector<double> sum(lobes * bins, 0.0), sum_sq(lobes * bins, 0.0), se2(lobes * bins, 0.0),
-      min_ess(lobes * bins, 1e300);
-  std::vector<double> e_sum(lobes, 0.0), e_sum_sq(lobes, 0.0), e_se2(lobes, 0.0);
-  for (int seed = 0; seed < kSeeds; ++seed) {
-    s.seed = 1000 + seed;
-    const ResultFile r = testing::run(s, 1);
-    const double n = static_cast<double>(r.photons[0]);
-    for (int l = 0; l < lobes; ++l) {
-      for (int b = 0; b < bins; ++b) {
-        const std::size_t c = r.cell(0, l, b / s.tally.n_phi, b % s.tally.n_phi, 0);
-        const double p = r.weight_sum[c] / n;
-        sum[l * bins + b] += p;
-        sum_sq[l * bins + b] += p * p;
-        se2[l * bins + b] += (r.weight_sq_sum[c] / n - p * p) / (n - 1.0) / kSeeds;
-        min_ess[l * bins + b] = std::min(min_ess[l * bins + b], ess(r, c));
-      }
-      const Estimate e = lobe_energy(r, 0, l, 0);
-      EXPECT_DOUBLE_EQ(e.mean, r.exited[l * r.channels] / n);
-      e_sum[l] += e.mean;
-      e_sum_sq[l] += e.mean * e.mean;
-      e_se2[l] += e.std_error * e.std_error / kSeeds;
-    }
-  }
-  for (int l = 0; l < lobes; ++l) {
-    double spread = 0.0, reported = 0.0;
-    int used = 0;
-    for (int b = 0; b < bins; ++b) {
-      const int i = l * bins + b;
-      if (min_ess[i] < 30.0) continue;
-      const double mean = sum[i] / kSeeds;
-      spread += (sum_sq[i] - kSeeds * mean * mean) / (kSeeds - 1);
-      reported += se2[i];
-      ++used;
-    }
-    ASSERT_GT(used, 0) << what << ", lobe " << l;
-    const double ratio = spread / reported;
-    const double e_mean = e_sum[l] / kSeeds;
-    const double e_ratio = (e_sum_sq[l] - kSeeds * e_mean * e_mean) / (kSeeds - 1) / e_se2[l];
-    std::printf("%s, lobe %d: %d bins, spread / reported SE^2 = %.3f; lobe energy %.3f\n", what, l,
-                used, ratio, e_ratio);
-    EXPECT_GT(ratio, 0.6) << what << ", lobe " << l;
-    EXPECT_LT(ratio, 1.5) << what << ", lobe " << l;
-    EXPECT_GT(e_ratio, 0.6) << what << ", lobe " << l << " energy";
-    EXPECT_LT(e_ratio, 1.5) << what << ", lobe " << l << " energy";
-  }
-}
+// tests/sim/spread_over_seeds.h: bins, then lobe energies.
+using testing::expect_errors_match_spread;
+using testing::expect_lobe_errors_match_spread;
 
 TEST(ExitNormals, ErrorsMatchSpreadOverSeeds) {
   Settings s = testing::smooth_circle(30.0, 4000);
@@ -334,11 +285,13 @@ TEST(ExitNormals, ErrorsMatchSpreadOverSeeds) {
   s.tally.n_phi = 2;
   s.tally.lobes = 3;
   expect_errors_match_spread(s, "exit_normals 4, 3 lobes, 3 x 2 bins");
+  expect_lobe_errors_match_spread(s, "exit_normals 4, 3 lobes, 3 x 2 bins");
   // One bin: every row of a photon in a lobe adds to the same bin.
   s.tally.n_theta = 1;
   s.tally.n_phi = 1;
   s.tally.lobes = 2;
   expect_errors_match_spread(s, "exit_normals 4, 2 lobes, 1 bin");
+  expect_lobe_errors_match_spread(s, "exit_normals 4, 2 lobes, 1 bin");
 }
 
 // ---------------------------------------------------------------- the gain
@@ -373,40 +326,10 @@ TEST(ExitNormals, ReducesRVariance) {
 
 // ---------------------------------------------------------------- batched, threads
 
-// tests/sim/test_batch_tracer.cpp's comparison of the batched tracer with
-// the reference, photon by photon and row by row (expected value only).
-double drift(int segments) { return 1e-7 * (1.0 + segments); }
-
-std::vector<ScoredExitOutcome> joined(const std::vector<ScoredExitOutcome>& rows) {
-  std::vector<ScoredExitOutcome> out;
-  for (std::size_t k = 0; k < rows.size(); ++k) {
-    ScoredExitOutcome e = rows[k];
-    if (e.weight == 0.0 && k + 1 < rows.size() && rows[k + 1].segments == e.segments &&
-        rows[k + 1].path_length == e.path_length) {
-      const double r = e.roulette;
-      e = rows[++k];
-      e.roulette += r;
-    }
-    out.push_back(e);
-  }
-  return out;
-}
-
-bool same_scored(const std::vector<ScoredExitOutcome>& a_rows,
-                 const std::vector<ScoredExitOutcome>& b_rows) {
-  const std::vector<ScoredExitOutcome> a = joined(a_rows), b = joined(b_rows);
-  if (a.size() != b.size()) return false;
-  for (std::size_t k = 0; k < a.size(); ++k)
-    if (a[k].segments != b[k].segments ||
-        (a[k].direction - b[k].direction).norm() > drift(a[k].segments) ||
-        std::abs(a[k].path_length - b[k].path_length) > 1e-7 * (1.0 + a[k].path_length) ||
-        std::abs(a[k].weight - b[k].weight) > drift(a[k].segments) ||
-        std::abs(a[k].roulette - b[k].roulette) > drift(a[k].segments) ||
-        a[k].scattered != b[k].scattered ||
-        std::abs(a[k].medulla_path - b[k].medulla_path) > 1e-7 * (1.0 + a[k].medulla_path))
-      return false;
-  return true;
-}
+// tests/sim/scored_rows.h: the batched tracer's rows against the
+// reference tracer's, photon by photon and row by row.
+using testing::drift;
+using testing::same_scored;
 
 void expect_same_photons(const Settings& s, const char* what) {
   const std::uint64_t n = 50000;
