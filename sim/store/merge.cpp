@@ -12,6 +12,7 @@
 #include <map>
 #include <memory>
 #include <set>
+#include <sstream>
 
 #include "common/error.h"
 #include "common/units.h"
@@ -31,6 +32,19 @@ std::string comparable(Settings s) {
   s.source.theta_i = {0.0};
   s.source.phi_i = {0.0};
   return to_yaml(s);
+}
+
+// " (A has `a`, B `b`)": the first line where the configs of files A and B
+// differ, or nothing when they agree line by line (the bins' edges differ then).
+std::string first_difference(const std::string& name_a, const std::string& here, const std::string& name_b,
+                             const std::string& there) {
+  std::istringstream a(here), b(there);
+  std::string x, y;
+  while (true) {
+    const bool more_a = static_cast<bool>(std::getline(a, x)), more_b = static_cast<bool>(std::getline(b, y));
+    if (!more_a && !more_b) return "";
+    if (!more_a || !more_b || x != y) return fmt::format(" ({} has `{}`, {} `{}`)", name_a, x, name_b, y);
+  }
 }
 
 std::uint64_t bits(double x) {
@@ -70,9 +84,10 @@ void check_compatible(const std::vector<std::unique_ptr<ResultReader>>& readers,
     if (i > 0 && (comparable(h.settings) != reference ||
                   h.grid.theta_edges != first.grid.theta_edges ||
                   h.grid.phi_edges != first.grid.phi_edges))
-      throw Error(fmt::format("merge: {} does not match {}: fiber, roughness, tally, segment and "
-                              "polarization settings must be identical (seed, photons and "
-                              "incident directions may differ)", names[i], names[0]));
+      throw Error(fmt::format("merge: {} does not match {}{}: fiber, roughness, tally, segment, "
+                              "polarization and estimator settings must be identical (seed, photons and "
+                              "incident directions may differ)",
+                              names[i], names[0], first_difference(names[i], comparable(h.settings), names[0], reference)));
     const std::vector<Settings::Incidence> inc = h.settings.incidences();
     for (std::size_t k = 0; k < inc.size(); ++k)
       if (inc.size() != h.theta_i.size() || bits(inc[k].theta_i) != bits(h.theta_i[k]) ||

@@ -89,6 +89,22 @@ TEST_F(Cli, RunInfoMergeSucceed) {
   EXPECT_FALSE(fs::exists(path("d.h5")));
 }
 
+// Files whose settings differ are refused with the first line of their
+// configs that differs (here the estimator's exit_normals), and no output.
+TEST_F(Cli, MergeNamesTheSettingThatDiffers) {
+  const std::string ev = std::string(kGood) + "estimator: expected_value\n";
+  write("four.yaml", ev + "exit_normals: 4\n");
+  write("eight.yaml", ev + "exit_normals: [8, 2]\n");
+  ASSERT_EQ(fiberlab("run " + path("four.yaml") + " -o " + path("four.h5") + " --quiet").status, 0);
+  ASSERT_EQ(fiberlab("run " + path("eight.yaml") + " -o " + path("eight.h5") + " --seed 4 --quiet").status, 0);
+  const Outcome o = fiberlab("merge " + path("four.h5") + " " + path("eight.h5") + " -o " + path("both.h5"));
+  EXPECT_EQ(o.status, 2) << o.err;
+  EXPECT_EQ(std::count(o.err.begin(), o.err.end(), '\n'), 1) << o.err;
+  EXPECT_NE(o.err.find("eight.h5 has `exit_normals: [8, 2]`"), std::string::npos) << o.err;
+  EXPECT_NE(o.err.find("four.h5 `exit_normals: [4]`"), std::string::npos) << o.err;
+  EXPECT_FALSE(fs::exists(path("both.h5")));
+}
+
 TEST_F(Cli, MissingConfigFile) {
   expect_refused("run " + path("nope.yaml"), {"nope.yaml"});
 }
