@@ -26,6 +26,10 @@
 // An extra normal whose draw gives up (a rejection sampler's cap, SPEC
 // section 3: never seen in practice) counts as s_k = 0; it does not
 // truncate the photon.
+// SPEC section 5 does not name exit splitting (it allows expected-value
+// scoring, roulette and stratified h, each changing the variance and never
+// the expectation): fiberlab's own, held to analog runs by
+// tests/sim/test_exit_normals.cpp (docs/PHYSICS.md "Exit splitting").
 #include <algorithm>
 #include <cstdint>
 
@@ -91,7 +95,7 @@ ExtraExit<T> extra_exit(const Model& model, const SplitEvent<T>& e, const Vec3Of
   ExtraExit<T> out;
   const MaskOf<T> leaves = leaving_branch(ExitScoring<T>{ready, e.inside, e.n0}, e.d_in, m, fr.tir, cos_i, fr.cos_t,
                                           e.index.ratio, out.d);
-  out.share = select(leaves, select(e.inside, T(1.0) - fr.F, fr.F), T(0.0));
+  out.share = select(leaves, leaving_probability(e.inside, fr.F), T(0.0));
   if constexpr (HasEventWeight<Model, T>) {
     const EventWeight<T> w = model.event_weight(EventGeometry<T>{e.d_in, out.d, m, e.frame, e.inside}, leaves, rng);
     out.share = select(leaves & !w.lost, out.share * w.factor, T(0.0));

@@ -59,6 +59,13 @@ MaskOf<T> leaving_branch(const ExitScoring<T>& e, const Vec3Of<T>& d, const Vec3
   return e.eligible & !(e.inside & tir) & (leave.dot(e.n0) > T(0.0));
 }
 
+// The leaving branch's probability: the reflection's, p_reflect, for a
+// photon outside; the refraction's, 1 - p_reflect, for one inside.
+template <class T>
+T leaving_probability(const MaskOf<T>& inside, const T& p_reflect) {
+  return select(inside, T(1.0) - p_reflect, p_reflect);
+}
+
 // Mirror reflection or vector Snell refraction of d about m (cos_i = -d.m),
 // only the chosen one computed: d' = a d + b m with (a, b) = (1, 2 cos_i)
 // for reflection and (ratio, ratio cos_i - cos_t) for refraction, normalised.
@@ -97,7 +104,7 @@ struct ScalarLight {
     MaskOf<T> reflect;
     if constexpr (kScore) {
       r.scored = leaving_branch(e, d, m, f.tir, cos_i, f.cos_t, n.ratio, r.leave_direction);
-      r.p_leave = select(e.inside, T(1.0) - f.F, f.F);
+      r.p_leave = leaving_probability(e.inside, f.F);
       // Where the leaving branch is scored, the photon takes the other one:
       // it reflects when inside.
       reflect = f.tir | (r.scored & e.inside) |
@@ -178,7 +185,7 @@ struct StokesLight {
       res.scored = leaving_branch(e, d, m, tir, cos_i, r.cos_t, n.ratio, res.leave_direction);
       // The first row of the transmission matrix times the Stokes vector:
       // A_T + B_T Q = 1 - (A_R + B_R Q).
-      res.p_leave = select(e.inside, T(1.0) - p_reflect, p_reflect);
+      res.p_leave = leaving_probability(e.inside, p_reflect);
       reflect = tir | (res.scored & e.inside) |
                 ((!res.scored) & (rng.uniform(act & !tir & !res.scored) < p_reflect));
     } else {

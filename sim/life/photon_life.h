@@ -106,10 +106,10 @@ struct ScoredExit {
   T medulla_path;  // 3D path length inside the medulla so far
   T scatters;      // scattering events in the medulla so far
   T roulette;      // signed weight of this step's Russian roulette, before absorption
-  // The event that scored it, for exit splitting (sim/life/exit_splitting.h):
-  // the photon's direction before it, the boundary point, its side (1
-  // inside), and the scored branch's share of the weight (its leaving
-  // probability times its masking factor; 0 where none was scored).
+  // The event that scored it, for exit splitting (sim/life/exit_splitting.h;
+  // set only when it splits): the photon's direction before it, the boundary
+  // point, its side (1 inside), and the scored branch's share of the weight
+  // (its leaving probability times its masking factor; 0 where none was scored).
   Vec3Of<T> d_in;
   T px, py, inside;
   T share;
@@ -161,7 +161,7 @@ concept HasEventWeight = requires(const Model& m, const EventGeometry<T>& e, con
 template <class T, class Model, class Light>
 void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const EventResult<T>& r,
                           const BoundaryFrame<T>& frame, const Vec3Of<T>& m,
-                          const MaskOf<T>& inside) {
+                          const MaskOf<T>& inside, bool splits) {
   T exit_weight = select(r.scored, s.weight * r.p_leave, T(0.0));
   T share = select(r.scored, r.p_leave, T(0.0));
   if constexpr (HasEventWeight<Model, T>) {
@@ -173,11 +173,13 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
     share = select(r.scored, select(w.lost, T(0.0), share * w.factor), T(0.0));
   }
   s.scored.weight = exit_weight;
-  s.scored.share = share;
-  s.scored.d_in = s.d;
-  s.scored.px = s.px;
-  s.scored.py = s.py;
-  s.scored.inside = ones<T>(inside);
+  if (splits) {  // the event, for exit splitting (LifeConfig::most_exit_normals > 1)
+    s.scored.share = share;
+    s.scored.d_in = s.d;
+    s.scored.px = s.px;
+    s.scored.py = s.py;
+    s.scored.inside = ones<T>(inside);
+  }
   s.scored.d = r.leave_direction;
   s.scored.path = s.path;
   s.scored.segments = s.segments;
@@ -221,7 +223,7 @@ MaskOf<T> interface_event(const LifeConfig& c, const Model& model, PhotonState<T
   EventResult<T> r;
   if constexpr (kExpectedValue) {
     r = s.light.interact(s.d, f.m, index, act, s.rng, ExitScoring<T>{act, inside, n0});
-    score_leaving_branch(model, s, r, frame, f.m, inside);
+    score_leaving_branch(model, s, r, frame, f.m, inside, c.most_exit_normals > 1);
   } else {
     r = s.light.interact(s.d, f.m, index, act, s.rng);
   }

@@ -14,104 +14,14 @@
 
 #include "sim/life/batch_tracer.h"
 #include "sim/life/source.h"
-#include "tests/sim/scored_rows.h"
+#include "tests/sim/batched_vs_reference.h"
 #include "tests/sim/sim_test_support.h"
 
 namespace fiberlab::sim {
 namespace {
 
 using testing::drift;
-using testing::same_scored;
-
-// Prints how many photons' outcomes (fate, segments, path, weight, exit
-// direction, losses) are also equal to the last bit.
-void expect_same_photons_with(const Settings& s, const std::string& what_estimator) {
-  const char* what = what_estimator.c_str();
-  const std::uint64_t n = 50000;
-  const Tracer reference(s);
-  const BatchTracer batch(s);
-  const auto inc = s.incidences().front();
-  std::vector<PhotonOutcome> batched(n);
-  std::vector<double> batched_phi(n);
-  std::vector<int> seen(n, 0);
-  // Exits scored by expected value on the way (rows before a photon's last).
-  std::vector<std::vector<ScoredExitOutcome>> scored(n);
-  TracerCounters counters;
-  batch.trace(inc.theta_i, inc.phi_i, 0, n,
-              [&](const FinishedPhotons& f) {
-                for (int j = 0; j < f.n; ++j) {
-                  const std::uint64_t i = f.photon[j];
-                  // A photon that roulette ended ends on its row of that step.
-                  if (!f.last[j] || (f.ended[j] && (f.weight[j] > 0.0 || f.roulette[j] != 0.0)))
-                    scored[i].push_back({Vec3(f.dx[j], f.dy[j], f.dz[j]), f.segments[j], f.path[j],
-                                         f.weight[j], f.medulla_path[j], f.scattered[j],
-                                         f.roulette[j]});
-                  if (!f.last[j]) continue;
-                  batched[i] = f.outcome(j);
-                  batched_phi[i] = f.phi_i[j];
-                  ++seen[i];
-                }
-              },
-              counters);
-  int differ = 0, long_paths = 0, long_differ = 0, bit_equal = 0;
-  constexpr int kLongPath = 50;
-  double diverged_segments = 0.0;  // over photons whose paths came apart
-  TracerCounters reference_counters;
-  for (std::uint64_t i = 0; i < n; ++i) {
-    ASSERT_EQ(seen[i], 1) << "photon " << i << " reported " << seen[i] << " times";
-    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, s.source.phi_i_uniform);
-    const PhotonOutcome r = reference.trace(p.wi, p.h, p.rng, &reference_counters);
-    ASSERT_EQ(batched_phi[i], p.phi_i);
-    const PhotonOutcome& b = batched[i];
-    bool same_losses = r.losses.size() == b.losses.size();
-    for (std::size_t k = 0; same_losses && k < r.losses.size(); ++k)
-      same_losses = std::abs(r.losses[k].weight - b.losses[k].weight) <= 1e-7 &&
-                    std::abs(r.losses[k].path_length - b.losses[k].path_length) <=
-                        1e-7 * (1.0 + r.losses[k].path_length);
-    const bool same = r.fate == b.fate && r.segments == b.segments && same_losses &&
-                      std::abs(r.path_length - b.path_length) <= 1e-7 * (1.0 + r.path_length) &&
-                      (r.direction - b.direction).norm() <= drift(r.segments) &&
-                      (r.fate != PhotonFate::Exited ||
-                       (std::abs(r.theta - b.theta) <= drift(r.segments) &&
-                        std::abs(r.phi - b.phi) <= drift(r.segments))) &&
-                      std::abs(r.weight - b.weight) <= drift(r.segments) &&
-                      r.scattered == b.scattered &&
-                      std::abs(r.medulla_path - b.medulla_path) <= 1e-7 * (1.0 + r.medulla_path) &&
-                      same_scored(r.scored, scored[i]);
-    // Light-guided paths are chaotic: after ~50 segments the last-bit
-    // drift grows beyond any fixed tolerance (judged apart, below).
-    const bool long_path = r.segments > kLongPath;
-    differ += !same && !long_path;
-    long_paths += long_path;
-    long_differ += !same && long_path;
-    bool equal = r.fate == b.fate && r.segments == b.segments && r.path_length == b.path_length &&
-                 r.weight == b.weight && r.direction == b.direction &&
-                 r.losses.size() == b.losses.size();
-    for (std::size_t k = 0; equal && k < r.losses.size(); ++k)
-      equal = r.losses[k].weight == b.losses[k].weight &&
-              r.losses[k].path_length == b.losses[k].path_length;
-    bit_equal += equal;
-    diverged_segments += std::abs(r.segments - b.segments);
-  }
-  std::printf("%s: %d of %llu photons differ, %d equal to the last bit; of %d paths longer than %d "
-              "segments, %d differ\n",
-              what, differ, static_cast<unsigned long long>(n), bit_equal, long_paths, kLongPath,
-              long_differ);
-  EXPECT_LE(differ, static_cast<int>(n / 1000)) << what;
-  // Expected-value scoring follows many more photons along light-guided
-  // paths (past their TT exit) than the analog estimator does.
-  EXPECT_LE(long_differ, long_paths / 2) << what;
-  // The same work, counted lane by lane in the batch. A photon whose path
-  // came apart (a light-guided one, after ~100 segments of last-bit drift)
-  // has its events and normals for a different number of segments: at most
-  // a few events per segment (repeated events of the consistency rule) and
-  // about 1.7 candidate normals per event, hence 4 per segment of difference.
-  EXPECT_NEAR(counters.events, reference_counters.events,
-              1e-3 * reference_counters.events + 4.0 * diverged_segments) << what;
-  EXPECT_NEAR(counters.normal_draws, reference_counters.normal_draws,
-              1e-3 * reference_counters.normal_draws + 4.0 * diverged_segments) << what;
-  EXPECT_EQ(counters.sampler_caps, reference_counters.sampler_caps) << what;
-}
+using testing::expect_same_photons_with;
 
 // Both estimators (Settings::estimator): with expected-value scoring the
 // exits scored on the way match too, one by one.

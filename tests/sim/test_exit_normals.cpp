@@ -56,7 +56,7 @@
 //   16,200 bins of 200,000 photons vary by a few percent).
 // - BatchedEqualsReference, ThreadsAgreeBitForBit: the batched tracer draws
 //   each extra normal from the same stream as the reference tracer
-//   (tests/sim/test_batch_tracer.cpp's comparison, photon by photon, row by
+//   (tests/sim/batched_vs_reference.h, photon by photon, row by
 //   row), and the tallies are bit-identical for any thread count (SPEC
 //   section 6), whatever photons share a vector with a photon's split.
 // - ConfigKey: the forms, the round trip, the stored default {1}, the limits
@@ -74,7 +74,7 @@
 #include "sim/life/source.h"
 #include "sim/life/tracer.h"
 #include "tests/error_text.h"
-#include "tests/sim/scored_rows.h"
+#include "tests/sim/batched_vs_reference.h"
 #include "tests/sim/sim_test_support.h"
 #include "tests/sim/spread_over_seeds.h"
 
@@ -326,75 +326,12 @@ TEST(ExitNormals, ReducesRVariance) {
 
 // ---------------------------------------------------------------- batched, threads
 
-// tests/sim/scored_rows.h: the batched tracer's rows against the
-// reference tracer's, photon by photon and row by row.
-using testing::drift;
-using testing::same_scored;
-
+// tests/sim/batched_vs_reference.h, photon by photon and row by row; the
+// split happened (over 5 rows a photon: R's 8 and TT's and TRT's 4).
 void expect_same_photons(const Settings& s, const char* what) {
-  const std::uint64_t n = 50000;
-  const Tracer reference(s);
-  const BatchTracer batch(s);
-  const auto inc = s.incidences().front();
-  std::vector<PhotonOutcome> batched(n);
-  std::vector<int> seen(n, 0);
-  std::vector<std::vector<ScoredExitOutcome>> scored(n);
-  TracerCounters counters;
-  batch.trace(inc.theta_i, inc.phi_i, 0, n,
-              [&](const FinishedPhotons& f) {
-                for (int j = 0; j < f.n; ++j) {
-                  const std::uint64_t i = f.photon[j];
-                  if (!f.last[j] || (f.ended[j] && (f.weight[j] > 0.0 || f.roulette[j] != 0.0)))
-                    scored[i].push_back({Vec3(f.dx[j], f.dy[j], f.dz[j]), f.segments[j], f.path[j],
-                                         f.weight[j], f.medulla_path[j], f.scattered[j],
-                                         f.roulette[j]});
-                  if (!f.last[j]) continue;
-                  batched[i] = f.outcome(j);
-                  ++seen[i];
-                }
-              },
-              counters);
-  int differ = 0, long_paths = 0, long_differ = 0, rows_differ = 0;
-  constexpr int kLongPath = 50;
-  double diverged_segments = 0.0;
   std::size_t rows = 0;
-  TracerCounters reference_counters;
-  for (std::uint64_t i = 0; i < n; ++i) {
-    ASSERT_EQ(seen[i], 1) << "photon " << i << " reported " << seen[i] << " times";
-    LaunchedPhoton p = launch_photon(s.seed, i, inc.theta_i, inc.phi_i, s.source.phi_i_uniform);
-    const PhotonOutcome r = reference.trace(p.wi, p.h, p.rng, &reference_counters);
-    const PhotonOutcome& b = batched[i];
-    rows += r.scored.size();
-    bool same_losses = r.losses.size() == b.losses.size();
-    for (std::size_t k = 0; same_losses && k < r.losses.size(); ++k)
-      same_losses = std::abs(r.losses[k].weight - b.losses[k].weight) <= 1e-7 &&
-                    std::abs(r.losses[k].path_length - b.losses[k].path_length) <=
-                        1e-7 * (1.0 + r.losses[k].path_length);
-    const bool rows_same = same_scored(r.scored, scored[i]);
-    const bool same = r.fate == b.fate && r.segments == b.segments && same_losses &&
-                      std::abs(r.path_length - b.path_length) <= 1e-7 * (1.0 + r.path_length) &&
-                      (r.direction - b.direction).norm() <= drift(r.segments) &&
-                      std::abs(r.weight - b.weight) <= drift(r.segments) && rows_same;
-    const bool long_path = r.segments > kLongPath;
-    differ += !same && !long_path;
-    rows_differ += !rows_same && !long_path;
-    long_paths += long_path;
-    long_differ += !same && long_path;
-    diverged_segments += std::abs(r.segments - b.segments);
-  }
-  std::printf("%s: %zu rows; %d of %llu photons differ (%d in their rows); of %d paths longer "
-              "than %d segments, %d differ\n",
-              what, rows, differ, static_cast<unsigned long long>(n), rows_differ, long_paths,
-              kLongPath, long_differ);
-  EXPECT_GT(rows, 5 * n) << what;  // the split happened
-  EXPECT_LE(differ, static_cast<int>(n / 1000)) << what;
-  EXPECT_LE(long_differ, long_paths / 2) << what;
-  EXPECT_NEAR(counters.events, reference_counters.events,
-              1e-3 * reference_counters.events + 4.0 * diverged_segments) << what;
-  // (The extra normals' candidates are not counted: they are not events.)
-  EXPECT_NEAR(counters.normal_draws, reference_counters.normal_draws,
-              1e-3 * reference_counters.normal_draws + 4.0 * diverged_segments) << what;
-  EXPECT_EQ(counters.sampler_caps, reference_counters.sampler_caps) << what;
+  testing::expect_same_photons_with(s, what, &rows);
+  EXPECT_GT(rows, 5u * 50000u) << what;
 }
 
 TEST(ExitNormals, BatchedEqualsReference) {
