@@ -12,7 +12,8 @@
 //  (m) case c's geometry, white, `ggx` alpha 0.3 with `masking: smith_g1`.
 // One thread, so the rate is per core. Counters: photons/s, interface events
 // and candidate normals per photon. `trace_expected_value` runs b and c with
-// `estimator: expected_value` (docs/PHYSICS.md "Estimator"), scoring included. `trace` is the batched SIMD tracer that
+// `estimator: expected_value` (docs/PHYSICS.md "Estimator"), scoring included,
+// and `trace_exit_splitting` the same with `exit_normals` (below). `trace` is the batched SIMD tracer that
 // `fiberlab run` uses for unpolarised light (binning and tally included);
 // `trace_reference` the scalar reference tracer (tracing only).
 //
@@ -23,6 +24,8 @@
 
 #include <filesystem>
 #include <string>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 #include "common/units.h"
@@ -78,9 +81,10 @@ Settings bench_case(char which) {
 // round, fed runs of chunks of 4096 (sim/life/photon_feed.h), so it drains less
 // often than here; trace_per_chunk shows one chunk per call.
 void trace(benchmark::State& state, char which, std::uint64_t batch = 0,
-           Estimator estimator = Estimator::Analog) {
+           Estimator estimator = Estimator::Analog, std::vector<int> exit_normals = {1}) {
   Settings settings = bench_case(which);
   settings.estimator = estimator;
+  settings.exit_normals = std::move(exit_normals);
   const Simulation sim(settings);
   if (batch == 0) batch = which == 'd' ? 2048 : 65536;
   Tally tally(8, 90, 180, static_cast<int>(sim.settings().fiber.sigma_a.size()));
@@ -129,6 +133,18 @@ void trace_expected_value(benchmark::State& state, char which) {
 }
 BENCHMARK_CAPTURE(trace_expected_value, b_rough_tilted_circle, 'b')->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace_expected_value, c_rough_tilted_ellipse, 'c')->Unit(benchmark::kMillisecond)->MinTime(2.0);
+// Exit splitting (docs/PHYSICS.md "Exit splitting") at the settings aimed
+// at one lobe: R on case c (exit_normals [16, 1]), TRT on case b ([1, 1, 16,
+// 1]). Against trace_expected_value on the same case, the time per photon
+// grows by (extra normals per photon) x (the cost of an extra normal: its
+// draw and Fresnel term, and its row for the scorer).
+void trace_exit_splitting(benchmark::State& state, char which, std::vector<int> exit_normals) {
+  trace(state, which, 0, Estimator::ExpectedValue, std::move(exit_normals));
+}
+BENCHMARK_CAPTURE(trace_exit_splitting, c_R_16, 'c', std::vector<int>{16, 1})
+    ->Unit(benchmark::kMillisecond)->MinTime(2.0);
+BENCHMARK_CAPTURE(trace_exit_splitting, b_TRT_16, 'b', std::vector<int>{1, 1, 16, 1})
+    ->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, b_per_chunk, 'b', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(trace, c_per_chunk, 'c', Simulation::kChunk)->Unit(benchmark::kMillisecond)->MinTime(2.0);
 
