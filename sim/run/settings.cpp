@@ -130,10 +130,15 @@ void read_tally(const Reader& r, const YAML::Node& parent, TallySettings& t) {
 std::vector<int> read_exit_normals(const Reader& r, const YAML::Node& n) {
   const std::string rule = fmt::format("an integer in [1, {}], or a list of at most {} of them by lobe p",
                                        kMaxExitNormals, kMaxExitNormalsEntries);
-  const Rule each{rule, [](double k) { return k >= 1 && k <= kMaxExitNormals && k == std::floor(k); }};
   if (n.IsSequence() && (n.size() == 0 || n.size() > kMaxExitNormalsEntries))
     r.bad("exit_normals", n, fmt::format("has {} entries", n.size()), rule);
-  const std::vector<double> k = r.numbers(n, "exit_normals", each, true);
+  const std::vector<double> k = r.numbers(n, "exit_normals", Rule{rule, [](double) { return true; }}, true);
+  for (std::size_t i = 0; i < k.size(); ++i) {
+    const std::string path = n.IsSequence() ? fmt::format("exit_normals[{}]", i) : "exit_normals";
+    const YAML::Node& x = n.IsSequence() ? n[i] : n;
+    if (k[i] != std::floor(k[i])) r.bad(path, x, "is not an integer", rule);
+    if (k[i] < 1 || k[i] > kMaxExitNormals) r.bad(path, x, "is out of range", rule);
+  }
   return std::vector<int>(k.begin(), k.end());
 }
 

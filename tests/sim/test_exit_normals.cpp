@@ -67,6 +67,7 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/error.h"
@@ -456,6 +457,18 @@ TEST(ExitNormals, ConfigKey) {
                           "exit_normals: .nan\n", "exit_normals: 1e100\n", "exit_normals:\n",
                           "exit_normals: \"8\"\n"})
     expect_refused(config(bad), bad);
+  // The message says which entry and what is wrong with it.
+  for (const auto& [bad, says] : {std::pair{"exit_normals: 2.5\n", "exit_normals = 2.5 is not an integer"},
+                                  std::pair{"exit_normals: [8, 4.5]\n", "exit_normals[1] = 4.5 is not an integer"},
+                                  std::pair{"exit_normals: [8, 33]\n", "exit_normals[1] = 33 is out of range"},
+                                  std::pair{"exit_normals: 0\n", "exit_normals = 0 is out of range"}}) {
+    try {
+      parse_settings_yaml(config(bad), "t");
+      ADD_FAILURE() << bad << " accepted";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find(says), std::string::npos) << e.what();
+    }
+  }
   // Any entry > 1 where the normals are not drawn per event, or no exit is
   // scored on the way: the analog estimator, Stokes light, smooth and
   // exit_blur.
