@@ -31,9 +31,12 @@
 // the expectation): fiberlab's own, held to analog runs by
 // tests/sim/test_exit_normals.cpp (docs/PHYSICS.md "Exit splitting").
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 
 #include "sim/life/photon_life.h"
+#include "sim/simd/lane_packing.h"
+#include "sim/simd/lane_permute.h"
 
 namespace fiberlab::sim::life {
 
@@ -123,78 +126,49 @@ T exit_normals_at(const LifeConfig& c, const T& p) {
   return k;
 }
 
-// A scored exit's event as split_scored_exits reads it: d_in, px, py, inside.
-inline constexpr int kSplitInputs = 6;
-
 // The extra normals still to draw, as (lane l, k) pairs, k = 1 ..
 // normals[l] - 1, lane by lane, and the vector of W of them being drawn: a
 // pair keeps its vector lane (its event, stream and candidate count) until
 // its normal is drawn or its sampler gives up, and refill() gives the lanes
 // that are free the next pairs, so that no vector waits for its slowest
-// lane (a rejection sampler's). A free lane repeats a busy lane's inputs;
-// its numbers are never used.
+// lane (a rejection sampler's). What a lane draws with is moved to it from
+// the photons' lanes by lane permutations (sim/simd/lane_permute.h): a free
+// lane takes a busy lane's (its numbers are never used).
 template <int W>
 struct ExtraNormalQueue {
-  explicit ExtraNormalQueue(const double* normals) : normals_(normals) {}
-  alignas(64) double in[kSplitInputs][W], tries[W];
-  alignas(64) std::uint64_t words[4][W];
-  int lane[W], k[W];
-  bool is_busy[W] = {};
+  explicit ExtraNormalQueue(const double* normals) {
+    for (int l = 0; l < W; ++l)
+      for (int k = 1; k < static_cast<int>(normals[l]); ++k) pairs_[n_pairs_++] = {l, k};
+  }
+  // Per vector lane j, the photon lane of its pair and its k.
+  alignas(64) std::uint64_t lane[W] = {}, k[W] = {};
+  std::uint64_t busy = 0;  // bits: the lanes with a pair
 
-  // Fills the free lanes, their streams extra_normal_stream's of the
-  // lanes' split_hash (`hash`, by lane of the photons' vector) and k,
-  // computed a vector at a time; false once no pair is left to draw.
-  template <class T>
-  bool refill(const double (*event)[W], const std::uint64_t* hash) {
-    int some = -1;
-    bool fresh[W] = {};
-    alignas(64) std::uint64_t pair_hash[W] = {}, pair_k[W] = {};
-    for (int j = 0; j < W; ++j) {
-      if (!is_busy[j] && next(lane[j], k[j])) {
-        for (int q = 0; q < kSplitInputs; ++q) in[q][j] = event[q][lane[j]];
-        pair_hash[j] = hash[lane[j]];
-        pair_k[j] = static_cast<std::uint64_t>(k[j]);
-        tries[j] = 0.0;
-        is_busy[j] = fresh[j] = true;
-      }
-      if (is_busy[j]) some = j;
+  // Gives the free lanes the next pairs; `fresh` their bits. False once no
+  // lane has a pair.
+  bool refill(std::uint64_t& fresh) {
+    fresh = 0;
+    for (int j = 0; j < W && next_ < n_pairs_; ++j) {
+      if ((busy >> j) & 1) continue;
+      lane[j] = static_cast<std::uint64_t>(pairs_[next_].lane);
+      k[j] = static_cast<std::uint64_t>(pairs_[next_].k);
+      ++next_;
+      fresh |= std::uint64_t{1} << j;
     }
-    if (some < 0) return false;
-    const LaneRandom<T> r = extra_normal_stream<T>(load_bits<T>(pair_hash), load_bits<T>(pair_k));
-    alignas(64) std::uint64_t w[4][W];
-    for (int q = 0; q < 4; ++q) store_bits(r.word(q), w[q]);
-    for (int j = 0; j < W; ++j) {
-      if (fresh[j])
-        for (int q = 0; q < 4; ++q) words[q][j] = w[q][j];
-      if (!is_busy[j]) {
-        for (int q = 0; q < kSplitInputs; ++q) in[q][j] = in[q][some];
-        for (int q = 0; q < 4; ++q) words[q][j] = words[q][some];
-        tries[j] = 0.0;
-      }
-    }
+    busy |= fresh;
+    if (busy == 0) return false;
+    const int some = std::countr_zero(busy);
+    for (int j = 0; j < W; ++j)
+      if (!((busy >> j) & 1)) lane[j] = lane[some];
     return true;
-  }
-  template <class T>
-  MaskOf<T> busy() const {
-    alignas(64) double b[W];
-    for (int j = 0; j < W; ++j) b[j] = is_busy[j] ? 1.0 : 0.0;
-    return load<T>(b) != T(0.0);
-  }
-  template <class T>
-  LaneRandom<T> stream() const {
-    return {load_bits<T>(words[0]), load_bits<T>(words[1]), load_bits<T>(words[2]), load_bits<T>(words[3])};
   }
 
  private:
-  bool next(int& l, int& kk) {
-    while (next_lane_ < W && next_k_ >= static_cast<int>(normals_[next_lane_])) ++next_lane_, next_k_ = 1;
-    if (next_lane_ == W) return false;
-    l = next_lane_;
-    kk = next_k_++;
-    return true;
-  }
-  const double* normals_;
-  int next_lane_ = 0, next_k_ = 1;
+  struct PairOf {
+    int lane, k;
+  };
+  PairOf pairs_[W * (kMaxExitNormals - 1)];
+  int n_pairs_ = 0, next_ = 0;
 };
 
 // The scored exits e of a vector of photons (ScoredExit: this step's, with
@@ -214,49 +188,50 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   store(e.weight, out.weight[0]);
   const MaskOf<T> scored = e.weight > T(0.0);
   if (c.most_exit_normals == 1 || !any(scored)) return;
-  // The lanes' events, streams and normals (1 where nothing was scored).
-  alignas(64) double event[kSplitInputs][W], normals[W], share[W];
-  alignas(64) std::uint64_t hash[W];
-  store(e.d_in.x, event[0]);
-  store(e.d_in.y, event[1]);
-  store(e.d_in.z, event[2]);
-  store(e.px, event[3]);
-  store(e.py, event[4]);
-  store(e.inside, event[5]);
+  // The lanes' normals (1 where nothing was scored) and shares.
+  alignas(64) double normals[W], share[W];
   store(select(scored, exit_normals_at(c, e.segments), T(1.0)), normals);
   store(e.share, share);
-  store_bits(split_hash(rng), hash);
+  const BitsOf<T> hash = split_hash(rng);
   for (int l = 0; l < W; ++l) out.n = std::max(out.n, static_cast<int>(normals[l]));
   for (int k = 1; k < out.n; ++k)
     for (int l = 0; l < W; ++l) out.weight[k][l] = 0.0;
   ExtraNormalQueue<W> queue(normals);
-  while (queue.template refill<T>(event, hash)) {
-    const MaskOf<T> busy = queue.template busy<T>();
-    LaneRandom<T> r = queue.template stream<T>();
-    T tries = load<T>(queue.tries);
-    const SplitEvent<T> ev =
-        split_event(c, Vec3Of<T>(load<T>(queue.in[0]), load<T>(queue.in[1]), load<T>(queue.in[2])),
-                    load<T>(queue.in[3]), load<T>(queue.in[4]), load<T>(queue.in[5]));
+  // Each vector lane's stream and candidate count (its pair's).
+  LaneRandom<T> r(BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0));
+  T tries(0.0);
+  std::uint64_t fresh = 0;
+  while (queue.refill(fresh)) {
+    const BitsOf<T> lane = load_bits<T>(queue.lane);
+    const MaskOf<T> busy = mask_of_bits<T>(queue.busy), is_fresh = mask_of_bits<T>(fresh);
+    if (fresh != 0) {
+      const LaneRandom<T> seeded = extra_normal_stream<T>(permute_lanes(hash, lane), load_bits<T>(queue.k));
+      const auto m = bits_mask(is_fresh);
+      r = LaneRandom<T>(select(m, seeded.word(0), r.word(0)), select(m, seeded.word(1), r.word(1)),
+                        select(m, seeded.word(2), r.word(2)), select(m, seeded.word(3), r.word(3)));
+      tries = select(is_fresh, T(0.0), tries);
+    }
+    const SplitEvent<T> ev = split_event(
+        c, Vec3Of<T>(permute_lanes(e.d_in.x, lane), permute_lanes(e.d_in.y, lane), permute_lanes(e.d_in.z, lane)),
+        permute_lanes(e.px, lane), permute_lanes(e.py, lane), permute_lanes(e.inside, lane));
     LifeCounts<T> counts;  // not the run's: an extra normal is not an event
     const FacetDraw<T> f = model.draw_normal(ev.d_in, ev.frame, busy, r, tries, counts, kMaxNormalTries);
     const ExtraExit<T> x = extra_exit(model, ev, f.m, f.ready, r);
+    std::uint64_t done = lane_bits(f.ready | f.failed) & queue.busy;
+    if (done == 0) continue;
     alignas(64) double ox[W], oy[W], oz[W], os[W];
     store(x.d.x, ox);
     store(x.d.y, oy);
     store(x.d.z, oz);
     store(x.share, os);
-    store(tries, queue.tries);
-    for (int q = 0; q < 4; ++q) store_bits(r.word(q), queue.words[q]);
-    alignas(64) double done[W];
-    store(ones<T>(f.ready | f.failed), done);
-    for (int j = 0; j < W; ++j) {
-      if (!queue.is_busy[j] || done[j] == 0.0) continue;
-      const int l = queue.lane[j], k = queue.k[j];
+    queue.busy &= ~done;
+    for (; done != 0; done &= done - 1) {
+      const int j = std::countr_zero(done);
+      const std::size_t l = queue.lane[j], k = queue.k[j];
       out.dx[k][l] = ox[j];
       out.dy[k][l] = oy[j];
       out.dz[k][l] = oz[j];
       out.weight[k][l] = os[j];  // 0 where the draw gave up
-      queue.is_busy[j] = false;
     }
   }
   // Normal k's weight w s_1 s_k / S (S >= s_1 > 0 where a lane scored; the
