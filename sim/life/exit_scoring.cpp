@@ -241,9 +241,9 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
         const WeightLoss& l = f.losses[j].loss;
         for (int c = 0; c < channels; ++c) weight[c] += l.weight * std::exp(-sigma_a_[c] * l.path_length);
       }
-      // Room for the losses: 1 + created - booked (Tally::score_lost's 1 - kept).
+      // What it kept: 1 - its room (Tally::score_lost's 1 - kept is the room).
       const std::size_t at = static_cast<std::size_t>(slot) * channels;
-      for (int c = 0; c < channels; ++c) fixed_[c] = booked_[at + c] - created_[at + c];
+      for (int c = 0; c < channels; ++c) fixed_[c] = Tally::kOne - room_[at + c];
       tally.score_lost(weight, fixed_.data());
     }
     end_photon(slot);
@@ -257,8 +257,7 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
                                                           const std::size_t* bin,
                                                           const Tally& tally) const {
   const std::size_t at = static_cast<std::size_t>(f.slot[i]) * sigma_a_.size();
-  __builtin_prefetch(booked_.data() + at, 1);
-  __builtin_prefetch(created_.data() + at);
+  __builtin_prefetch(room_.data() + at, 1);
   if (!f.exited[i]) return;
   tally.prefetch_all(bin[i], lobe_[i]);
   const Run& run = runs_[f.slot[i]];
@@ -275,16 +274,14 @@ void ExitScorer::reserve_slots(const FinishedPhotons& f) {
   for (int i = 0; i < f.n; ++i) top = std::max(top, f.slot[i]);
   if (top < runs_.size()) return;
   const std::size_t slots = top + 1, channels = sigma_a_.size();
-  booked_.resize(slots * channels, Tally::Fixed{0});
-  created_.resize(slots * channels, Tally::Fixed{0});
+  room_.resize(slots * channels, Tally::kOne);
   lobe_total_.resize(slots * channels, 0.0);
   runs_.resize(slots);
 }
 
 void ExitScorer::end_photon(std::uint32_t slot) {
   const std::size_t channels = sigma_a_.size(), at = slot * channels;
-  std::fill_n(booked_.begin() + at, channels, Tally::Fixed{0});
-  std::fill_n(created_.begin() + at, channels, Tally::Fixed{0});
+  std::fill_n(room_.begin() + at, channels, Tally::kOne);
   Run& run = runs_[slot];
   run.lobe = -1;
   run.bins.clear();
@@ -304,14 +301,14 @@ template <int kChannels>
   const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   for (std::size_t c = 0; c < channels; ++c) {
     Tally::Fixed w = Tally::to_fixed(weight[c * stride]);
-    const Tally::Fixed room = Tally::kOne + created_[at + c] - booked_[at + c];
+    const Tally::Fixed room = room_[at + c];
     if (w > room) {
       if (w - room > Tally::kRoundingAllowance)
         throw Error(fmt::format("internal error: a photon's exits and truncated weight exceed 1 "
                                 "(channel {}) by more than rounding", c));
       w = room;
     }
-    booked_[at + c] += w;
+    room_[at + c] = room - w;
     fixed[c] = w;
   }
 }
@@ -328,7 +325,7 @@ void ExitScorer::score_roulette(const FinishedPhotons& f, int i, Tally& tally) {
   if (r > 0.0) {
     for (std::size_t c = 0; c < channels; ++c) {
       fixed_[c] = Tally::to_fixed(growth_[c]);
-      created_[at + c] += fixed_[c];
+      room_[at + c] += fixed_[c];
     }
   } else {
     book(growth_.data(), 1, f.slot[i], fixed_.data());

@@ -45,8 +45,9 @@ class ExitScorer {
   std::vector<double> absorption_;
   int lobe_[FinishedPhotons::kCapacity];
   // Per slot (sim/life/finished_photons.h), the photon in it so far, in flat
-  // arrays sized once per slot ([slot][channel]): the weight it booked in
-  // fixed point, and what Russian roulette created for it; the lobe of its
+  // arrays sized once per slot ([slot][channel]): its room in fixed point
+  // (1 plus what Russian roulette created for it, minus what it booked,
+  // which is at most that); the lobe of its
   // latest exit and its total there. A photon's lobes never decrease along
   // its rows (min(p, L - 1) with p growing; the medulla's `scattered` once
   // scattered), so its exits in one lobe are consecutive: its Run holds the
@@ -58,7 +59,7 @@ class ExitScorer {
     std::vector<std::size_t> bins;
     std::vector<double> totals;  // [entry][channel]
   };
-  std::vector<Tally::Fixed> booked_, created_;
+  std::vector<Tally::Fixed> room_;
   std::vector<double> lobe_total_;
   std::vector<Run> runs_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
