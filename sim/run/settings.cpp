@@ -128,18 +128,17 @@ void read_tally(const Reader& r, const YAML::Node& parent, TallySettings& t) {
 
 // exit_normals: an integer in [1, kMaxExitNormals], or a list of them by lobe p.
 std::vector<int> read_exit_normals(const Reader& r, const YAML::Node& n) {
-  const std::string rule = fmt::format("an integer in [1, {}], or a list of at most {} of them by lobe p",
-                                       kMaxExitNormals, kMaxExitNormalsEntries);
-  if (n.IsSequence() && (n.size() == 0 || n.size() > kMaxExitNormalsEntries))
-    r.bad("exit_normals", n, fmt::format("has {} entries", n.size()), rule);
-  const std::vector<double> k = r.numbers(n, "exit_normals", Rule{rule, [](double) { return true; }}, true);
-  for (std::size_t i = 0; i < k.size(); ++i) {
-    const std::string path = n.IsSequence() ? fmt::format("exit_normals[{}]", i) : "exit_normals";
-    const YAML::Node& x = n.IsSequence() ? n[i] : n;
-    if (k[i] != std::floor(k[i])) r.bad(path, x, "is not an integer", rule);
-    if (k[i] < 1 || k[i] > kMaxExitNormals) r.bad(path, x, "is out of range", rule);
-  }
-  return std::vector<int>(k.begin(), k.end());
+  const auto one = [&](const YAML::Node& x, const std::string& path) {
+    return static_cast<int>(r.integer(x, path, 1, kMaxExitNormals));
+  };
+  if (!n.IsSequence()) return {one(n, "exit_normals")};
+  if (n.size() == 0 || n.size() > kMaxExitNormalsEntries)
+    r.bad("exit_normals", n, fmt::format("has {} entries", n.size()),
+          fmt::format("an integer in [1, {}], or a list of at most {} of them by lobe p", kMaxExitNormals,
+                      kMaxExitNormalsEntries));
+  std::vector<int> k;
+  for (std::size_t i = 0; i < n.size(); ++i) k.push_back(one(n[i], fmt::format("exit_normals[{}]", i)));
+  return k;
 }
 
 void read_top_level(const Reader& r, const YAML::Node& n, Settings& s) {

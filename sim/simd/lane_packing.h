@@ -19,7 +19,8 @@
 
 namespace fiberlab::sim::life {
 
-// Bit k set where lane k of m is.
+// Bit k set where lane k of m is (one lane: the reference tracer's).
+inline std::uint64_t lane_bits(bool m) { return m ? 1 : 0; }
 inline std::uint64_t lane_bits(const MaskOf<Batch>& m) {
 #if defined(__AVX512F__)
   if constexpr (kBatchWidth == 8) return static_cast<std::uint64_t>(static_cast<__mmask8>(m.data));

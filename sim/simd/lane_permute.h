@@ -12,7 +12,6 @@
 #include <bit>
 #include <cstdint>
 
-#include "sim/simd/lane_packing.h"
 #include "sim/simd/lane_pair.h"
 #include "sim/simd/lanes.h"
 
@@ -63,9 +62,6 @@ Pair<V> permute_lanes(const Pair<V>& x, const Pair<I>& index) {
   for (int j = 0; j < 2 * kHalf; ++j) out[j] = v[k[j]];
   return Pair<V>::load_aligned(out);
 }
-
-// lane_bits of one lane (the reference tracer's).
-inline std::uint64_t lane_bits(bool m) { return m ? 1 : 0; }
 
 template <class T>
 MaskOf<T> mask_of_bits(std::uint64_t bits) {
