@@ -3,6 +3,7 @@
 #include <fmt/core.h>
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdint>
@@ -50,17 +51,9 @@ class Halton {
   Halton(std::uint64_t first, long n, std::uint64_t end) : half_cell_(0.5 / static_cast<double>(n)) {
     for (int k = 0; k < kDims; ++k) {
       Digits& d = digits_[k];
-      const unsigned b = kBases[k];
-      d.block = 1;
-      int e = 0;
-      while (d.block * b <= kBlockMax) d.block *= b, ++e;
-      d.table.resize(d.block);
-      for (unsigned j = 0; j < d.block; ++j) {
-        // radical inverse of the e-digit block j: the digits of j reversed.
-        double f = 1.0 / b, r = 0.0;
-        for (unsigned x = j, q = 0; q < static_cast<unsigned>(e); ++q, x /= b, f /= b) r += (x % b) * f;
-        d.table[j] = r;
-      }
+      const std::vector<double>& table = block_tables()[k];
+      d.block = static_cast<unsigned>(table.size());
+      d.table = table.data();
       d.inv_block = 1.0 / d.block;
       std::uint64_t x = first;
       for (int q = 0; q < kMaxBlocks; ++q, x /= d.block) d.c[q] = static_cast<unsigned>(x % d.block);
@@ -79,13 +72,15 @@ class Halton {
     u[0] += half_cell_;  // midpoints in dimension 0
     if (u[0] >= 1.0) u[0] -= 1.0;
   }
-  // The W points from the current one (coordinate k of point l in
-  // u[k][l]), then advanced past them. The same values as W calls of
-  // get() and advance(): within a block the lowest digits of W consecutive
-  // indices are consecutive table entries over the same higher blocks.
+  // The W points from the current one (coordinate k < dims of point l in
+  // u[k][l]; the others not written), then advanced past them. The same
+  // values as W calls of get() and advance(): within a block the lowest
+  // digits of W consecutive indices are consecutive table entries over the
+  // same higher blocks.
   template <int W>
-  void get_lanes(double (*u)[W]) {
-    for (int k = 0; k < kDims; ++k) {
+  void get_lanes(double (*u)[W], int dims = kDims) {
+    for (int k = dims; k < kDims; ++k) skip<W>(digits_[k]);
+    for (int k = 0; k < dims; ++k) {
       Digits& d = digits_[k];
       if (d.c[0] + W > d.block) {  // a carry inside the group: point by point
         for (int l = 0; l < W; ++l) {
@@ -123,11 +118,33 @@ class Halton {
  private:
   static constexpr unsigned kBlockMax = 4096;  // tables of at most 4096 entries (32 KiB)
   static constexpr int kMaxBlocks = 8;          // 23^2 = 529 per block: 8 blocks hold i < 2^64
+  // Per base b, the radical inverse of every block of e base-b digits (the
+  // digits of j reversed), b^e the largest power within kBlockMax: made once
+  // (a quadrature makes a Halton per block of points).
+  static const std::array<std::vector<double>, kDims>& block_tables() {
+    static const std::array<std::vector<double>, kDims> tables = [] {
+      std::array<std::vector<double>, kDims> t;
+      for (int k = 0; k < kDims; ++k) {
+        const unsigned b = kBases[k];
+        unsigned block = 1;
+        int e = 0;
+        while (block * b <= kBlockMax) block *= b, ++e;
+        t[k].resize(block);
+        for (unsigned j = 0; j < block; ++j) {
+          double f = 1.0 / b, r = 0.0;
+          for (unsigned x = j, q = 0; q < static_cast<unsigned>(e); ++q, x /= b, f /= b) r += (x % b) * f;
+          t[k][j] = r;
+        }
+      }
+      return t;
+    }();
+    return tables;
+  }
   struct Digits {
     unsigned block = 1;
     int used = kMaxBlocks;
     double inv_block = 1.0;
-    std::vector<double> table;
+    const double* table = nullptr;
     unsigned c[kMaxBlocks] = {};
   };
   static double value(const Digits& d) {
@@ -137,6 +154,17 @@ class Halton {
   }
   static void step(Digits& d) {
     for (int q = 0; q < kMaxBlocks; ++q) {
+      if (++d.c[q] < d.block) break;
+      d.c[q] = 0;
+    }
+  }
+  // W steps at once (W is below every block: one carry at most).
+  template <int W>
+  static void skip(Digits& d) {
+    d.c[0] += W;
+    if (d.c[0] < d.block) return;
+    d.c[0] -= d.block;
+    for (int q = 1; q < kMaxBlocks; ++q) {
       if (++d.c[q] < d.block) break;
       d.c[q] = 0;
     }
@@ -501,11 +529,23 @@ void integrate(const Paths& paths, long n, Sink& sink) {
   }
 }
 
+// The coordinates (Point) the paths of `orders` read: R's the entry and
+// interface 1's normal, TT's also interface 2's, TRT's interface 3's, the
+// residual's its spread.
+int coordinates_of(unsigned orders) {
+  if (orders & 8u) return kDims;
+  if (orders & 4u) return 7;
+  if (orders & 2u) return 5;
+  return 3;
+}
+
 // Points [first, end) of the set whose coordinate 0 is offset by half a
 // cell of `cells` points (the midpoints of a `cells`-point set: a fixed
-// quadrature_points = n is [0, n) with cells n).
+// quadrature_points = n is [0, n) with cells n); `orders`, what their paths
+// follow (TracerT::trace).
 struct PointRange {
   long first, end, cells;
+  unsigned orders = huang_lanes::kAllOrders | huang_lanes::kLedger;
 };
 
 // The same points W at a time through the lanes' paths (huang2022_lanes.h),
@@ -519,18 +559,20 @@ void integrate_lanes(const Tracer& tracer, const PointRange& r, long first, long
   using T = typename B::value_type;
   constexpr int W = Tracer::kWidth;
   Halton set(static_cast<std::uint64_t>(first) * W, r.cells, static_cast<std::uint64_t>(r.end) + W);
-  alignas(64) double u[kDims][W];
+  alignas(64) double u[kDims][W] = {};
   alignas(64) T ut[kDims][W], share[W];
   B ub[kDims];
+  for (B& x : ub) x = B(0.0);
   typename Tracer::Exits exits;
+  const int dims = coordinates_of(r.orders);  // (the others are not read)
   for (long i0 = first * W; i0 < end * W; i0 += W) {
-    set.get_lanes<W>(u);
+    set.get_lanes<W>(u, dims);
     for (int l = 0; l < W; ++l) share[l] = i0 + l < r.end ? T(1) : T(0);
-    for (int k = 0; k < kDims; ++k) {
+    for (int k = 0; k < dims; ++k) {
       for (int l = 0; l < W; ++l) ut[k][l] = static_cast<T>(u[k][l]);
       ub[k] = B::load_aligned(ut[k]);
     }
-    tracer.trace(ub, B::load_aligned(share), exits);
+    tracer.trace(ub, B::load_aligned(share), exits, r.orders);
     deposit(exits, u);
   }
 }
@@ -593,6 +635,14 @@ double residual_theta(double theta_i, double v, double u1, double u2) {
 }
 
 int lobe_index(int p, int lobes) { return lobe_of(std::min(p, kResidualP), lobes); }
+
+// The orders (huang_lanes::kAllOrders's bits) whose exits land in `lobe`.
+unsigned orders_of_lobe(int lobe, int lobes) {
+  unsigned orders = 0;
+  for (int p = 0; p <= kResidualP; ++p)
+    if (lobe_index(p, lobes) == lobe) orders |= 1u << p;
+  return orders;
+}
 
 // Whether the model is symmetric under the mirror through the fiber axis u
 // and the light's direction (relative azimuth phi -> -phi): that plane must
@@ -1003,22 +1053,24 @@ void on_lanes(HuangPaths choice, const Huang2022Params& p, double theta_i, doubl
 // point set than the whole, so the spread overstates the error rather than
 // understating it (what auto's points give on the atlas's fibers:
 // huang2022.h). The error falls as 1/sqrt(points) (a
-// little faster: huang2022.h), so the points are the smallest multiple of
-// 2^18 whose projected error is at most a tenth of a standard error in every
-// lobe and channel; the pilot's points are the first of them (the set's
-// coordinate 0 offset by half a cell of 2^18 points, whatever the total).
+// little faster: huang2022.h), so a lobe's points are the smallest multiple
+// of 2^18 whose projected error is at most a tenth of a standard error in
+// each of its channels (each lobe is judged on its own); the pilot's points
+// are the first of every lobe's (the set's coordinate 0 offset by half a
+// cell of 2^18 points, whatever the total).
 constexpr long kPilotPoints = 1L << 18;
 constexpr double kTargetErrorSE = 0.1;
 constexpr double kMinPhotonsWeight = 10.0;  // bins holding at least this many photons' weight
 
-// The points quadrature_points=auto takes, from the pilot's kPointBlocks
-// block sums (each point's weight 1, the pilot's estimate their sum over
-// kPilotPoints; block k's times kPointBlocks a replicate of it) and the
-// pilot's sums at twice the absorption (`squares`, the same entries): entry
-// m belongs to group group(m) of `groups` (a lobe and channel).
+// The points quadrature_points=auto takes for each of `groups` groups (a
+// lobe and channel), from the pilot's kPointBlocks block sums (each point's
+// weight 1, the pilot's estimate their sum over kPilotPoints; block k's
+// times kPointBlocks a replicate of it) and the pilot's sums at twice the
+// absorption (`squares`, the same entries): entry m belongs to group
+// group(m). A group without a bin of kMinPhotonsWeight takes the pilot.
 template <class Group>
-long auto_points(const std::vector<std::vector<double>>& blocks, const std::vector<double>& squares, int groups,
-                 Group&& group, double photons) {
+std::vector<long> auto_points(const std::vector<std::vector<double>>& blocks, const std::vector<double>& squares,
+                              int groups, Group&& group, double photons) {
   constexpr double K = kPointBlocks, kShare = 1.0 / kPilotPoints;
   std::vector<double> sum(groups, 0.0);
   std::vector<int> count(groups, 0);
@@ -1033,18 +1085,21 @@ long auto_points(const std::vector<std::vector<double>>& blocks, const std::vect
     sum[g] += ss / (K * (K - 1.0)) / se2;  // (error / SE)^2 at the pilot
     ++count[g];
   }
-  double worst = 0.0;  // the largest mean squared error in SE^2 at the pilot
-  for (int g = 0; g < groups; ++g)
-    if (count[g] > 0) worst = std::max(worst, sum[g] / count[g]);
-  const double needed = static_cast<double>(kPilotPoints) * worst / (kTargetErrorSE * kTargetErrorSE);
-  const double pilots = std::max(1.0, std::ceil(needed / static_cast<double>(kPilotPoints)));
-  if (pilots * kPilotPoints > static_cast<double>(kMaxQuadraturePoints))
-    throw Error(fmt::format(
-        "huang2022: quadrature_points=auto would need about {:.3g} points (at most 2^30) for a tenth of the standard "
-        "error of {:g} photons; set quadrature_points to a number (error then above that bound) or a smaller "
-        "quadrature_photons",
-        needed, photons));
-  return static_cast<long>(pilots) * kPilotPoints;
+  std::vector<long> points(groups, kPilotPoints);
+  for (int g = 0; g < groups; ++g) {
+    if (count[g] == 0) continue;
+    // The group's mean squared error in SE^2 at the pilot, falling as 1 / points.
+    const double needed = static_cast<double>(kPilotPoints) * (sum[g] / count[g]) / (kTargetErrorSE * kTargetErrorSE);
+    const double pilots = std::max(1.0, std::ceil(needed / static_cast<double>(kPilotPoints)));
+    if (pilots * kPilotPoints > static_cast<double>(kMaxQuadraturePoints))
+      throw Error(fmt::format(
+          "huang2022: quadrature_points=auto would need about {:.3g} points (at most 2^30) for a tenth of the "
+          "standard error of {:g} photons; set quadrature_points to a number (error then above that bound) or a "
+          "smaller quadrature_photons",
+          needed, photons));
+    points[g] = static_cast<long>(pilots) * kPilotPoints;
+  }
+  return points;
 }
 
 // Whether any channel absorbs.
@@ -1097,7 +1152,9 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
     std::vector<std::vector<double>> blocks(kPointBlocks, std::vector<double>(n_out, 0.0));
     std::deque<BinSink> sinks;
     for (std::vector<double>& o : blocks) sinks.emplace_back(on, grid, theta_i, phi_i, o);
-    integrate_blocks(tracer, r, [&](int b, const auto& e, const auto* u) { sinks[b].lanes(e, u, share); });
+    PointRange bins_only = r;  // (bins need no ledger)
+    bins_only.orders &= ~huang_lanes::kLedger;
+    integrate_blocks(tracer, bins_only, [&](int b, const auto& e, const auto* u) { sinks[b].lanes(e, u, share); });
     if (!apart)
       for (int b = 1; b < kPointBlocks; ++b) sinks[0].add(sinks[b]);
     for (int b = 0; b < (apart ? kPointBlocks : 1); ++b) sinks[b].finish();
@@ -1119,10 +1176,13 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
         });
     return out;
   }
-  // auto: the pilot's blocks finished one by one, the points it asks for
-  // after them (the same set), each point's weight 1 / points in the end.
-  // The standard errors need the second moment of the simulated photons'
-  // weights in each bin: the pilot's points once more at twice the absorption.
+  // auto: the pilot's blocks finished one by one, then the points each lobe
+  // asks for (the most of its channels') after them (the same set), in
+  // stretches over which the same lobes take points, the paths following
+  // only those lobes' orders; each of a lobe's points weighs 1 / its points
+  // in the end. The standard errors need the second moment of the simulated
+  // photons' weights in each bin: the pilot's points once more at twice the
+  // absorption.
   std::vector<double> squares =
       at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
         return blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, on)[0];
@@ -1133,15 +1193,26 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
     out = sum_blocks(pilot);
     if (squares.empty()) squares = out;  // no absorption: weights 0 or 1
     const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;
-    const long points = auto_points(
+    const std::vector<long> points = auto_points(
         pilot, squares, params_.lobes * C,
         [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
         params_.quadrature_photons);
-    if (points > kPilotPoints) {
-      const std::vector<double> rest = blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, false, paths)[0];
+    std::vector<long> lobe_points(params_.lobes, kPilotPoints);
+    for (int g = 0; g < params_.lobes * C; ++g) lobe_points[g / C] = std::max(lobe_points[g / C], points[g]);
+    for (long from = kPilotPoints;;) {
+      long to = kMaxQuadraturePoints;
+      unsigned orders = 0;
+      for (int l = 0; l < params_.lobes; ++l)
+        if (lobe_points[l] > from) {
+          to = std::min(to, lobe_points[l]);
+          orders |= orders_of_lobe(l, params_.lobes);
+        }
+      if (orders == 0) break;
+      const std::vector<double> rest = blocks_of(tracer, {from, to, kPilotPoints, orders}, 1.0, false, paths)[0];
       for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
+      from = to;
     }
-    for (double& x : out) x /= static_cast<double>(points);
+    for (std::size_t m = 0; m < size; ++m) out[m] /= static_cast<double>(lobe_points[m / per_lobe]);
   });
   return out;
 }
@@ -1185,9 +1256,11 @@ HuangEnergies Huang2022::energies(double theta_i, double phi_i) const {
     if (squares.empty()) squares = e.lobe;  // no absorption: weights 0 or 1
     std::vector<std::vector<double>> lobes;
     for (const HuangEnergies& x : pilot) lobes.push_back(x.lobe);
-    const long points = auto_points(
+    // (One count for every lobe: the furnace closes over the same paths.)
+    const std::vector<long> each = auto_points(
         lobes, squares, static_cast<int>(lobes[0].size()), [](std::size_t m) { return static_cast<int>(m); },
         params_.quadrature_photons);
+    const long points = *std::max_element(each.begin(), each.end());
     if (points > kPilotPoints)
       add_energies(e, sum(blocks_of(tracer, {kPilotPoints, points, kPilotPoints}, 1.0, paths)));
     scale_energies(e, 1.0 / static_cast<double>(points));

@@ -146,12 +146,12 @@
 // about the same on absorbing fibers in their simulations' own (smaller)
 // standard errors. So `quadrature_points` is `auto` by default:
 // per incident direction, a pilot of 2^18 points estimates the error and
-// the quadrature takes as many points (a multiple of 2^18, the pilot's
-// included) as make it a tenth of the standard error of a simulation of
+// each lobe takes as many points (a multiple of 2^18, the pilot's included)
+// as make its error a tenth of the standard error of a simulation of
 // `quadrature_photons` photons (the simulation's own photons when the
 // parameters come from one; huang2022.cpp says how). On configs/atlas.yaml
-// (300k photons) a fiber's RMS bin error is then at most 0.015, 0.069,
-// 0.076 and 0.002 standard errors for R, TT, TRT and p >= 3
+// (300k photons) a fiber's RMS bin error is then at most 0.052, 0.069,
+// 0.089 and 0.009 standard errors for R, TT, TRT and p >= 3
 // (`scripts/huang2022_quadrature_error.py configs/atlas.yaml --points auto
 // --reference 33554432`), in the simulation's own standard errors, whose
 // photons carry their attenuation (huang2022.cpp).

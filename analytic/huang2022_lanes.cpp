@@ -135,7 +135,8 @@ inline typename TracerT<B>::V3 TracerT<B>::normal(const Hit& h, double side, con
 }
 
 template <class B>
-void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
+void TracerT<B>::trace(const B* u, const B& base, Exits& out, unsigned orders) const {
+  const bool ledger = orders & kLedger;
   for (int c = 0; c < C_; ++c) {
     out.residual[c] = out.masked[c] = out.stopped[c] = B(0.0);
     for (int p = 0; p < 3; ++p) out.w[p][c] = B(0.0);
@@ -155,13 +156,13 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
   out.incident = w0;
   M alive = (macro > B(0.0)) & (w0 != B(0.0));
   const M facing = meso > B(0.0);
-  for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & !facing, w0);
+  if (ledger) for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & !facing, w0);
   alive = alive & facing;
   if (cycles_eval_) {
     // Cycles' eval() integrates over |h| <= 0.999 of the projected width only
     // (Paths::trace, kCyclesEvalMaxImpact).
     const M outside = xsimd::abs(sg) > B(0.999);
-    for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & outside, w0);
+    if (ledger) for (int c = 0; c < C_; ++c) out.stopped[c] += zero_unless(alive & outside, w0);
     alive = alive & !outside;
   }
   if (!xsimd::any(alive)) return;
@@ -172,7 +173,7 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
   const auto fr = fresnel_reflectance(ci, B(eta_), B(inv_eta_));
   const B F = fr.F;
   // R: reflection about m, on the outer side of ns and n0, masked towards o.
-  {
+  if (orders & 1u) {
     const V3 o = reflect(d0, m);
     const B on = dot(o, h.ns), om = dot(o, h.n0);
     // (form=cycles_eval: Cycles' eval_r tests the macro normal only.)
@@ -180,13 +181,14 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
     const B gl = leaving(meso, on), wf = w0 * F;
     const M live = alive & ok;
     for (int c = 0; c < C_; ++c) {
-      out.stopped[c] += zero_unless(alive & !ok, wf);
-      out.masked[c] += zero_unless(live, wf * (B(1.0) - gl));
+      if (ledger) out.stopped[c] += zero_unless(alive & !ok, wf);
+      if (ledger) out.masked[c] += zero_unless(live, wf * (B(1.0) - gl));
       out.w[0][c] = zero_unless(live, wf * gl);
     }
     out.live[0] = live & (F > B(0.0));
     out.dir[0] = o;
   }
+  if (!(orders & ~1u)) return;
   // T: into the fiber, on the inner side of ns and n0, masked towards t.
   const M entering = alive & !fr.tir;
   const V3 t = refract(d0, m, ci, fr.cos_t, inv_eta_);
@@ -196,12 +198,12 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
   const M live = entering & ok;
   B w[kMaxChannels];
   for (int c = 0; c < C_; ++c) {
-    out.stopped[c] += zero_unless(entering & !ok, w0 * prob);
-    out.masked[c] += zero_unless(live, w0 * prob * (B(1.0) - gl));
+    if (ledger) out.stopped[c] += zero_unless(entering & !ok, w0 * prob);
+    if (ledger) out.masked[c] += zero_unless(live, w0 * prob * (B(1.0) - gl));
     w[c] = zero_unless(live, w0 * prob * gl);
   }
   const M inside_live = live & (prob > B(0.0));
-  if (xsimd::any(inside_live)) inside(u, h, t, inside_live, w, prob, base * cycles_scale_, out);
+  if (xsimd::any(inside_live)) inside(u, h, t, inside_live, w, prob, base * cycles_scale_, orders, out);
 }
 
 // Huang2022's Paths::inside for k = 1 then k = 2: a chord, absorption, the
@@ -211,7 +213,8 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out) const {
 // Cycles' eval()'s at interface 2 and nothing from interface 3).
 template <class B>
 void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& alive_in, const B* w_in,
-                    const B& t1, const B& cycles_weight, Exits& out) const {
+                    const B& t1, const B& cycles_weight, unsigned orders, Exits& out) const {
+  const bool ledger = orders & kLedger;
   const int C = C_;
   M alive = alive_in;
   Hit at = from;
@@ -224,7 +227,7 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
     const B qa = d.y * d.y * irv2_ + d.z * d.z * irw2_;
     const B qb = B(2.0) * (at.pv * d.y * irv2_ + at.pw * d.z * irw2_);
     const M runs = qa > B(0.0);
-    add_where(out.stopped, alive & !runs, w, C);
+    if (ledger) add_where(out.stopped, alive & !runs, w, C);
     alive = alive & runs;
     const B len = xsimd::max(B(0.0), -qb / qa);
     // (The scalar Fiber::next also rescales the point onto the ellipse: a
@@ -246,7 +249,7 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
     const V3 nf = -at.ns, wv = -d;
     const B wn = dot(wv, nf);
     const M facing = wn > B(0.0);
-    add_where(out.stopped, alive & !facing, w, C);
+    if (ledger) add_where(out.stopped, alive & !facing, w, C);
     alive = alive & facing;
     if (!xsimd::any(alive)) return;
     const V3 m = normal(at, -1.0, wv, u[2 * k + 1], u[2 * k + 2]);
@@ -254,7 +257,7 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
     const auto fr = fresnel_reflectance(ci, B(inv_eta_), B(eta_));
     const B F = fr.F;
     // Out: order p = k (crossing: on the outer side of ns and n0).
-    {
+    if (orders >> k & 1u) {
       const M leaving_side = alive & !fr.tir;
       const V3 o = refract(d, m, ci, fr.cos_t, eta_);
       const B on = dot(o, at.ns), om = dot(o, at.n0);
@@ -263,19 +266,21 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
       const B gl = leaving(wn, on), prob = B(1.0) - F;
       const M live = leaving_side & ok;
       for (int c = 0; c < C; ++c) {
-        out.stopped[c] += zero_unless(leaving_side & !ok, w[c] * prob);
-        out.masked[c] += zero_unless(live, w[c] * prob * (B(1.0) - gl));
+        if (ledger) out.stopped[c] += zero_unless(leaving_side & !ok, w[c] * prob);
+        if (ledger) out.masked[c] += zero_unless(live, w[c] * prob * (B(1.0) - gl));
         out.w[k][c] = zero_unless(live, w[c] * prob * gl);
       }
       out.live[k] = live & (prob > B(0.0));
       out.dir[k] = o;
     }
-    // Internal reflection (staying: on the inner side of ns and n0).
+    // Internal reflection (staying: on the inner side of ns and n0), where
+    // an order beyond k is followed.
+    if (!(orders >> (k + 1))) return;
     if (cycles_residual_ && k == 2) {
-      for (int c = 0; c < C; ++c) out.stopped[c] += zero_unless(alive, w[c] * F);
+      if (ledger) for (int c = 0; c < C; ++c) out.stopped[c] += zero_unless(alive, w[c] * F);
       return;
     }
-    if (cycles_residual_ && cycles_trt_gate_) {
+    if (cycles_residual_ && cycles_trt_gate_ && (orders & 8u)) {
       // Cycles' eval() residual at interface 2: T1 R2^2 T_avg A^3 / (1 - A (1 - T_avg)).
       const B t_avg = xsimd::max(B(1.0) - F, B(1e-5));
       for (int c = 0; c < C; ++c)
@@ -288,8 +293,8 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
     const B gl = leaving(wn, on);
     const M live = alive & ok;
     for (int c = 0; c < C; ++c) {
-      out.stopped[c] += zero_unless(alive & !ok, w[c] * F);
-      out.masked[c] += zero_unless(live, w[c] * F * (B(1.0) - gl));
+      if (ledger) out.stopped[c] += zero_unless(alive & !ok, w[c] * F);
+      if (ledger) out.masked[c] += zero_unless(live, w[c] * F * (B(1.0) - gl));
       w[c] = zero_unless(live, w[c] * F * gl);
     }
     alive = live & (F > B(0.0));

@@ -28,6 +28,11 @@ namespace fiberlab::analytic::huang_lanes {
 
 inline constexpr int kMaxChannels = 8;  // Huang2022's constructor's limit
 inline constexpr int kDims = 9;         // the point set's coordinates (huang2022.cpp)
+// What trace() follows: bit p the exits of order p = 0, 1, 2, bit 3 the
+// residual (every p >= 3); with kLedger also what the paths lose (masked,
+// stopped), which bins do not need.
+inline constexpr unsigned kAllOrders = 0b1111;
+inline constexpr unsigned kLedger = 1u << 4;
 
 template <class B>
 struct V3T {
@@ -70,7 +75,12 @@ class TracerT {
   // u[k]: coordinate k of the W points (0 the entry angle, 1-2 / 3-4 / 5-6
   // the normals of interfaces 1 / 2 / 3); base: each point's share of the
   // beam (0 for a lane that holds no point; 1 gives Exits per unit share).
-  void trace(const B* u, const B& base, Exits& out) const;
+  // orders: kAllOrders's bits for the exits to follow, kLedger for the
+  // losses. An order left out has no exit (live false, weight 0), and a path
+  // ends where no order left to follow lies further along it (auto's points
+  // beyond what a lobe needs, huang2022.cpp). Without kLedger, or without
+  // every order, `masked` and `stopped` are not whole: bins only.
+  void trace(const B* u, const B& base, Exits& out, unsigned orders = kAllOrders | kLedger) const;
   int channels() const { return C_; }
 
  private:
@@ -83,7 +93,7 @@ class TracerT {
   [[gnu::always_inline]] B leaving(const B& cos_in, const B& cos_out) const;
   [[gnu::always_inline]] B lambda_root(const B& c) const;
   void inside(const B* u, const Hit& from, const V3& d, const M& alive, const B* w, const B& t1,
-              const B& cycles_weight, Exits& out) const;
+              const B& cycles_weight, unsigned orders, Exits& out) const;
 
   double eta_, inv_eta_, alpha_, ct_, st_, irv2_, irw2_, rv_, rw_;
   double sigma_[kMaxChannels];
