@@ -1181,15 +1181,36 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   // stretches over which the same lobes take points, the paths following
   // only those lobes' orders; each of a lobe's points weighs 1 / its points
   // in the end. The standard errors need the second moment of the simulated
-  // photons' weights in each bin: the pilot's points once more at twice the
-  // absorption.
-  std::vector<double> squares =
-      at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
-        return blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, on)[0];
-      });
+  // photons' weights in each bin: the pilot's points at twice the
+  // absorption. Where the lanes hold twice the channels, these are C more
+  // channels of the pilot's own paths (a channel's weights are apart from
+  // the others' in the paths, so the first C are the pilot's alone, bit for
+  // bit); else the pilot's points are traced once more.
+  std::vector<std::vector<double>> pilot;
+  std::vector<double> squares;
+  if (absorbs(params_) && 2 * C <= huang_lanes::kMaxChannels) {
+    Huang2022Params both = params_;
+    for (double s : params_.sigma_a) both.sigma_a.push_back(2.0 * s);
+    const Paths paths_both(both, theta_i, phi_i);
+    on_lanes(paths_, both, theta_i, phi_i, [&](const auto& tracer) {
+      pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths_both);
+    });
+    squares.assign(size, 0.0);
+    for (std::vector<double>& b : pilot) {
+      for (std::size_t e = 0; e < size / C; ++e)
+        for (int c = 0; c < C; ++c) {
+          squares[e * C + c] += b[e * 2 * C + C + c];
+          b[e * C + c] = b[e * 2 * C + c];  // (e * C + c <= e * 2 C + c: read before written)
+        }
+      b.resize(size);
+    }
+  } else {
+    squares = at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
+      return blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, on)[0];
+    });
+  }
   on_lanes(paths_, params_, theta_i, phi_i, [&](const auto& tracer) {
-    const std::vector<std::vector<double>> pilot =
-        blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths);
+    if (pilot.empty()) pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths);
     out = sum_blocks(pilot);
     if (squares.empty()) squares = out;  // no absorption: weights 0 or 1
     const std::size_t per_lobe = static_cast<std::size_t>(grid.n_theta()) * grid.n_phi() * C;

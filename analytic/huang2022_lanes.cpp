@@ -1,6 +1,8 @@
 #include "analytic/huang2022_lanes.h"
 
 #include <cmath>
+#include <type_traits>
+#include <utility>
 
 #include "analytic/model.h"
 #include "common/fiber_frame.h"
@@ -37,6 +39,46 @@ B zero_unless(const typename B::batch_bool_type& m, const B& x) { return xsimd::
 template <class B>
 V3T<B> refract(const V3T<B>& d, const V3T<B>& m, const B& cos_i, const B& cos_t, double inv_eta_rel) {
   return B(inv_eta_rel) * d + (cos_i * B(inv_eta_rel) - cos_t) * m;
+}
+
+// (sin, cos) of 2 pi t for |t| <= 1 (t in turns: a microfacet normal's
+// azimuth). Double lanes: xsimd's sincos of 2 pi t, as the scalar paths.
+// Float lanes: t is reduced exactly to the nearest quarter turn q / 4
+// (t - q / 4 is exact in float for |t| <= 1), a = 2 pi (t - q / 4), |a| <=
+// pi / 4, with 2 pi in two parts (float's 2 pi alone is 2.8e-8 high), then
+// the Taylor series of sin to a^9 and of cos to a^10 (truncation below
+// 2e-9, under float's rounding), rotated by the quarter turns: the exact
+// values to float's rounding, without a general range reduction or a call
+// (FloatLanesAreTheDoubleLanesToRounding holds the paths to the double
+// lanes').
+template <class B>
+std::pair<B, B> sincos_turns(const B& t) {
+  if constexpr (std::is_same_v<typename B::value_type, double>) {
+    return xsimd::sincos(B(kTwoPi) * t);
+  } else {
+    const B q = xsimd::nearbyint(B(4.0) * t);
+    constexpr float kHi = static_cast<float>(kTwoPi), kLo = static_cast<float>(kTwoPi - kHi);
+    const B r = t - B(0.25) * q, a = xsimd::fma(r, B(kHi), r * B(kLo)), a2 = a * a;
+    const B sin_a = a * xsimd::fma(a2, xsimd::fma(a2, xsimd::fma(a2, xsimd::fma(a2, B(1.0 / 362880.0),
+                                                                                B(-1.0 / 5040.0)),
+                                                               B(1.0 / 120.0)),
+                                              B(-1.0 / 6.0)),
+                                   B(1.0));
+    const B cos_a =
+        xsimd::fma(a2, xsimd::fma(a2, xsimd::fma(a2, xsimd::fma(a2, xsimd::fma(a2, B(-1.0 / 3628800.0),
+                                                                                B(1.0 / 40320.0)),
+                                                               B(-1.0 / 720.0)),
+                                              B(1.0 / 24.0)),
+                                 B(-0.5)),
+                   B(1.0));
+    // Quarter turns q mod 4: (sin, cos) -> (cos, -sin) per quarter.
+    const B quadrant = q - B(4.0) * xsimd::floor(B(0.25) * q);
+    const auto odd = (quadrant == B(1.0)) | (quadrant == B(3.0));
+    const auto negate_sin = quadrant >= B(2.0);
+    const auto negate_cos = (quadrant == B(1.0)) | (quadrant == B(2.0));
+    const B s0 = xsimd::select(odd, cos_a, sin_a), c0 = xsimd::select(odd, sin_a, cos_a);
+    return {xsimd::select(negate_sin, -s0, s0), xsimd::select(negate_cos, -c0, c0)};
+  }
 }
 
 // Adds x to acc where m (per channel).
@@ -125,7 +167,7 @@ inline typename TracerT<B>::V3 TracerT<B>::normal(const Hit& h, double side, con
   const V3 t1{xsimd::select(flat, -vh.y * inv, B(1.0)), xsimd::select(flat, vh.x * inv, B(0.0)), B(0.0)};
   const V3 t2 = cross(vh, t1);
   const B r = xsimd::sqrt(u1);
-  const auto sc = xsimd::sincos(B(kTwoPi) * u2);
+  const auto sc = sincos_turns(u2);
   const B p1 = r * sc.second;
   const B s = B(0.5) * (B(1.0) + vh.z);
   const B p2 = (B(1.0) - s) * xsimd::sqrt(xsimd::max(B(0.0), B(1.0) - p1 * p1)) + s * (r * sc.first);
@@ -144,6 +186,9 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out, unsigned orders) c
   for (int p = 0; p < 3; ++p) out.live[p] = M(false);
   // The entry at circle-space angle g (Fiber::entry), its share of the beam
   // cos(g) dg / 2, scaled onto the mesonormal by (wi.ns)/(wi.n0) (paper).
+  // (xsimd's sincos, not sincos_turns: in float, g's and pi / 2's roundings
+  // are both 2.8e-8 high and cancel in the shares' sum, the light reaching
+  // the fiber, which holds to 1e-9.)
   const B g = (u[0] - B(0.5)) * B(kPi);
   const auto sc = xsimd::sincos(g);
   const B sg = sc.first, cg = sc.second;
