@@ -1137,6 +1137,51 @@ std::vector<double> sum_blocks(const std::vector<std::vector<double>>& blocks) {
   return out;
 }
 
+// Blocks of bins whose channels are C channels and then the same C at twice
+// the absorption, made blocks of the first C; returns the sum over the
+// blocks, in block order, of the other C.
+std::vector<double> split_doubled_channels(std::vector<std::vector<double>>& blocks, int C) {
+  const std::size_t size = blocks[0].size() / 2;
+  std::vector<double> doubled(size, 0.0);
+  for (std::vector<double>& b : blocks) {
+    for (std::size_t e = 0; e < size / C; ++e)
+      for (int c = 0; c < C; ++c) {
+        doubled[e * C + c] += b[e * 2 * C + C + c];
+        b[e * C + c] = b[e * 2 * C + c];  // (e C + c <= 2 e C + c: read before written)
+      }
+    b.resize(size);
+  }
+  return doubled;
+}
+
+// Per lobe, the most points of its channels' groups (lobe l's channel c is
+// group l C + c).
+std::vector<long> most_of_channels(const std::vector<long>& group_points, int lobes, int C) {
+  std::vector<long> out(lobes, 0);
+  for (int g = 0; g < lobes * C; ++g) out[g / C] = std::max(out[g / C], group_points[g]);
+  return out;
+}
+
+// stretch(from, to, orders) for the points from `first` on that the lobes
+// ask for (lobe l the points below lobe_points[l]), in stretches over which
+// the same lobes take points, `orders` their exits (orders_of_lobe).
+template <class Stretch>
+void for_each_stretch(long first, const std::vector<long>& lobe_points, Stretch&& stretch) {
+  const int lobes = static_cast<int>(lobe_points.size());
+  for (long from = first;;) {
+    long to = kMaxQuadraturePoints;
+    unsigned orders = 0;
+    for (int l = 0; l < lobes; ++l)
+      if (lobe_points[l] > from) {
+        to = std::min(to, lobe_points[l]);
+        orders |= orders_of_lobe(l, lobes);
+      }
+    if (orders == 0) return;
+    stretch(from, to, orders);
+    from = to;
+  }
+}
+
 }  // namespace
 
 std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double theta_i, double phi_i) const {
@@ -1195,15 +1240,7 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
     on_lanes(paths_, both, theta_i, phi_i, [&](const auto& tracer) {
       pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths_both);
     });
-    squares.assign(size, 0.0);
-    for (std::vector<double>& b : pilot) {
-      for (std::size_t e = 0; e < size / C; ++e)
-        for (int c = 0; c < C; ++c) {
-          squares[e * C + c] += b[e * 2 * C + C + c];
-          b[e * C + c] = b[e * 2 * C + c];  // (e * C + c <= e * 2 C + c: read before written)
-        }
-      b.resize(size);
-    }
+    squares = split_doubled_channels(pilot, C);
   } else {
     squares = at_twice_the_absorption(paths_, params_, theta_i, phi_i, [&](const auto& tracer, const Paths& on) {
       return blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, false, on)[0];
@@ -1218,21 +1255,11 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
         pilot, squares, params_.lobes * C,
         [&](std::size_t m) { return static_cast<int>(m / per_lobe) * C + static_cast<int>(m % C); },
         params_.quadrature_photons);
-    std::vector<long> lobe_points(params_.lobes, kPilotPoints);
-    for (int g = 0; g < params_.lobes * C; ++g) lobe_points[g / C] = std::max(lobe_points[g / C], points[g]);
-    for (long from = kPilotPoints;;) {
-      long to = kMaxQuadraturePoints;
-      unsigned orders = 0;
-      for (int l = 0; l < params_.lobes; ++l)
-        if (lobe_points[l] > from) {
-          to = std::min(to, lobe_points[l]);
-          orders |= orders_of_lobe(l, params_.lobes);
-        }
-      if (orders == 0) break;
+    const std::vector<long> lobe_points = most_of_channels(points, params_.lobes, C);
+    for_each_stretch(kPilotPoints, lobe_points, [&](long from, long to, unsigned orders) {
       const std::vector<double> rest = blocks_of(tracer, {from, to, kPilotPoints, orders}, 1.0, false, paths)[0];
       for (std::size_t m = 0; m < size; ++m) out[m] += rest[m];
-      from = to;
-    }
+    });
     for (std::size_t m = 0; m < size; ++m) out[m] /= static_cast<double>(lobe_points[m / per_lobe]);
   });
   return out;
