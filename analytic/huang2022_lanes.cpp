@@ -233,7 +233,7 @@ void TracerT<B>::trace(const B* u, const B& base, Exits& out, unsigned orders) c
     out.live[0] = live & (F > B(0.0));
     out.dir[0] = o;
   }
-  if (!(orders & ~1u)) return;
+  if (!(orders & kAllOrders & ~1u)) return;
   // T: into the fiber, on the inner side of ns and n0, masked towards t.
   const M entering = alive & !fr.tir;
   const V3 t = refract(d0, m, ci, fr.cos_t, inv_eta_);
@@ -320,7 +320,7 @@ void TracerT<B>::inside(const B* u, const Hit& from, const V3& d_in, const M& al
     }
     // Internal reflection (staying: on the inner side of ns and n0), where
     // an order beyond k is followed.
-    if (!(orders >> (k + 1))) return;
+    if (!((orders & kAllOrders) >> (k + 1))) return;
     if (cycles_residual_ && k == 2) {
       if (ledger) for (int c = 0; c < C; ++c) out.stopped[c] += zero_unless(alive, w[c] * F);
       return;

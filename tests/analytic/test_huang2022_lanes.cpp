@@ -207,27 +207,55 @@ TEST(Huang2022, FloatLanesAreTheDoubleLanesToRounding) {
 // TracerT::trace told to follow some orders only (quadrature_points=auto
 // traces the points beyond what a lobe needs so, huang2022.cpp): the orders
 // it follows have the exits, weights and residual of a path that follows
-// every order, to the bit; the others have none. On every case (the
-// cycles_eval residual arrives at interface 2, on the way to TRT), in
-// float and double lanes, for random points.
+// every order, to the bit, with the ledger kept or not; the others have
+// none. On every case (the cycles_eval residual arrives at interface 2, on
+// the way to TRT), in float and double lanes, for random points.
 // Mutations caught: the order gate of interface 2 or 3 dropped (TT or TRT
 // exits where they were not asked for); cycles_eval's residual at interface
-// 2 kept without its order.
+// 2 kept without its order; the ledger bit read as an order.
 template <class Tracer>
-void expect_orders_apart(const Case& k) {
+void expect_only_the_followed_orders(const Case& k, const typename Tracer::Exits& all,
+                                     const typename Tracer::Exits& some, unsigned orders) {
   using B = typename Tracer::Batch;
   using T = typename B::value_type;
   constexpr int W = Tracer::kWidth;
-  const Tracer tracer(k.p, deg_to_rad(k.theta_deg), deg_to_rad(k.phi_deg));
   const int C = static_cast<int>(k.p.sigma_a.size());
-  std::mt19937_64 rng(7);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   auto lanes_of = [](const B& x) {
     std::array<T, W> a;
     x.store_unaligned(a.data());
     return a;
   };
   auto live_of = [&](const typename B::batch_bool_type& m) { return lanes_of(xsimd::select(m, B(1), B(0))); };
+  const std::string what = k.name + " orders " + std::to_string(orders);
+  for (int p = 0; p < 3; ++p) {
+    const bool followed = orders >> p & 1u;
+    const auto live = live_of(some.live[p]), live_all = live_of(all.live[p]);
+    const auto x = lanes_of(some.dir[p].x), x_all = lanes_of(all.dir[p].x);
+    for (int l = 0; l < W; ++l) {
+      ASSERT_EQ(live[l], followed ? live_all[l] : T(0)) << what << " p " << p;
+      if (live[l] != T(0)) {
+        ASSERT_EQ(x[l], x_all[l]) << what << " p " << p;
+      }
+    }
+    for (int c = 0; c < C; ++c) {
+      const auto w = lanes_of(some.w[p][c]), w_all = lanes_of(all.w[p][c]);
+      for (int l = 0; l < W; ++l) ASSERT_EQ(w[l], followed ? w_all[l] : T(0)) << what << " p " << p;
+    }
+  }
+  for (int c = 0; c < C; ++c) {
+    const auto r = lanes_of(some.residual[c]), r_all = lanes_of(all.residual[c]);
+    for (int l = 0; l < W; ++l) ASSERT_EQ(r[l], orders & 8u ? r_all[l] : T(0)) << what << " residual";
+  }
+}
+
+template <class Tracer>
+void expect_orders_apart(const Case& k) {
+  using B = typename Tracer::Batch;
+  using T = typename B::value_type;
+  constexpr int W = Tracer::kWidth;
+  const Tracer tracer(k.p, deg_to_rad(k.theta_deg), deg_to_rad(k.phi_deg));
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
   for (int group = 0; group < 200; ++group) {
     B u[huang_lanes::kDims];
     for (B& x : u) {
@@ -237,31 +265,12 @@ void expect_orders_apart(const Case& k) {
     }
     typename Tracer::Exits all, some;
     tracer.trace(u, B(1.0), all);
-    for (unsigned orders : {0b0001u, 0b0010u, 0b0100u, 0b1000u, 0b0110u, 0b1100u, 0b0011u, 0b1111u}) {
-      tracer.trace(u, B(1.0), some, orders);
-      for (int p = 0; p < 3; ++p) {
-        const bool followed = orders >> p & 1u;
-        const auto live = live_of(some.live[p]), live_all = live_of(all.live[p]);
-        for (int c = 0; c < C; ++c) {
-          const auto w = lanes_of(some.w[p][c]), w_all = lanes_of(all.w[p][c]);
-          for (int l = 0; l < W; ++l) {
-            ASSERT_EQ(live[l], followed ? live_all[l] : T(0)) << k.name << " orders " << orders << " p " << p;
-            ASSERT_EQ(w[l], followed ? w_all[l] : T(0)) << k.name << " orders " << orders << " p " << p;
-          }
-        }
-        const auto x = lanes_of(some.dir[p].x), x_all = lanes_of(all.dir[p].x);
-        for (int l = 0; l < W; ++l) {
-          if (live[l] != T(0)) {
-            ASSERT_EQ(x[l], x_all[l]) << k.name << " orders " << orders << " p " << p;
-          }
-        }
+    for (unsigned exits : {0b0001u, 0b0010u, 0b0100u, 0b1000u, 0b0110u, 0b1100u, 0b0011u, 0b1111u})
+      for (unsigned ledger : {0u, huang_lanes::kLedger}) {
+        tracer.trace(u, B(1.0), some, exits | ledger);
+        expect_only_the_followed_orders<Tracer>(k, all, some, exits | ledger);
+        if (::testing::Test::HasFatalFailure()) return;
       }
-      for (int c = 0; c < C; ++c) {
-        const auto r = lanes_of(some.residual[c]), r_all = lanes_of(all.residual[c]);
-        for (int l = 0; l < W; ++l)
-          ASSERT_EQ(r[l], orders & 8u ? r_all[l] : T(0)) << k.name << " orders " << orders << " residual";
-      }
-    }
   }
 }
 
