@@ -1116,6 +1116,15 @@ Huang2022Params doubly_absorbing(Huang2022Params p) {
   return p;
 }
 
+// `p` with C more channels: its own C, then the same at twice the absorption
+// (doubly_absorbing's).
+Huang2022Params with_doubled_channels(const Huang2022Params& p) {
+  Huang2022Params both = p;
+  const std::vector<double> doubled = doubly_absorbing(p).sigma_a;
+  both.sigma_a.insert(both.sigma_a.end(), doubled.begin(), doubled.end());
+  return both;
+}
+
 // pilot(tracer, paths) for the fiber at twice its absorption, on the lanes
 // of `choice`; nothing where no channel absorbs (p2 = p there).
 template <class Pilot>
@@ -1234,8 +1243,7 @@ std::vector<double> Huang2022::bin_probabilities(const BinGrid& grid, double the
   std::vector<std::vector<double>> pilot;
   std::vector<double> squares;
   if (absorbs(params_) && 2 * C <= huang_lanes::kMaxChannels) {
-    Huang2022Params both = params_;
-    for (double s : params_.sigma_a) both.sigma_a.push_back(2.0 * s);
+    const Huang2022Params both = with_doubled_channels(params_);
     const Paths paths_both(both, theta_i, phi_i);
     on_lanes(paths_, both, theta_i, phi_i, [&](const auto& tracer) {
       pilot = blocks_of(tracer, {0, kPilotPoints, kPilotPoints}, 1.0, true, paths_both);
