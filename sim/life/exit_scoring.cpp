@@ -100,7 +100,7 @@ ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lob
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()), expected_value_(expected_value),
       absorption_(expected_value ? sigma_a_.size() * FinishedPhotons::kCapacity : 0),
-      fixed_(sigma_a_.size()), growth_(sigma_a_.size()), lobe_growth_(sigma_a_.size()),
+      runs_(sigma_a_.size()), fixed_(sigma_a_.size()), growth_(sigma_a_.size()), lobe_growth_(sigma_a_.size()),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -260,11 +260,8 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   __builtin_prefetch(room_.data() + at, 1);
   if (!f.exited[i]) return;
   tally.prefetch_all(bin[i], lobe_[i]);
-  const Run& run = runs_[f.slot[i]];
-  __builtin_prefetch(&run, 1);
   __builtin_prefetch(lobe_total_.data() + at, 1);
-  __builtin_prefetch(run.bins.data(), 1);
-  __builtin_prefetch(run.totals.data(), 1);
+  runs_.prefetch(f.slot[i]);
 }
 
 // Room for every slot the block uses (once: slots are the tracer's, a
@@ -272,20 +269,17 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
 void ExitScorer::reserve_slots(const FinishedPhotons& f) {
   std::uint32_t top = 0;
   for (int i = 0; i < f.n; ++i) top = std::max(top, f.slot[i]);
-  if (top < runs_.size()) return;
+  if (top < runs_.slots()) return;
   const std::size_t slots = top + 1, channels = sigma_a_.size();
   room_.resize(slots * channels, Tally::kOne);
   lobe_total_.resize(slots * channels, 0.0);
-  runs_.resize(slots);
+  runs_.reserve(slots);
 }
 
 void ExitScorer::end_photon(std::uint32_t slot) {
   const std::size_t channels = sigma_a_.size(), at = slot * channels;
   std::fill_n(room_.begin() + at, channels, Tally::kOne);
-  Run& run = runs_[slot];
-  run.lobe = -1;
-  run.bins.clear();
-  run.totals.clear();
+  runs_.start(slot, -1);
 }
 
 // One row's weight in fixed point, into fixed_: at most the room the
@@ -352,25 +346,18 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
   double* growth = kChannels > 0 ? growth_local : growth_.data();
   double* lobe_growth = kChannels > 0 ? lobe_growth_local : lobe_growth_.data();
   book<kChannels>(weight, kCap, slot, fixed);
-  Run& run = runs_[slot];
   double* lobe_total = lobe_total_.data() + at;
   // (A new lobe's total starts from 0 without being stored first: a store
   // then load of the same numbers on every row would stall.)
-  const bool new_lobe = run.lobe != lobe_[i];
-  if (new_lobe) {
-    run.lobe = lobe_[i];
-    run.bins.clear();
-    run.totals.clear();
-  }
+  const bool new_lobe = runs_.lobe(slot) != lobe_[i];
+  if (new_lobe) runs_.start(slot, lobe_[i]);
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
     const double t = new_lobe ? 0.0 : lobe_total[c];
     lobe_growth[c] = w * (2.0 * t + w);
     lobe_total[c] = t + w;
   }
-  for (std::size_t e = 0; e < run.bins.size(); ++e) {
-    if (run.bins[e] != bin) continue;
-    double* total = run.totals.data() + e * channels;
+  if (double* total = runs_.find(slot, bin)) {
     for (std::size_t c = 0; c < channels; ++c) {
       const double w = weight[c * kCap];
       growth[c] = w * (2.0 * total[c] + w);
@@ -379,11 +366,10 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
     tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, false);
     return;
   }
-  run.bins.push_back(bin);
+  runs_.append(slot, bin, weight, kCap);
   for (std::size_t c = 0; c < channels; ++c) {
     const double w = weight[c * kCap];
     growth[c] = w * w;
-    run.totals.push_back(w);
   }
   tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, true);
 }

@@ -12,6 +12,7 @@
 
 #include "common/bin_grid.h"
 #include "sim/life/finished_photons.h"
+#include "sim/life/photon_runs.h"
 #include "sim/store/tally.h"
 
 namespace fiberlab::sim {
@@ -44,24 +45,14 @@ class ExitScorer {
   // ([channel][row]; weights_ is the row's weight times it) and lobe.
   std::vector<double> absorption_;
   int lobe_[FinishedPhotons::kCapacity];
-  // Per slot (sim/life/finished_photons.h), the photon in it so far, in flat
-  // arrays sized once per slot ([slot][channel]): its room in fixed point
-  // (1 plus what Russian roulette created for it, minus what it booked,
-  // which is at most that); the lobe of its
-  // latest exit and its total there. A photon's lobes never decrease along
-  // its rows (min(p, L - 1) with p growing; the medulla's `scattered` once
-  // scattered), so its exits in one lobe are consecutive: its Run holds the
-  // bins of the current lobe with its total in each, and is emptied when
-  // the lobe changes. A Run's vectors keep their capacity: no allocation per
-  // photon once the runs have met their longest.
-  struct Run {
-    int lobe = -1;
-    std::vector<std::size_t> bins;
-    std::vector<double> totals;  // [entry][channel]
-  };
+  // Per slot (sim/life/finished_photons.h), the photon in it so far: its
+  // room in fixed point (1 plus what Russian roulette created for it, minus
+  // what it booked, which is at most that) in a flat array ([slot][channel]);
+  // its total in its latest lobe ([slot][channel]) and in that lobe's bins
+  // (runs_).
   std::vector<Tally::Fixed> room_;
   std::vector<double> lobe_total_;
-  std::vector<Run> runs_;
+  PhotonRuns runs_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
   std::vector<double> growth_;        // [channel]: one row's bin S2 growth
   std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
