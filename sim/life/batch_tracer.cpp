@@ -261,19 +261,28 @@ void hand_over_event_rows(const life::PhotonState<Lanes, Light>& s, const life::
 // event's own normal (with the roulette term, and the end of a photon that
 // roulette ended), as the reference Tracer lists them. Returns where those
 // last rows start.
+// A first event (ScoredExit::first) splits even where its own normal's
+// branch did not leave: `split_only` are such lanes with nothing else to
+// hand over (no row of their own). The weight a first event's split created
+// or destroyed rides on its first extra row, as roulette, so that the
+// scorer widens the photon's room before booking the split's exits.
 template <class Model, class Light>
 int hand_over_scored(const life::LifeConfig& c, const Model& model, const life::PhotonState<Lanes, Light>& s,
                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
-                     const life::BitsOf<Lanes>& slot, std::uint64_t lanes, FinishedPhotons& f) {
+                     const life::BitsOf<Lanes>& slot, std::uint64_t lanes, std::uint64_t split_only,
+                     FinishedPhotons& f) {
   if (f.n == 0) f.losses.clear();  // a new block (hand_over_losses adds the photons' losses)
   Lanes own = s.scored.weight;  // the event's own normal's exit
   if (c.most_exit_normals > 1) {
     life::SplitExits<W> split;
     life::split_scored_exits(c, model, s.scored, s.rng, split);
+    const Lanes created = load<Lanes>(split.created);
     for (int e = 1; e < split.n; ++e) {
       const Lanes w = load<Lanes>(split.weight[e]);
+      const Lanes roulette = e == 1 ? created : Lanes(0.0);
       hand_over_event_rows(s, {load<Lanes>(split.dx[e]), load<Lanes>(split.dy[e]), load<Lanes>(split.dz[e])}, w,
-                           Lanes(0.0), 0, phi_i, photon, slot, lanes & life::lane_bits(w > Lanes(0.0)), f);
+                           roulette, 0, phi_i, photon, slot,
+                           (lanes | split_only) & life::lane_bits((w > Lanes(0.0)) | (roulette != Lanes(0.0))), f);
     }
     own = load<Lanes>(split.weight[0]);
   }
@@ -484,9 +493,11 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         const std::uint64_t scored = life::lane_bits(
             live & ((s.scored.weight > Lanes(0.0)) | (s.scored.roulette != Lanes(0.0))));
         const std::uint64_t ended = life::lane_bits(live & (s.code == Lanes(double(life::kEnded))));
+        const std::uint64_t split_only = life::lane_bits(live & (s.scored.first != Lanes(0.0))) & ~scored;
         end_rows = finished & ~ended;
-        if (scored != 0) {
-          const int n_before = hand_over_scored(config_, model, s, phi_lanes, photon, slot, scored, *done);
+        if ((scored | split_only) != 0) {
+          const int n_before =
+              hand_over_scored(config_, model, s, phi_lanes, photon, slot, scored, split_only, *done);
           if constexpr (kLosses)
             if (ended != 0) hand_over_losses_of_ended(s.losses.slot, scored, ended, n_before, pool, *done);
         }

@@ -98,10 +98,24 @@ class EllipseCrossSection {
   // with explicit fused multiply-adds so that both round alike.
   template <class T>
   void entry_point_in_beam(const Eigen::Vector2d& g, const T& h, T& pv, T& pw) const {
+    entry_point_in_beam(T(g.x()), T(g.y()), h, pv, pw);
+  }
+  // The same with the beam direction (gv, gw) per lane (beam_direction_of).
+  template <class T>
+  void entry_point_in_beam(const T& gv, const T& gw, const T& h, T& pv, T& pw) const {
     using namespace life;
     const T s = sqrt(max(T(0.0), fma(-h, h, T(1.0))));
-    pv = T(rv_) * fma(h, T(-g.y()), -(s * T(g.x())));
-    pw = T(rw_) * fma(h, T(g.x()), -(s * T(g.y())));
+    pv = T(rv_) * fma(h, -gw, -(s * gv));
+    pw = T(rw_) * fma(h, gv, -(s * gw));
+  }
+  // beam_direction for one photon or a vector of them, each its own d.
+  template <class T>
+  void beam_direction_of(const T& dv, const T& dw, T& gv, T& gw) const {
+    using namespace life;
+    const T a = dv / T(rv_), b = dw / T(rw_);
+    const T norm = sqrt(a * a + b * b);
+    gv = a / norm;
+    gw = b / norm;
   }
 
  private:

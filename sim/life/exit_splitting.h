@@ -23,6 +23,23 @@
 // - What it buys: where an event's roughness spreads its exit over many
 //   bins, the variance of those bins falls by up to K; the cost is K - 1
 //   normal draws and exit rows (the figure of merit per lobe: docs/PHYSICS.md).
+//
+// The photon's first event (outside, at its entry point, no event there
+// before; ScoredExit::first) splits differently: its K - 1 extra events
+// each draw an impact parameter h uniform in [-1, 1) and a normal at that
+// entry point, so that the K are K independent first events (the photon's
+// own among them), and each scores w s_k / K (resampled_weights), whether
+// or not the photon's own branch left. Unbiased: each term is 1 / K of an
+// expected-value score of a first event, whose expectation over h and the
+// normal is the bin's. Where most of R's remaining variance is that of h
+// (which bins a given h can reach), weights in proportion to s_1 would keep
+// it, since a photon's total there stays its own w s_1; this removes it.
+// The event's total is then w (s_1 + ... + s_K) / K, not the photon's own
+// w s_1, while the photon goes on with w (1 - P_1) as before: the
+// difference is weight the split created (> 0) or destroyed (< 0), booked
+// with the photon's roulette term (on its first extra row), so that each
+// photon's ledger still closes exactly and the roulette term keeps
+// expectation 0.
 // An extra normal whose draw gives up (a rejection sampler's cap, SPEC
 // section 3: never seen in practice) counts as s_k = 0; it does not
 // truncate the photon.
@@ -114,6 +131,9 @@ struct SplitExits {
   int n = 1;
   alignas(64) double dx[kMaxExitNormals][W], dy[kMaxExitNormals][W], dz[kMaxExitNormals][W];
   alignas(64) double weight[kMaxExitNormals][W];
+  // Per lane, the weight the split created (> 0) or destroyed (< 0) at a
+  // first event (resampled_weights), booked as the ledger's roulette term.
+  alignas(64) double created[W];
 };
 
 // Settings::exit_normals for the lobes p of the lanes.
@@ -171,6 +191,28 @@ struct ExtraNormalQueue {
   int n_pairs_ = 0, next_ = 0;
 };
 
+// A first event's K exits (lane l of `out`: entry 0 the photon's own, w s_1;
+// entries k >= 1 the shares s_k of K - 1 more first events, each at its own
+// entry point and normal) scored as K independent first events: w s_k / K
+// each. Unbiased: each is an expected-value score of a first event, whose
+// expectation over h and the normal is the bin's. Their total is not the
+// photon's own w s_1: the difference is weight the split created or
+// destroyed (out.created), booked with the photon's roulette term so that
+// its ledger still closes, and whose expectation is 0.
+template <int W>
+void resampled_weights(SplitExits<W>& out, int l, int normals, double w) {
+  const double per_event = w / normals;
+  double total = 0.0;
+  const double own = out.weight[0][l];
+  out.weight[0][l] = own / normals;
+  total += out.weight[0][l];
+  for (int k = 1; k < normals; ++k) {
+    out.weight[k][l] *= per_event;
+    total += out.weight[k][l];
+  }
+  out.created[l] = total - own;
+}
+
 // The scored exits e of a vector of photons (ScoredExit: this step's, with
 // their streams `rng` after the step) spread over c.exit_normals[lobe p]
 // normals each. The extra normals of all the lanes' splits are drawn a
@@ -186,7 +228,10 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   store(e.d.y, out.dy[0]);
   store(e.d.z, out.dz[0]);
   store(e.weight, out.weight[0]);
-  const MaskOf<T> scored = e.weight > T(0.0);
+  for (double& x : out.created) x = 0.0;
+  // A first event splits whether or not its own normal's branch left.
+  const MaskOf<T> first = e.first != T(0.0);
+  const MaskOf<T> scored = (e.weight > T(0.0)) | first;
   if (c.most_exit_normals == 1 || !any(scored)) return;
   // The lanes' normals (1 where nothing was scored) and shares.
   alignas(64) double normals[W], share[W];
@@ -200,6 +245,7 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   // Each vector lane's stream and candidate count (its pair's).
   LaneRandom<T> r(BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0));
   T tries(0.0);
+  T h(0.0);  // a first event's pair: its entry point's impact parameter
   std::uint64_t fresh = 0;
   while (queue.refill(fresh)) {
     const BitsOf<T> lane = load_bits<T>(queue.lane);
@@ -211,9 +257,21 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
                         select(m, seeded.word(2), r.word(2)), select(m, seeded.word(3), r.word(3)));
       tries = select(is_fresh, T(0.0), tries);
     }
-    const SplitEvent<T> ev = split_event(
-        c, Vec3Of<T>(permute_lanes(e.d_in.x, lane), permute_lanes(e.d_in.y, lane), permute_lanes(e.d_in.z, lane)),
-        permute_lanes(e.px, lane), permute_lanes(e.py, lane), permute_lanes(e.inside, lane));
+    const MaskOf<T> at_entry = permute_lanes(e.first, lane) != T(0.0);
+    // A first event's pair draws its impact parameter first from its fresh stream.
+    const MaskOf<T> new_entry = is_fresh & at_entry;
+    if (any(new_entry)) h = select(new_entry, T(2.0) * r.uniform(new_entry) - T(1.0), h);
+    const Vec3Of<T> d_in(permute_lanes(e.d_in.x, lane), permute_lanes(e.d_in.y, lane),
+                         permute_lanes(e.d_in.z, lane));
+    T px = permute_lanes(e.px, lane), py = permute_lanes(e.py, lane);
+    if (any(at_entry)) {
+      T gv, gw, ev_v, ev_w;
+      c.ellipse.beam_direction_of(d_in.y, d_in.z, gv, gw);
+      c.ellipse.entry_point_in_beam(gv, gw, h, ev_v, ev_w);
+      px = select(at_entry, ev_v, px);
+      py = select(at_entry, ev_w, py);
+    }
+    const SplitEvent<T> ev = split_event(c, d_in, px, py, permute_lanes(e.inside, lane));
     LifeCounts<T> counts;  // not the run's: an extra normal is not an event
     const FacetDraw<T> f = model.draw_normal(ev.d_in, ev.frame, busy, r, tries, counts, kMaxNormalTries);
     const ExtraExit<T> x = extra_exit(model, ev, f.m, f.ready, r);
@@ -238,8 +296,15 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   // shares summed in the order of k, whatever order the pairs were drawn
   // in, so that S does not depend on the photon's neighbours in the
   // vector); a lane with one normal keeps its weight as it is.
+  alignas(64) double is_first[W], weight_in[W];
+  store(select(first, T(1.0), T(0.0)), is_first);
+  store(e.weight_in, weight_in);
   for (int l = 0; l < W; ++l) {
     if (normals[l] < 2.0) continue;
+    if (is_first[l] != 0.0) {
+      resampled_weights(out, l, static_cast<int>(normals[l]), weight_in[l]);
+      continue;
+    }
     double extra = 0.0;
     for (int k = 1; k < static_cast<int>(normals[l]); ++k) extra += out.weight[k][l];
     const double scale = out.weight[0][l] / (share[l] + extra);

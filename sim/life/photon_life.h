@@ -113,6 +113,12 @@ struct ScoredExit {
   Vec3Of<T> d_in;
   T px, py, inside;
   T share;
+  // 1 where the event is the photon's first (outside, at its entry point,
+  // no event there before: the photon's weight is its launch weight), whose
+  // split also draws the entry point (sim/life/exit_splitting.h); the
+  // photon's weight before the event.
+  T first;
+  T weight_in;
 };
 
 template <class T, class Light>
@@ -140,7 +146,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -179,6 +185,7 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
     s.scored.px = s.px;
     s.scored.py = s.py;
     s.scored.inside = ones<T>(inside);
+    s.scored.weight_in = s.weight;
   }
   s.scored.d = r.leave_direction;
   s.scored.path = s.path;
@@ -224,6 +231,8 @@ MaskOf<T> interface_event(const LifeConfig& c, const Model& model, PhotonState<T
   if constexpr (kExpectedValue) {
     r = s.light.interact(s.d, f.m, index, act, s.rng, ExitScoring<T>{act, inside, n0});
     score_leaving_branch(model, s, r, frame, f.m, inside, c.most_exit_normals > 1);
+    if (c.exit_normals[0] > 1)  // R's split at the first event draws entry points too
+      s.scored.first = ones<T>(act & !inside & (s.segments == T(0.0)) & (s.events_here == T(0.0)));
   } else {
     r = s.light.interact(s.d, f.m, index, act, s.rng);
   }

@@ -28,23 +28,28 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
       step<true>(config_, model, s, true, counts, kMaxNormalTries);
     else
       step<false>(config_, model, s, true, counts, kMaxNormalTries);
-    if (config_.expected_value && (s.scored.weight > 0.0 || s.scored.roulette != 0.0)) {
+    const bool own_row = s.scored.weight > 0.0 || s.scored.roulette != 0.0;
+    if (config_.expected_value && (own_row || s.scored.first != 0.0)) {
       const int p = static_cast<int>(s.scored.segments);
       Vec3 d = s.scored.d.to_vec3();
       if (s.scored.weight > 0.0) {
         PhotonRandom blur = scored_exit_stream(s.rng.word(0), s.rng.word(1), s.rng.word(2), s.rng.word(3));
         d = exit_direction_of(model, d, p, blur);
       }
-      // Exit splitting: the extra normals' exits first, the event's own
-      // (with the roulette term) last, as the batched tracer hands them over.
+      // Exit splitting: the extra normals' exits first (the first carrying
+      // what a first event's split created), the event's own (with the
+      // roulette term) last, as the batched tracer hands them over.
       life::SplitExits<1> split;
       life::split_scored_exits(config_, model, s.scored, s.rng, split);
-      for (int k = 1; k < split.n; ++k)
-        if (split.weight[k][0] > 0.0)
+      for (int k = 1; k < split.n; ++k) {
+        const double roulette = k == 1 ? split.created[0] : 0.0;
+        if (split.weight[k][0] > 0.0 || roulette != 0.0)
           scored.push_back({Vec3(split.dx[k][0], split.dy[k][0], split.dz[k][0]), p, s.scored.path,
-                            split.weight[k][0], s.scored.medulla_path, s.scored.scatters > 0.0, 0.0});
-      scored.push_back({d, p, s.scored.path, split.weight[0][0], s.scored.medulla_path,
-                        s.scored.scatters > 0.0, s.scored.roulette});
+                            split.weight[k][0], s.scored.medulla_path, s.scored.scatters > 0.0, roulette});
+      }
+      if (own_row)
+        scored.push_back({d, p, s.scored.path, split.weight[0][0], s.scored.medulla_path,
+                          s.scored.scatters > 0.0, s.scored.roulette});
     }
   }
   rng.core() = s.rng;
