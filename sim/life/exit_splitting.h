@@ -245,7 +245,10 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   // Each vector lane's stream and candidate count (its pair's).
   LaneRandom<T> r(BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0), BitsOf<T>(0));
   T tries(0.0);
-  T h(0.0);  // a first event's pair: its entry point's impact parameter
+  // A first event's pair: its entry point (drawn once per pair, from the
+  // photon's beam direction, computed once per photon).
+  T entry_v(0.0), entry_w(0.0), beam_v(0.0), beam_w(0.0);
+  if (any(first)) c.ellipse.beam_direction_of(e.d_in.y, e.d_in.z, beam_v, beam_w);
   std::uint64_t fresh = 0;
   while (queue.refill(fresh)) {
     const BitsOf<T> lane = load_bits<T>(queue.lane);
@@ -260,17 +263,17 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
     const MaskOf<T> at_entry = permute_lanes(e.first, lane) != T(0.0);
     // A first event's pair draws its impact parameter first from its fresh stream.
     const MaskOf<T> new_entry = is_fresh & at_entry;
-    if (any(new_entry)) h = select(new_entry, T(2.0) * r.uniform(new_entry) - T(1.0), h);
+    if (any(new_entry)) {
+      const T h = T(2.0) * r.uniform(new_entry) - T(1.0);
+      T v, w;
+      c.ellipse.entry_point_in_beam(permute_lanes(beam_v, lane), permute_lanes(beam_w, lane), h, v, w);
+      entry_v = select(new_entry, v, entry_v);
+      entry_w = select(new_entry, w, entry_w);
+    }
     const Vec3Of<T> d_in(permute_lanes(e.d_in.x, lane), permute_lanes(e.d_in.y, lane),
                          permute_lanes(e.d_in.z, lane));
-    T px = permute_lanes(e.px, lane), py = permute_lanes(e.py, lane);
-    if (any(at_entry)) {
-      T gv, gw, ev_v, ev_w;
-      c.ellipse.beam_direction_of(d_in.y, d_in.z, gv, gw);
-      c.ellipse.entry_point_in_beam(gv, gw, h, ev_v, ev_w);
-      px = select(at_entry, ev_v, px);
-      py = select(at_entry, ev_w, py);
-    }
+    const T px = select(at_entry, entry_v, permute_lanes(e.px, lane));
+    const T py = select(at_entry, entry_w, permute_lanes(e.py, lane));
     const SplitEvent<T> ev = split_event(c, d_in, px, py, permute_lanes(e.inside, lane));
     LifeCounts<T> counts;  // not the run's: an extra normal is not an event
     const FacetDraw<T> f = model.draw_normal(ev.d_in, ev.frame, busy, r, tries, counts, kMaxNormalTries);
