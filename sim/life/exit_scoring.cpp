@@ -100,7 +100,7 @@ ExitScorer::ExitScorer(const BinGrid& grid, std::vector<double> sigma_a, int lob
       weights_(sigma_a_.size() * FinishedPhotons::kCapacity), one_photon_(sigma_a_.size()),
       kept_(sigma_a_.size()), expected_value_(expected_value),
       absorption_(expected_value ? sigma_a_.size() * FinishedPhotons::kCapacity : 0),
-      runs_(sigma_a_.size()), fixed_(sigma_a_.size()), growth_(sigma_a_.size()), lobe_growth_(sigma_a_.size()),
+      runs_(sigma_a_.size()), fixed_(sigma_a_.size()), growth_(sigma_a_.size()),
       // (equal-area theta bins go through a vector sine, not shown monotone: always settled)
       theta_closed_form_(grid.theta_binning == ThetaBinning::Uniform &&
                          edges_at_closed_form(grid.theta_edges, kPi / 2, kPi)),
@@ -246,7 +246,7 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
       for (int c = 0; c < channels; ++c) fixed_[c] = Tally::kOne - room_[at + c];
       tally.score_lost(weight, fixed_.data());
     }
-    end_photon(slot);
+    end_photon(slot, tally);
   }
 }
 
@@ -259,7 +259,7 @@ void ExitScorer::score_rows_expected_value(const FinishedPhotons& f, const std::
   const std::size_t at = static_cast<std::size_t>(f.slot[i]) * sigma_a_.size();
   __builtin_prefetch(room_.data() + at, 1);
   if (!f.exited[i]) return;
-  tally.prefetch_all(bin[i], lobe_[i]);
+  tally.prefetch_all(bin[i]);
   __builtin_prefetch(lobe_total_.data() + at, 1);
   runs_.prefetch(f.slot[i]);
 }
@@ -276,9 +276,10 @@ void ExitScorer::reserve_slots(const FinishedPhotons& f) {
   runs_.reserve(slots);
 }
 
-void ExitScorer::end_photon(std::uint32_t slot) {
+void ExitScorer::end_photon(std::uint32_t slot, Tally& tally) {
   const std::size_t channels = sigma_a_.size(), at = slot * channels;
   std::fill_n(room_.begin() + at, channels, Tally::kOne);
+  if (runs_.lobe(slot) >= 0) tally.score_lobe_total(runs_.lobe(slot), lobe_total_.data() + at);
   runs_.start(slot, -1);
 }
 
@@ -338,32 +339,29 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
   const std::uint32_t slot = f.slot[i];
   const std::size_t channels = kChannels > 0 ? kChannels : sigma_a_.size(), at = slot * channels;
   const double* weight = weights_.data() + i;
-  // One row's numbers: fixed, growth and lobe_growth (channels of them).
+  // One row's numbers: fixed and growth (channels of them).
   constexpr std::size_t kLocal = kChannels > 0 ? kChannels : 1;
   Tally::Fixed fixed_local[kLocal];
-  double growth_local[kLocal], lobe_growth_local[kLocal];
+  double growth_local[kLocal];
   Tally::Fixed* fixed = kChannels > 0 ? fixed_local : fixed_.data();
   double* growth = kChannels > 0 ? growth_local : growth_.data();
-  double* lobe_growth = kChannels > 0 ? lobe_growth_local : lobe_growth_.data();
   book<kChannels>(weight, kCap, slot, fixed);
+  // The photon's total in its lobe: squared into the lobe's sum of squares
+  // once it is done there (a new lobe, or its end: end_photon).
   double* lobe_total = lobe_total_.data() + at;
-  // (A new lobe's total starts from 0 without being stored first: a store
-  // then load of the same numbers on every row would stall.)
-  const bool new_lobe = runs_.lobe(slot) != lobe_[i];
-  if (new_lobe) runs_.start(slot, lobe_[i]);
-  for (std::size_t c = 0; c < channels; ++c) {
-    const double w = weight[c * kCap];
-    const double t = new_lobe ? 0.0 : lobe_total[c];
-    lobe_growth[c] = w * (2.0 * t + w);
-    lobe_total[c] = t + w;
+  if (runs_.lobe(slot) != lobe_[i]) {
+    if (runs_.lobe(slot) >= 0) tally.score_lobe_total(runs_.lobe(slot), lobe_total);
+    runs_.start(slot, lobe_[i]);
+    for (std::size_t c = 0; c < channels; ++c) lobe_total[c] = 0.0;
   }
+  for (std::size_t c = 0; c < channels; ++c) lobe_total[c] += weight[c * kCap];
   if (double* total = runs_.find(slot, bin)) {
     for (std::size_t c = 0; c < channels; ++c) {
       const double w = weight[c * kCap];
       growth[c] = w * (2.0 * total[c] + w);
       total[c] += w;
     }
-    tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, false);
+    tally.score_exit_fixed<kChannels>(bin, fixed, growth, false);
     return;
   }
   runs_.append(slot, bin, weight, kCap);
@@ -371,7 +369,7 @@ void ExitScorer::score_scored_exit(const FinishedPhotons& f, int i, std::size_t 
     const double w = weight[c * kCap];
     growth[c] = w * w;
   }
-  tally.score_exit_fixed<kChannels>(bin, lobe_[i], fixed, growth, lobe_growth, true);
+  tally.score_exit_fixed<kChannels>(bin, fixed, growth, true);
 }
 
 }  // namespace fiberlab::sim

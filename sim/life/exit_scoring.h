@@ -48,21 +48,20 @@ class ExitScorer {
   // Per slot (sim/life/finished_photons.h), the photon in it so far: its
   // room in fixed point (1 plus what Russian roulette created for it, minus
   // what it booked, which is at most that) in a flat array ([slot][channel]);
-  // its total in its latest lobe ([slot][channel]) and in that lobe's bins
-  // (runs_).
+  // its total in its latest lobe ([slot][channel], squared into the lobe's
+  // sum of squares when it moves on or ends) and in that lobe's bins (runs_).
   std::vector<Tally::Fixed> room_;
   std::vector<double> lobe_total_;
   PhotonRuns runs_;
   std::vector<Tally::Fixed> fixed_;   // [channel]: one row's weight as booked
   std::vector<double> growth_;        // [channel]: one row's bin S2 growth
-  std::vector<double> lobe_growth_;   // [channel]: one row's lobe S2 growth
   void reserve_slots(const FinishedPhotons& f);
   template <int kChannels = 0>
   void book(const double* weight, std::size_t stride, std::uint32_t slot, Tally::Fixed* fixed);
   template <int kChannels>
   void score_scored_exit(const FinishedPhotons& f, int i, std::size_t bin, Tally& tally);
   void score_roulette(const FinishedPhotons& f, int i, Tally& tally);
-  void end_photon(std::uint32_t slot);
+  void end_photon(std::uint32_t slot, Tally& tally);
   void prefetch_row(const FinishedPhotons& f, int i, const std::size_t* bin, const Tally& tally) const;
   void score_rows_expected_value(const FinishedPhotons& f, const std::size_t* bin, Tally& tally);
   // The grid's edges are where block_bins' closed form puts them (to within

@@ -63,26 +63,28 @@ class Tally {
   // exits, its S1 already in fixed point (s1[c], booked so that the photon's
   // parts never exceed its unit weight: see ExitScorer), S2 growing by
   // s2_growth[c] (the growth of the square of the photon's total in the bin),
-  // the count by one when this is the photon's first exit in the bin, and
-  // the bin's lobe's sum of squares of photon totals by lobe_growth[c] (a
-  // photon may leave in several bins of a lobe, and the lobe's standard
-  // error needs the sum over photons of the square of its total there, not
-  // the sum of its bins' S2; the analog estimator books none: there each
-  // photon leaves once and the lobe's S2 is its bins' S2).
+  // and the count by one when this is the photon's first exit in the bin.
   // kChannels: channels(), when the caller knows it at compile time (0: not).
   template <int kChannels = 0>
-  void score_exit_fixed(std::size_t bin, int lobe_of_bin, const Fixed* s1, const double* s2_growth,
-                        const double* lobe_growth, bool first) {
+  void score_exit_fixed(std::size_t bin, const Fixed* s1, const double* s2_growth, bool first) {
     const int channels = kChannels > 0 ? kChannels : channels_;
     touched_[bin / kPageBins] = 1;
     Fixed* cell = cells() + bin * block_of(channels);
     cell[0] += first ? 1 : 0;
-    Fixed* lobe = lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels;
     for (int c = 0; c < channels; ++c) {
       cell[1 + c] += s1[c];
       cell[1 + channels + c] += to_fixed(s2_growth[c]);
-      lobe[c] += to_fixed(lobe_growth[c]);
     }
+  }
+  // Expected-value scoring: a photon's total[c] in `lobe`, once it is
+  // done there, added squared to the lobe's sum of squares of photon totals
+  // (a photon may leave in several bins of a lobe, and the lobe's standard
+  // error needs the sum over photons of the square of its total there, not
+  // the sum of its bins' S2; the analog estimator books none: there each
+  // photon leaves once and the lobe's S2 is its bins' S2).
+  void score_lobe_total(int lobe, const double* total) {
+    Fixed* sq = lobe_sq_.data() + static_cast<std::size_t>(lobe) * channels_;
+    for (int c = 0; c < channels_; ++c) sq[c] += to_fixed(total[c] * total[c]);
   }
   // A photon's truncated weight, already in fixed point.
   void score_truncated_fixed(const Fixed* weight) {
@@ -114,16 +116,15 @@ class Tally {
   }
   // The same for every cache line of the bin's cells (a 3-channel bin is
   // 112 bytes: half of them straddle three lines, whose middle one the two
-  // ends miss) and of its lobe's sum of squares (score_exit_fixed).
+  // ends miss).
   // Always inline: GCC 12 removes an out-of-line call to it (prefetches are
   // no effect it counts).
-  [[gnu::always_inline]] void prefetch_all(std::size_t bin, int lobe_of_bin) const {
+  [[gnu::always_inline]] void prefetch_all(std::size_t bin) const {
     const char* first = reinterpret_cast<const char*>(cells() + bin * block());
     const char* last = reinterpret_cast<const char*>(cells() + (bin + 1) * block()) - 1;
     __builtin_prefetch(first, 1);
     if (last - first >= 64) __builtin_prefetch(first + 64, 1);
     __builtin_prefetch(last, 1);
-    __builtin_prefetch(lobe_sq_.data() + static_cast<std::size_t>(lobe_of_bin) * channels_, 1);
   }
   // A photon still inside when it was stopped, with weight[c] left.
   void score_truncated(const double* weight);
@@ -198,7 +199,7 @@ class Tally {
   std::vector<Fixed> truncated_;
   std::vector<Fixed> lost_;
   std::vector<Fixed> roulette_;  // signed
-  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_exit_fixed's lobe_growth
+  std::vector<Fixed> lobe_sq_;   // [lobe][channel]: score_lobe_total's
 };
 
 }  // namespace fiberlab::sim
