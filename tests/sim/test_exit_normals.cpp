@@ -57,9 +57,14 @@
 //   3 x 2 bins; negative reported variances on 1 bin).
 // - ReducesRVariance: what the key is for, measured (not timed): case b's
 //   fiber (bench/configs/case_b.yaml, 4 lobes), 200,000 photons, the R
-//   lobe's summed SE^2 (channel 0) with exit_normals 8 at most 1/3 of that
-//   with 1 (a model of this fiber predicts ~6.7x, measured 6.5; sums over
-//   16,200 bins of 200,000 photons vary by a few percent).
+//   lobe's summed SE^2 (channel 0) with exit_normals 1 over that with 8.
+//   R's 8 exits at a first event are those of 8 independent first events,
+//   which divides the variance of its R score by 8 exactly; a photon's R
+//   exits at later events at its entry point are split over normals only,
+//   so a little less than 8 (measured 7.8). Accepted within [7.0, 8.8]: sums
+//   over 16,200 bins of 200,000 photons vary by a few percent, so the upper
+//   bound flags standard errors too small; the split in proportion to s_1
+//   at the first event too (measured 6.5, the lower bound).
 // - BatchedEqualsReference, ThreadsAgreeBitForBit: the batched tracer draws
 //   each extra normal from the same stream as the reference tracer
 //   (tests/sim/batched_vs_reference.h, photon by photon, row by
@@ -339,7 +344,8 @@ TEST(ExitNormals, ReducesRVariance) {
   for (int l = 0; l < 3; ++l) ratio[l] = lobe_se2_sum(one, l) / lobe_se2_sum(eight, l);
   std::printf("summed SE^2, exit_normals 1 / 8: R %.2f, TT %.2f, TRT %.2f\n", ratio[0], ratio[1],
               ratio[2]);
-  EXPECT_GE(ratio[0], 3.0);
+  EXPECT_GE(ratio[0], 7.0);
+  EXPECT_LE(ratio[0], 8.8);
 }
 
 // ---------------------------------------------------------------- batched, threads
