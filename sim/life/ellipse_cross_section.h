@@ -108,7 +108,10 @@ class EllipseCrossSection {
     pv = T(rv_) * fma(h, -gw, -(s * gv));
     pw = T(rw_) * fma(h, gv, -(s * gw));
   }
-  // beam_direction for one photon or a vector of them, each its own d.
+  // beam_direction for one photon or a vector of them, each its own d
+  // (exit splitting's extra entry points). beam_direction keeps Eigen's
+  // normalized(), which rounds differently in the last bit: the source's
+  // entry points, and so every run's numbers, stay as they are.
   template <class T>
   void beam_direction_of(const T& dv, const T& dw, T& gv, T& gw) const {
     using namespace life;

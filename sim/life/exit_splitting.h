@@ -194,14 +194,15 @@ struct ExtraNormalQueue {
 // A first event's K exits (lane l of `out`: entry 0 the photon's own, w s_1;
 // entries k >= 1 the shares s_k of K - 1 more first events, each at its own
 // entry point and normal) scored as K independent first events: w s_k / K
-// each. Unbiased: each is an expected-value score of a first event, whose
+// each, w = 1 (a photon's launch weight, which it still has at its first
+// event: ScoredExit::first). Unbiased: each is an expected-value score of a first event, whose
 // expectation over h and the normal is the bin's. Their total is not the
 // photon's own w s_1: the difference is weight the split created or
 // destroyed (out.created), booked with the photon's roulette term so that
 // its ledger still closes, and whose expectation is 0.
 template <int W>
-void resampled_weights(SplitExits<W>& out, int l, int normals, double w) {
-  const double per_event = w / normals;
+void resampled_weights(SplitExits<W>& out, int l, int normals) {
+  const double per_event = 1.0 / normals;
   double total = 0.0;
   const double own = out.weight[0][l];
   out.weight[0][l] = own / normals;
@@ -299,13 +300,12 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   // shares summed in the order of k, whatever order the pairs were drawn
   // in, so that S does not depend on the photon's neighbours in the
   // vector); a lane with one normal keeps its weight as it is.
-  alignas(64) double is_first[W], weight_in[W];
-  store(select(first, T(1.0), T(0.0)), is_first);
-  store(e.weight_in, weight_in);
+  alignas(64) double is_first[W];
+  store(e.first, is_first);
   for (int l = 0; l < W; ++l) {
     if (normals[l] < 2.0) continue;
     if (is_first[l] != 0.0) {
-      resampled_weights(out, l, static_cast<int>(normals[l]), weight_in[l]);
+      resampled_weights(out, l, static_cast<int>(normals[l]));
       continue;
     }
     double extra = 0.0;

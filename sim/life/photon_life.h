@@ -114,11 +114,9 @@ struct ScoredExit {
   T px, py, inside;
   T share;
   // 1 where the event is the photon's first (outside, at its entry point,
-  // no event there before: the photon's weight is its launch weight), whose
-  // split also draws the entry point (sim/life/exit_splitting.h); the
-  // photon's weight before the event.
+  // no event there before, so the photon still has its launch weight 1),
+  // whose split also draws the entry point (sim/life/exit_splitting.h).
   T first;
-  T weight_in;
 };
 
 template <class T, class Light>
@@ -146,7 +144,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -185,7 +183,6 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
     s.scored.px = s.px;
     s.scored.py = s.py;
     s.scored.inside = ones<T>(inside);
-    s.scored.weight_in = s.weight;
   }
   s.scored.d = r.leave_direction;
   s.scored.path = s.path;
