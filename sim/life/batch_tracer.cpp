@@ -261,11 +261,11 @@ void hand_over_event_rows(const life::PhotonState<Lanes, Light>& s, const life::
 // event's own normal (with the roulette term, and the end of a photon that
 // roulette ended), as the reference Tracer lists them. Returns where those
 // last rows start.
-// A first event (ScoredExit::first) splits even where its own normal's
-// branch did not leave: `split_only` are such lanes with nothing else to
-// hand over (no row of their own). The weight a first event's split created
-// or destroyed rides on its first extra row, as roulette, so that the
-// scorer widens the photon's room before booking the split's exits.
+// An event splits even where its own normal's branch did not leave:
+// `split_only` are such lanes with nothing else to hand over (no row of
+// their own). The weight a split created or destroyed rides on its first
+// extra row, as roulette, so that the scorer widens the photon's room
+// before booking the split's exits.
 template <class Model, class Light>
 int hand_over_scored(const life::LifeConfig& c, const Model& model, const life::PhotonState<Lanes, Light>& s,
                      const Lanes& phi_i, const life::BitsOf<Lanes>& photon,
@@ -493,7 +493,14 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         const std::uint64_t scored = life::lane_bits(
             live & ((s.scored.weight > Lanes(0.0)) | (s.scored.roulette != Lanes(0.0))));
         const std::uint64_t ended = life::lane_bits(live & (s.code == Lanes(double(life::kEnded))));
-        const std::uint64_t split_only = life::lane_bits(live & (s.scored.first != Lanes(0.0))) & ~scored;
+        // An event of a lobe with several normals splits even where its own
+        // branch did not leave (sim/life/exit_splitting.h).
+        const std::uint64_t split_only =
+            config_.most_exit_normals > 1
+                ? life::lane_bits(live & (s.scored.acted != Lanes(0.0)) &
+                                  (life::exit_normals_at(config_, s.scored.segments) > Lanes(1.0))) &
+                      ~scored
+                : 0;
         end_rows = finished & ~ended;
         if ((scored | split_only) != 0) {
           const int n_before =

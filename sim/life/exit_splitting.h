@@ -1,45 +1,42 @@
 #pragma once
-// Exit splitting (Settings::exit_normals; docs/PHYSICS.md "Estimator"), under
-// expected-value scoring (SPEC section 5). An event whose leaving branch was
-// scored, with weight w s_1 (s_1: that branch's leaving probability P_1
-// times its masking factor G1_1), spreads that weight over K leaving
-// directions: its own normal's, and those of K - 1 more normals drawn at the
-// same event from the same distribution (the roughness model's draw, for the
-// same direction and boundary frame). Normal k gets w s_1 s_k / S, with
-// S = s_1 + ... + s_K and s_k = P_k G1_k where normal k's leaving branch
-// leaves the fiber (SPEC section 3's consistency rule), 0 otherwise.
+// Exit splitting (Settings::exit_normals; docs/PHYSICS.md "Exit splitting"),
+// under expected-value scoring (SPEC section 5). At every interface event of
+// a lobe p with K = exit_normals[p] > 1, the exit the event scores is
+// estimated from K exits instead of one: the event's own normal's (its
+// leaving branch, scored w s_1 as with K = 1), and those of K - 1 more
+// normals drawn at the same event from the same distribution (the roughness
+// model's draw, for the same direction and boundary frame). Normal k's exit
+// is scored w s_k / K, with w the photon's weight before the event and
+// s_k = P_k G1_k (normal k's leaving probability times its masking factor)
+// where its leaving branch leaves the fiber (SPEC section 3's consistency
+// rule), 0 otherwise.
 //
-// - Unbiased: the K normals are exchangeable (independent, one
-//   distribution), so with f(j, k) = E[s_j s_k 1(b_k = b) / S] the sum over
-//   j and k is K E[s 1(b_1 = b)], and exchangeability makes it K times the
-//   sum over k of f(1, k), which is the split score of bin b: its
-//   expectation is E[s 1(b_1 = b)], the expected-value score of the bin.
-//   The photon's own normal must be one of the K, drawn as the others are.
-// - The photon's weight and path are those without splitting: the total it
-//   scores at the event is still w s_1, it goes on with w (1 - P_1) along
-//   its own normal, so the ledger closes per photon as before. The extra
-//   normals come from streams derived from the photon's (extra_normal_stream), not
-//   from its own.
+// - Unbiased: each of the K terms is 1 / K of an expected-value score of
+//   the event, since every normal has the distribution of the event's own
+//   given the photon's state before it. So an event splits whether or not
+//   its own leaving branch left (s_1 = 0): its extra normals' exits are part
+//   of the estimate. (Weights in proportion to s_1, w s_1 s_k / S, are
+//   unbiased too, by exchangeability, but they keep each event's total at
+//   w s_1, and score nothing where the own branch did not leave: the
+//   variance of which events score, and how much, stays. docs/PHYSICS.md
+//   gives the figures of merit of both.)
+// - The photon's path and weight are those without splitting: it goes on
+//   with w (1 - P_1) along its own normal (or as the analog choice where
+//   its leaving branch did not leave). The extra normals come from streams
+//   derived from the photon's (extra_normal_stream), not from its own.
+// - The ledger closes per photon: the event scores w (s_1 + ... + s_K) / K
+//   in total instead of the own w s_1; the difference is weight the split
+//   created (> 0) or destroyed (< 0), booked with the photon's roulette
+//   term (on the event's first extra row, so that the scorer widens the
+//   photon's room before booking the split's exits). Its expectation is 0.
+// - The photon's first event (outside, at its entry point, no event there
+//   before; ScoredExit::first) draws more: each extra normal also gets an
+//   impact parameter h uniform in [-1, 1) and its own entry point, so that
+//   the K are K independent first events. Where most of R's variance is
+//   that of h (which bins a given h can reach), this removes it.
 // - What it buys: where an event's roughness spreads its exit over many
 //   bins, the variance of those bins falls by up to K; the cost is K - 1
 //   normal draws and exit rows (the figure of merit per lobe: docs/PHYSICS.md).
-//
-// The photon's first event (outside, at its entry point, no event there
-// before; ScoredExit::first) splits differently: its K - 1 extra events
-// each draw an impact parameter h uniform in [-1, 1) and a normal at that
-// entry point, so that the K are K independent first events (the photon's
-// own among them), and each scores w s_k / K (resampled_weights), whether
-// or not the photon's own branch left. Unbiased: each term is 1 / K of an
-// expected-value score of a first event, whose expectation over h and the
-// normal is the bin's. Where most of R's remaining variance is that of h
-// (which bins a given h can reach), weights in proportion to s_1 would keep
-// it, since a photon's total there stays its own w s_1; this removes it.
-// The event's total is then w (s_1 + ... + s_K) / K, not the photon's own
-// w s_1, while the photon goes on with w (1 - P_1) as before: the
-// difference is weight the split created (> 0) or destroyed (< 0), booked
-// with the photon's roulette term (on its first extra row), so that each
-// photon's ledger still closes exactly and the roulette term keeps
-// expectation 0.
 // An extra normal whose draw gives up (a rejection sampler's cap, SPEC
 // section 3: never seen in practice) counts as s_k = 0; it does not
 // truncate the photon.
@@ -131,8 +128,8 @@ struct SplitExits {
   int n = 1;
   alignas(64) double dx[kMaxExitNormals][W], dy[kMaxExitNormals][W], dz[kMaxExitNormals][W];
   alignas(64) double weight[kMaxExitNormals][W];
-  // Per lane, the weight the split created (> 0) or destroyed (< 0) at a
-  // first event (resampled_weights), booked as the ledger's roulette term.
+  // Per lane, the weight the split created (> 0) or destroyed (< 0)
+  // (resampled_weights), booked as the ledger's roulette term.
   alignas(64) double created[W];
 };
 
@@ -191,32 +188,27 @@ struct ExtraNormalQueue {
   int n_pairs_ = 0, next_ = 0;
 };
 
-// A first event's K exits (lane l of `out`: entry 0 the photon's own, w s_1;
-// entries k >= 1 the shares s_k of K - 1 more first events, each at its own
-// entry point and normal) scored as K independent first events: w s_k / K
-// each, w = 1 (a photon's launch weight, which it still has at its first
-// event: ScoredExit::first). Unbiased: each is an expected-value score of a first event, whose
-// expectation over h and the normal is the bin's. Their total is not the
-// photon's own w s_1: the difference is weight the split created or
-// destroyed (out.created), booked with the photon's roulette term so that
-// its ledger still closes, and whose expectation is 0.
+// An event's K exits (lane l of `out`: entry 0 the photon's own, w s_1, or
+// 0 where its leaving branch did not leave; entries k >= 1 the shares s_k
+// of the extra normals) scored w s_k / K each, w = `weight_in`, the
+// photon's weight before the event. What their total adds to or takes from
+// the own w s_1 goes to out.created.
 template <int W>
-void resampled_weights(SplitExits<W>& out, int l, int normals) {
+void resampled_weights(SplitExits<W>& out, int l, int normals, double weight_in) {
   const double per_event = 1.0 / normals;
-  double total = 0.0;
   const double own = out.weight[0][l];
   out.weight[0][l] = own / normals;
-  total += out.weight[0][l];
+  double total = out.weight[0][l];
   for (int k = 1; k < normals; ++k) {
-    out.weight[k][l] *= per_event;
+    out.weight[k][l] = weight_in * out.weight[k][l] * per_event;
     total += out.weight[k][l];
   }
   out.created[l] = total - own;
 }
 
-// The scored exits e of a vector of photons (ScoredExit: this step's, with
-// their streams `rng` after the step) spread over c.exit_normals[lobe p]
-// normals each. The extra normals of all the lanes' splits are drawn a
+// The exits of the events of a vector of photons (ScoredExit: this step's,
+// with their streams `rng` after the step) estimated from
+// c.exit_normals[lobe p] normals each. The extra normals of all the lanes' splits are drawn a
 // vector at a time, whichever lanes they belong to, each from its own
 // stream (extra_normal_stream): a photon gets the same numbers traced alone
 // (T = double, the reference tracer) or in a vector. Scalar light only
@@ -230,14 +222,12 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   store(e.d.z, out.dz[0]);
   store(e.weight, out.weight[0]);
   for (double& x : out.created) x = 0.0;
-  // A first event splits whether or not its own normal's branch left.
-  const MaskOf<T> first = e.first != T(0.0);
-  const MaskOf<T> scored = (e.weight > T(0.0)) | first;
-  if (c.most_exit_normals == 1 || !any(scored)) return;
-  // The lanes' normals (1 where nothing was scored) and shares.
-  alignas(64) double normals[W], share[W];
-  store(select(scored, exit_normals_at(c, e.segments), T(1.0)), normals);
-  store(e.share, share);
+  // An event splits whether or not its own normal's branch left.
+  const MaskOf<T> acted = e.acted != T(0.0), first = e.first != T(0.0);
+  if (c.most_exit_normals == 1 || !any(acted)) return;
+  // The lanes' normals (1 where no event acted).
+  alignas(64) double normals[W];
+  store(select(acted, exit_normals_at(c, e.segments), T(1.0)), normals);
   const BitsOf<T> hash = split_hash(rng);
   for (int l = 0; l < W; ++l) out.n = std::max(out.n, static_cast<int>(normals[l]));
   for (int k = 1; k < out.n; ++k)
@@ -296,24 +286,10 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
       out.weight[k][l] = os[j];  // 0 where the draw gave up
     }
   }
-  // Normal k's weight w s_1 s_k / S (S >= s_1 > 0 where a lane scored; the
-  // shares summed in the order of k, whatever order the pairs were drawn
-  // in, so that S does not depend on the photon's neighbours in the
-  // vector); a lane with one normal keeps its weight as it is.
-  alignas(64) double is_first[W];
-  store(e.first, is_first);
-  for (int l = 0; l < W; ++l) {
-    if (normals[l] < 2.0) continue;
-    if (is_first[l] != 0.0) {
-      resampled_weights(out, l, static_cast<int>(normals[l]));
-      continue;
-    }
-    double extra = 0.0;
-    for (int k = 1; k < static_cast<int>(normals[l]); ++k) extra += out.weight[k][l];
-    const double scale = out.weight[0][l] / (share[l] + extra);
-    out.weight[0][l] = scale * share[l];
-    for (int k = 1; k < static_cast<int>(normals[l]); ++k) out.weight[k][l] *= scale;
-  }
+  alignas(64) double weight_in[W];
+  store(e.weight_in, weight_in);
+  for (int l = 0; l < W; ++l)
+    if (normals[l] >= 2.0) resampled_weights(out, l, static_cast<int>(normals[l]), weight_in[l]);
 }
 
 }  // namespace fiberlab::sim::life

@@ -106,16 +106,16 @@ struct ScoredExit {
   T medulla_path;  // 3D path length inside the medulla so far
   T scatters;      // scattering events in the medulla so far
   T roulette;      // signed weight of this step's Russian roulette, before absorption
-  // The event that scored it, for exit splitting (sim/life/exit_splitting.h;
-  // set only when it splits): the photon's direction before it, the boundary
-  // point, its side (1 inside), and the scored branch's share of the weight
-  // (its leaving probability times its masking factor; 0 where none was scored).
+  // The event, for exit splitting (sim/life/exit_splitting.h; set only when
+  // it splits): 1 where an interface event acted this step (it splits
+  // whether or not its own leaving branch left), the photon's direction and
+  // throughput weight before it, the boundary point and its side (1 inside).
+  T acted;
   Vec3Of<T> d_in;
+  T weight_in;
   T px, py, inside;
-  T share;
   // 1 where the event is the photon's first (outside, at its entry point,
-  // no event there before, so the photon still has its launch weight 1),
-  // whose split also draws the entry point (sim/life/exit_splitting.h).
+  // no event there before), whose split also draws the entry point.
   T first;
 };
 
@@ -144,7 +144,7 @@ PhotonState<T, Light> start_photon(const T& pv, const T& pw, const Vec3Of<T>& d,
                                    const LaneRandom<T>& rng) {
   const T zero(0.0);
   return {pv, pw, d, zero, zero, zero, zero, zero, T(1.0), T(double(kAtBoundary)), rng, Light(d), {},
-          zero, zero, {zero, d, zero, zero, zero, zero, zero, d, zero, zero, zero, zero, zero}};
+          zero, zero, {zero, d, zero, zero, zero, zero, zero, zero, d, zero, zero, zero, zero, zero}};
 }
 template <class Light>
 PhotonState<double, Light> start_photon(const Point2& p, const Vec3& d,
@@ -167,19 +167,17 @@ void score_leaving_branch(const Model& model, PhotonState<T, Light>& s, const Ev
                           const BoundaryFrame<T>& frame, const Vec3Of<T>& m,
                           const MaskOf<T>& inside, bool splits) {
   T exit_weight = select(r.scored, s.weight * r.p_leave, T(0.0));
-  T share = select(r.scored, r.p_leave, T(0.0));
   if constexpr (HasEventWeight<Model, T>) {
     // The leaving branch refracts when the photon is inside.
     const EventWeight<T> w =
         model.event_weight(EventGeometry<T>{s.d, r.leave_direction, m, frame, inside}, r.scored, s.rng);
     s.losses.add(r.scored & (w.factor < T(1.0)), exit_weight * (T(1.0) - w.factor), s.path);
     exit_weight = select(r.scored, select(w.lost, T(0.0), exit_weight * w.factor), T(0.0));
-    share = select(r.scored, select(w.lost, T(0.0), share * w.factor), T(0.0));
   }
   s.scored.weight = exit_weight;
   if (splits) {  // the event, for exit splitting (LifeConfig::most_exit_normals > 1)
-    s.scored.share = share;
     s.scored.d_in = s.d;
+    s.scored.weight_in = s.weight;
     s.scored.px = s.px;
     s.scored.py = s.py;
     s.scored.inside = ones<T>(inside);
@@ -228,8 +226,10 @@ MaskOf<T> interface_event(const LifeConfig& c, const Model& model, PhotonState<T
   if constexpr (kExpectedValue) {
     r = s.light.interact(s.d, f.m, index, act, s.rng, ExitScoring<T>{act, inside, n0});
     score_leaving_branch(model, s, r, frame, f.m, inside, c.most_exit_normals > 1);
-    if (c.exit_normals[0] > 1)  // R's split at the first event draws entry points too
+    if (c.most_exit_normals > 1) {
+      s.scored.acted = ones<T>(act);
       s.scored.first = ones<T>(act & !inside & (s.segments == T(0.0)) & (s.events_here == T(0.0)));
+    }
   } else {
     r = s.light.interact(s.d, f.m, index, act, s.rng);
   }

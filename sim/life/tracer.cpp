@@ -29,7 +29,7 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
     else
       step<false>(config_, model, s, true, counts, kMaxNormalTries);
     const bool own_row = s.scored.weight > 0.0 || s.scored.roulette != 0.0;
-    if (config_.expected_value && (own_row || s.scored.first != 0.0)) {
+    if (config_.expected_value && (own_row || s.scored.acted != 0.0)) {
       const int p = static_cast<int>(s.scored.segments);
       Vec3 d = s.scored.d.to_vec3();
       if (s.scored.weight > 0.0) {
@@ -37,8 +37,8 @@ PhotonOutcome Tracer::trace_with(const Model& model, const Vec3& wi, double h, P
         d = exit_direction_of(model, d, p, blur);
       }
       // Exit splitting: the extra normals' exits first (the first carrying
-      // what a first event's split created), the event's own (with the
-      // roulette term) last, as the batched tracer hands them over.
+      // what the split created), the event's own (with the roulette term)
+      // last, as the batched tracer hands them over.
       life::SplitExits<1> split;
       life::split_scored_exits(config_, model, s.scored, s.rng, split);
       for (int k = 1; k < split.n; ++k) {
