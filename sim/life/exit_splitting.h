@@ -208,8 +208,8 @@ void resampled_weights(SplitExits<W>& out, int l, int normals, double weight_in)
 
 // The exits of the events of a vector of photons (ScoredExit: this step's,
 // with their streams `rng` after the step) estimated from
-// c.exit_normals[lobe p] normals each. The extra normals of all the lanes' splits are drawn a
-// vector at a time, whichever lanes they belong to, each from its own
+// c.exit_normals[lobe p] normals each. The extra normals of all the lanes'
+// splits are drawn a vector at a time, whichever lanes they belong to, each from its own
 // stream (extra_normal_stream): a photon gets the same numbers traced alone
 // (T = double, the reference tracer) or in a vector. Scalar light only
 // (Settings refuses exit_normals > 1 with Stokes light).
