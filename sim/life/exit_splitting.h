@@ -17,9 +17,9 @@
 //   its own leaving branch left (s_1 = 0): its extra normals' exits are part
 //   of the estimate. (Weights in proportion to s_1, w s_1 s_k / S, are
 //   unbiased too, by exchangeability, but they keep each event's total at
-//   w s_1, and score nothing where the own branch did not leave: the
-//   variance of which events score, and how much, stays. docs/PHYSICS.md
-//   gives the figures of merit of both.)
+//   the own w s_1: nothing where the own branch did not leave, all of it
+//   where it did. That variance stays however large K is; the mean over
+//   the K normals averages it out.)
 // - The photon's path and weight are those without splitting: it goes on
 //   with w (1 - P_1) along its own normal (or as the analog choice where
 //   its leaving branch did not leave). The extra normals come from streams
