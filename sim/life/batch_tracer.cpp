@@ -497,9 +497,7 @@ void BatchTracer::trace_with(const Model& model, double theta_i, double phi_i,
         // branch did not leave (sim/life/exit_splitting.h).
         const std::uint64_t split_only =
             config_.most_exit_normals > 1
-                ? life::lane_bits(live & (s.scored.acted != Lanes(0.0)) &
-                                  (life::exit_normals_at(config_, s.scored.segments) > Lanes(1.0))) &
-                      ~scored
+                ? life::lane_bits(live & (life::normals_of_event(config_, s.scored) > Lanes(1.0))) & ~scored
                 : 0;
         end_rows = finished & ~ended;
         if ((scored | split_only) != 0) {

@@ -143,6 +143,14 @@ T exit_normals_at(const LifeConfig& c, const T& p) {
   return k;
 }
 
+// Per lane, the normals its event's exit is estimated from: exit_normals[p]
+// where an interface event acted (whether or not its own branch left), 1
+// where none did. The lanes above 1 split (split_scored_exits).
+template <class T>
+T normals_of_event(const LifeConfig& c, const ScoredExit<T>& e) {
+  return select(e.acted != T(0.0), exit_normals_at(c, e.segments), T(1.0));
+}
+
 // The extra normals still to draw, as (lane l, k) pairs, k = 1 ..
 // normals[l] - 1, lane by lane, and the vector of W of them being drawn: a
 // pair keeps its vector lane (its event, stream and candidate count) until
@@ -222,12 +230,12 @@ void split_scored_exits(const LifeConfig& c, const Model& model, const ScoredExi
   store(e.d.z, out.dz[0]);
   store(e.weight, out.weight[0]);
   for (double& x : out.created) x = 0.0;
-  // An event splits whether or not its own normal's branch left.
-  const MaskOf<T> acted = e.acted != T(0.0), first = e.first != T(0.0);
-  if (c.most_exit_normals == 1 || !any(acted)) return;
-  // The lanes' normals (1 where no event acted).
+  if (c.most_exit_normals == 1) return;
+  const T lane_normals = normals_of_event(c, e);
+  if (!any(lane_normals > T(1.0))) return;
   alignas(64) double normals[W];
-  store(select(acted, exit_normals_at(c, e.segments), T(1.0)), normals);
+  store(lane_normals, normals);
+  const MaskOf<T> first = e.first != T(0.0);
   const BitsOf<T> hash = split_hash(rng);
   for (int l = 0; l < W; ++l) out.n = std::max(out.n, static_cast<int>(normals[l]));
   for (int k = 1; k < out.n; ++k)
